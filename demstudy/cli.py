@@ -1,0 +1,132 @@
+"""Command line: ``demstudy validate | deck | run | plot | calibrate``.
+
+All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
+(otherwise a wall speed or the shear rate sets the time scale).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .scene import SceneError, load_scene
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    failed = 0
+    for path in args.scenes:
+        try:
+            scene = load_scene(path, args.set)
+        except SceneError as exc:
+            print(exc, file=sys.stderr)
+            failed += 1
+            continue
+        print(f"ok: {path} ({scene.dimension}D, {scene.n_particles} particles, "
+              f"solid fraction {scene.solid_fraction:.4g})")
+    return 1 if failed else 0
+
+
+def _cmd_deck(args: argparse.Namespace) -> int:
+    from .decks import write_deck
+
+    scene = load_scene(args.scene, args.set)
+    path = write_deck(scene, args.out, dump=args.dump)
+    print(f"wrote {path} (run it with: cd {path.parent} && lmp -in {path.name})")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from .engines.base import RunOptions, get_engine
+
+    scene = load_scene(args.scene, args.set)
+    out = Path(args.out or Path("results") / f"{Path(args.scene).stem}-{args.engine}.h5")
+    options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
+                         progress=not args.quiet, keep_frames=args.keep_frames or None)
+    path = get_engine(args.engine).run(scene, options)
+    print(f"results: {path}")
+    return 0
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from .plot import plot_profiles
+
+    print(f"figure: {plot_profiles(args.results, args.out)}")
+    return 0
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from .contact import calibrate as cal
+
+    rows = cal.calibrate(dim=args.dim, kind=args.kind, e=args.e, beta=args.beta,
+                         K=args.K if args.K is not None else (0.5 if args.dim == 2 else 0.4),
+                         kn=args.kn, steps_per_contact=args.steps,
+                         speeds=args.speeds, angles=args.angles)
+    print(cal.format_table(rows))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="demstudy",
+        description="Rapid granular shear flows from one scene file (units: d = m = 1, g = 1).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    overrides = argparse.ArgumentParser(add_help=False)
+    overrides.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                           help="override a scene value, e.g. --set run.production=20")
+
+    p = sub.add_parser("validate", parents=[overrides], help="check scene files")
+    p.add_argument("scenes", nargs="+")
+    p.set_defaults(func=_cmd_validate)
+
+    p = sub.add_parser("deck", parents=[overrides], help="write the LAMMPS deck of a scene")
+    p.add_argument("scene")
+    p.add_argument("-o", "--out", default="deck", help="output folder (default: ./deck)")
+    p.add_argument("--dump", help="add a custom dump of the particles to this file")
+    p.set_defaults(func=_cmd_deck)
+
+    p = sub.add_parser("run", parents=[overrides], help="run a scene")
+    p.add_argument("scene")
+    p.add_argument("--engine", default="lammps", choices=["lammps"])
+    p.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
+    p.add_argument("--out", help="results file (default results/<scene>-<engine>.h5)")
+    p.add_argument("--dump", type=Path, help="also write a LAMMPS custom dump of the samples")
+    p.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
+    p.add_argument("--keep-frames", action="store_true", help="store every sampled frame")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_run)
+
+    p = sub.add_parser("plot", help="plot profiles of one or more results files")
+    p.add_argument("results", nargs="+")
+    p.add_argument("-o", "--out", default="profiles.png")
+    p.set_defaults(func=_cmd_plot)
+
+    p = sub.add_parser("calibrate", help="measure e, beta, t_c of binary collisions in LAMMPS")
+    p.add_argument("--dim", type=int, choices=[2, 3], default=3)
+    p.add_argument("--kind", choices=["pair", "wall"], default="pair")
+    p.add_argument("--e", type=float, default=0.8)
+    p.add_argument("--beta", type=float, default=0.5)
+    p.add_argument("--K", type=float, default=None, help="reduced inertia (default disc/sphere)")
+    p.add_argument("--kn", type=float, default=1e5)
+    p.add_argument("--steps", type=float, default=200.0, help="steps per contact")
+    p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0, 2.0])
+    p.add_argument("--angles", type=float, nargs="+", default=[0.0, 30.0, 60.0])
+    p.set_defaults(func=_cmd_calibrate)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    from .decks.base import UnsupportedByEngine
+    from .engines.base import EngineError
+
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (SceneError, UnsupportedByEngine, EngineError, ValueError, OSError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2 if isinstance(exc, SceneError | UnsupportedByEngine) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,121 @@
+"""Contact model of a scene: pair and wall parameters, stiffness and time step.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. Stiffness k_n is in
+m v_ref²/d² where v_ref is the scene's reference speed (see ``reference_speed``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..contact import mapping
+from ..scene import Scene
+from ..scene.schema import Wall
+from .base import Block, UnsupportedByEngine
+
+#: Default hardness: at most this overlap (in d) at the reference speed.
+DEFAULT_OVERLAP = 0.005
+
+
+def reference_speed(scene: Scene) -> float:
+    """Typical impact speed: √(g H) under gravity (H = particle-bed height or box), the wall
+    speed in Couette flow, rate × Ly/2 under shear, √T for a free gas; never below 1e-3."""
+    speeds = [abs(w.velocity) for w in scene.walls]
+    if scene.gravity is not None:
+        height = scene.box.size[1]
+        if scene.initial.placement == "lattice":
+            height = scene.initial.rows * scene.initial.spacing
+        speeds.append(math.sqrt(scene.gravity.magnitude * min(height, 50.0)))
+    if scene.shear is not None:
+        speeds.append(scene.shear.rate * scene.box.size[1] / 2)
+    v = scene.initial.velocity
+    speeds += [abs(v.scale), math.sqrt(v.temperature)]
+    return max(max(speeds), 1e-3)
+
+
+@dataclass(frozen=True)
+class ContactSetup:
+    pair: mapping.ContactParameters
+    walls: dict[str, mapping.ContactParameters]
+    timestep: float
+    kn: float
+
+
+def _rule(rule) -> dict:
+    if rule.model == "smooth":
+        return {}
+    if rule.model in ("beta", "rough"):
+        return {"beta": rule.beta}
+    if rule.model == "coulomb":
+        return {"mu": rule.mu, "beta0": rule.beta0}
+    raise UnsupportedByEngine(
+        "lammps", "walls.tangential.model", rule.model,
+        "Campbell's no-slip wall (centre takes the wall velocity, spin unchanged) has no "
+        "soft-contact equivalent; use model = 'rough' or run it with --engine edmd",
+    )
+
+
+def choose_stiffness(scene: Scene, e: float, m_eff: float) -> float:
+    soft = scene.soft
+    if soft.stiffness is not None:
+        return soft.stiffness
+    h = soft.hardness
+    if h is None:
+        return mapping.hooke_kn_for_overlap(DEFAULT_OVERLAP, reference_speed(scene), m_eff, e)
+    if h.overlap is not None:
+        if soft.model == "hertz":
+            return mapping.hertz_kn_for_overlap(h.overlap, h.impact_speed, m_eff, 0.25, e)
+        return mapping.hooke_kn_for_overlap(h.overlap, h.impact_speed, m_eff, e)
+    if h.k_star is not None:
+        if scene.shear is None:
+            raise UnsupportedByEngine("lammps", "soft.hardness.k_star", h.k_star,
+                                      "k* = k/(ρ d³ γ̇²) needs a shear rate ([shear])")
+        return mapping.kn_from_kstar(h.k_star, scene.shear.rate, 1.0, scene.dimension)
+    return mapping.kn_from_kappa(h.kappa, h.pressure, scene.dimension)
+
+
+def contact_setup(scene: Scene) -> ContactSetup:
+    """Pair (m_eff = m/2) and per-wall (m_eff = m) contacts with a common time step."""
+    if scene.contact.law.model != "constant":
+        raise UnsupportedByEngine(
+            "lammps", "contact.law.model", scene.contact.law.model,
+            "LAMMPS granular contacts have a constant restitution; use --engine edmd",
+        )
+    K, e, model = scene.inertia_k, scene.contact.restitution, scene.soft.model
+    kn = choose_stiffness(scene, e, 0.5)
+    speed = reference_speed(scene)
+    extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
+    if K == 0 and scene.contact.tangential.model != "smooth":
+        raise UnsupportedByEngine("lammps", "particles.inertia", 0,
+                                  "point masses (K = 0) cannot carry a tangential contact")
+    pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
+                                **_rule(scene.contact.tangential), **extra)
+    walls = {w.side: _wall_contact(w, kn, K, model, speed) for w in scene.walls}
+    steps = scene.soft.steps_per_contact
+    dt = min([pair.timestep(steps)] + [c.timestep(steps) for c in walls.values()])
+    return ContactSetup(pair, walls, dt, kn)
+
+
+def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float):
+    extra = {"r_eff": 0.5, "speed": speed} if model == "hertz" else {}
+    return mapping.make_contact(kn=kn, e=wall.restitution, m_eff=1.0, K=K, model=model,
+                                **_rule(wall.tangential), **extra)
+
+
+def pair_block(scene: Scene, setup: ContactSetup) -> Block:
+    p = setup.pair
+    cmds = ["pair_style granular", f"pair_coeff * * {p.granular_args()}"]
+    if any(w.kind == "bumpy" for w in scene.walls):
+        # bump particles (type 2) collide with the wall's rule and m_eff = m (they are heavy)
+        wall = next(w for w in scene.walls if w.kind == "bumpy")
+        cmds.append(f"pair_coeff 1 2 {setup.walls[wall.side].granular_args()}")
+        cmds.append("pair_coeff 2 2 " + p.granular_args())  # unused: excluded below
+        cmds.append("neigh_modify exclude type 2 2")
+    cmds += ["neighbor 0.3 bin", "neigh_modify delay 0 every 1 check yes"]
+    comment = (
+        f"{p.model} contacts, k_n = {p.kn:.6g}, e = {p.restitution:g}, "
+        f"t_c = {p.contact_time:.6g} (m_eff = m/2)"
+        + ("" if p.tangential == "none" else f", k_t = {p.kt:.6g}, {p.tangential} tangential")
+    )
+    return Block("contact", comment, cmds)

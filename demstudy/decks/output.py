@@ -1,0 +1,48 @@
+"""Sampling computes and the bare deck's run commands (time in the scene's units)."""
+
+from __future__ import annotations
+
+import math
+
+from ..scene import Scene
+from .base import Block
+from .contact import ContactSetup
+from .walls import wall_fix_id
+
+
+def sampling_block(scene: Scene) -> Block:
+    cmds = ["compute ke mobile ke"]
+    columns = ["step", "time", "c_ke"]
+    if scene.rotation_matters:
+        cmds.append("compute erot mobile erotate/sphere")
+        columns.append("c_erot")
+    for wall in scene.walls:
+        fid = wall_fix_id(wall.side)
+        columns += [f"c_{fid}_force[{i}]" for i in range(1, scene.dimension + 1)]
+    cmds.append("thermo_style custom " + " ".join(columns))
+    cmds.append("thermo_modify norm no lost error")
+    return Block("sampling", "energies (translational, rotational) and wall forces", cmds)
+
+
+def steps(duration: float, dt: float) -> int:
+    return max(0, math.ceil(duration / dt - 1e-9))
+
+
+def run_block(scene: Scene, setup: ContactSetup, dump: str | None = None) -> Block:
+    """Commands that make the deck runnable with ``lmp -in deck.in`` (no Python needed)."""
+    dt = setup.timestep
+    n_sample = max(1, round(scene.run.sample_interval / dt))
+    cmds = [f"thermo {n_sample}"]
+    if dump:
+        cmds.append(
+            f"dump frames mobile custom {n_sample} {dump} id type radius x y z vx vy vz "
+            "omegax omegay omegaz"
+        )
+        cmds.append("dump_modify frames sort id")
+    eq, prod = steps(scene.run.equilibration, dt), steps(scene.run.production, dt)
+    if eq:
+        cmds.append(f"run {eq}  # equilibration: {scene.run.equilibration:g} time units")
+    cmds.append("reset_timestep 0 time 0.0" if eq else "# (no equilibration)")
+    cmds.append(f"run {prod}  # production: {scene.run.production:g} time units")
+    return Block("run", f"bare-deck runs, dt = {dt:.6g}, thermo every {n_sample} steps",
+                 cmds, stage="run")

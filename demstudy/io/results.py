@@ -1,0 +1,90 @@
+"""The results file: one HDF5 layout for every engine (see docs/results-format.md).
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
+or the shear rate sets the time scale); the root attribute ``units`` says so in every file.
+Writes are atomic: the file is written under a temporary name and renamed into place.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from .. import UNITS_NOTE, __version__
+
+FORMAT_VERSION = 1
+
+
+@dataclass
+class Results:
+    """In-memory content of a results file."""
+
+    attrs: dict[str, Any]
+    timeseries: dict[str, np.ndarray] = field(default_factory=dict)
+    profiles: dict[str, np.ndarray] = field(default_factory=dict)
+    profile_attrs: dict[str, Any] = field(default_factory=dict)
+    frames: dict[str, np.ndarray] | None = None
+    groups: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+
+
+def _write_group(group: h5py.Group, data: Mapping[str, Any], attrs: Mapping[str, Any] = {}) -> None:
+    for name, value in data.items():
+        arr = np.asarray(value)
+        kwargs = {"compression": "gzip", "compression_opts": 4} if arr.size > 4096 else {}
+        group.create_dataset(name, data=arr, **kwargs)
+    for key, value in attrs.items():
+        group.attrs[key] = value
+
+
+def write_results(path: str | os.PathLike, results: Results) -> Path:
+    """Write ``results`` to ``path`` atomically (temp file in the same folder, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        with h5py.File(tmp, "w") as f:
+            attrs = {
+                "format_version": FORMAT_VERSION,
+                "demstudy_version": __version__,
+                "units": UNITS_NOTE,
+                "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+                **results.attrs,
+            }
+            for key, value in attrs.items():
+                f.attrs[key] = value
+            _write_group(f.create_group("timeseries"), results.timeseries)
+            if results.profiles:
+                _write_group(f.create_group("profiles"), results.profiles, results.profile_attrs)
+            if results.frames:
+                _write_group(f.create_group("frames"), results.frames)
+            for name, data in results.groups.items():
+                _write_group(f.require_group(name), data)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def read_results(path: str | os.PathLike) -> Results:
+    """Read a results file written by any engine."""
+    with h5py.File(path, "r") as f:
+        def load(name: str) -> dict[str, np.ndarray]:
+            return {k: v[()] for k, v in f[name].items()} if name in f else {}
+
+        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        res = Results(attrs=attrs, timeseries=load("timeseries"), profiles=load("profiles"),
+                      frames=load("frames") or None)
+        if "profiles" in f:
+            res.profile_attrs = dict(f["profiles"].attrs)
+        for name in f:
+            if name not in ("timeseries", "profiles", "frames"):
+                res.groups[name] = load(name)
+    return res

@@ -1,0 +1,38 @@
+"""Strict pydantic base model: unknown keys are rejected with the nearest valid name."""
+
+from __future__ import annotations
+
+import difflib
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, model_validator
+
+
+def nearest(name: str, allowed: list[str]) -> str | None:
+    """The allowed name closest to ``name`` (None when nothing is close)."""
+    found = difflib.get_close_matches(name, allowed, n=1, cutoff=0.5)
+    return found[0] if found else None
+
+
+class StrictModel(BaseModel):
+    """Base of every scene section: frozen, no unknown keys, helpful messages."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _reject_unknown_keys(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        allowed = sorted(cls.model_fields)
+        problems = []
+        for key in data:
+            if key in cls.model_fields:
+                continue
+            hint = nearest(str(key), allowed)
+            text = f"unknown key {key!r}"
+            text += f"; did you mean {hint!r}?" if hint else ""
+            problems.append(text + f" (allowed: {', '.join(allowed)})")
+        if problems:
+            raise ValueError("; ".join(problems))
+        return data

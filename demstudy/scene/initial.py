@@ -1,0 +1,228 @@
+"""Initial particle states built from a scene, identical for every engine.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. Deterministic for a
+given ``run.seed``. Centres are kept at least ``MARGIN`` inside walls and box faces, because
+some engines (LIGGGHTS) crash on particles lying exactly on a boundary.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .scene import Scene
+
+MARGIN = 1e-3
+#: Campbell's (1982) 7th-order least-squares fit to a chute velocity profile, F(y/H).
+CAMPBELL_CHUTE_FIT = (0.2018029, 3.5299215, -15.2262754, 47.4364204, -88.1786499,
+                      93.5828476, -51.8336868, 11.4877520)
+
+
+@dataclass
+class InitialState:
+    position: np.ndarray  # (N, dim)
+    velocity: np.ndarray  # (N, dim)
+    angular_velocity: np.ndarray  # (N, 1) in 2D, (N, 3) in 3D
+    diameter: np.ndarray  # (N,)
+
+    @property
+    def mass(self) -> np.ndarray:
+        return self.diameter ** self.position.shape[1]
+
+
+def y_range(scene: Scene) -> tuple[float, float]:
+    """The interval available to particle centres along y."""
+    if scene.y_periodic:
+        return 0.0, scene.box.size[1]
+    lo = scene.wall_position("lower") + 0.5 + MARGIN
+    hi = (scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]) - 0.5 - MARGIN
+    return lo, hi
+
+
+def build_initial_state(scene: Scene) -> InitialState:
+    rng = np.random.default_rng(scene.run.seed)
+    dim, n = scene.dimension, scene.n_particles
+    spread = scene.particles.diameter_spread
+    diameter = 1.0 + spread * (rng.random(n) - 0.5) if spread > 0 else np.ones(n)
+    init = scene.initial
+    if init.placement == "lattice":
+        position = _campbell_lattice(scene, rng)
+    elif init.placement == "file":
+        position, velocity = _from_file(scene)
+    else:
+        position = _random_placement(scene, rng, d_max=1.0 + spread / 2)
+    if init.placement != "file" or velocity is None:
+        velocity = _velocity_profile(scene, position, rng)
+    spin_dofs = 1 if dim == 2 else 3
+    angular = np.zeros((n, spin_dofs))
+    temperature = init.velocity.temperature
+    if temperature > 0:
+        mass = diameter**dim
+        noise = rng.normal(size=(n, dim)) * np.sqrt(temperature / mass)[:, None]
+        velocity = velocity + noise - noise.mean(axis=0)
+        inertia = scene.inertia_k * mass * diameter**2 / 4
+        if scene.rotation_matters and scene.inertia_k > 0:
+            angular = rng.normal(size=(n, spin_dofs)) * np.sqrt(temperature / inertia)[:, None]
+    return InitialState(position, velocity, angular, diameter)
+
+
+def _campbell_lattice(scene: Scene, rng: np.random.Generator) -> np.ndarray:
+    """Campbell's COL007: square (cubic) lattice jittered by at most the gap (s − 1)/2."""
+    init, dim = scene.initial, scene.dimension
+    s = init.spacing
+    layers = (init.layers or 1) if dim == 3 else 1
+    cols, rows, deps = np.meshgrid(
+        np.arange(init.columns), np.arange(init.rows), np.arange(layers), indexing="ij"
+    )
+    lower = 0.0 if scene.y_periodic else scene.wall_position("lower")
+    pos = [s / 2 + s * cols.ravel(), lower + s / 2 + s * rows.ravel()]
+    if dim == 3:
+        pos.append(s / 2 + s * deps.ravel())
+    position = np.stack(pos, axis=1)
+    if init.jitter:
+        gap = (s - 1.0) / 2 - MARGIN / 2
+        position += gap * rng.uniform(-1.0, 1.0, size=position.shape)
+    # order by row then column, as Campbell numbered his particles
+    order = np.lexsort([position[:, 0], np.round(position[:, 1] / s)])
+    return position[order]
+
+
+def _random_placement(scene: Scene, rng: np.random.Generator, d_max: float) -> np.ndarray:
+    """Random non-overlapping centres: random sequential addition when dilute, otherwise a
+    random subset of a close-packed lattice (hexagonal / fcc), jittered within its gaps."""
+    dim, n = scene.dimension, scene.n_particles
+    lo_y, hi_y = y_range(scene)
+    lo = np.array([0.0, lo_y] + ([0.0] if dim == 3 else []))
+    hi = np.array([scene.box.size[0], hi_y] + ([scene.box.size[2]] if dim == 3 else []))
+    periodic = np.array([True, scene.y_periodic] + ([True] if dim == 3 else []))
+    rsa_limit = 0.30 if dim == 3 else 0.42
+    if scene.solid_fraction < rsa_limit:
+        found = _sequential_addition(n, lo, hi, periodic, d_max, rng)
+        if found is not None:
+            return found
+    return _lattice_subset(n, lo, hi, periodic, d_max, rng)
+
+
+def _sequential_addition(n, lo, hi, periodic, d_max, rng, max_tries: int = 200) -> np.ndarray | None:
+    lengths = hi - lo
+    accepted = np.empty((0, len(lo)))
+    remaining = n
+    for _ in range(max_tries):
+        trial = lo + rng.random((max(2 * remaining, 64), len(lo))) * lengths
+        # accept greedily among the batch, then against the already accepted set
+        keep = []
+        tree_box = np.where(periodic, lengths, 1e12)
+        shifted = trial - lo
+        tree_old = cKDTree(accepted - lo, boxsize=tree_box) if len(accepted) else None
+        tree_new = cKDTree(shifted, boxsize=tree_box)
+        clash = set()
+        for i, j in tree_new.query_pairs(d_max):
+            clash.add(max(i, j))
+        for i in range(len(trial)):
+            if i in clash:
+                continue
+            if tree_old is not None and tree_old.query_ball_point(shifted[i], d_max):
+                continue
+            keep.append(i)
+            if len(keep) == remaining:
+                break
+        accepted = np.vstack([accepted, trial[keep]])
+        remaining = n - len(accepted)
+        if remaining == 0:
+            return accepted
+    return None
+
+
+def _lattice_subset(n, lo, hi, periodic, d_max, rng) -> np.ndarray:
+    dim = len(lo)
+    lengths = hi - lo
+    # shrink the nearest-neighbour distance until the lattice holds n sites (never below d_max)
+    for a in np.geomspace(3.0 * d_max, d_max * (1 + 1e-6), 400):
+        sites = _close_packed(a, lengths, periodic)
+        if len(sites) >= n:
+            break
+    else:
+        raise ValueError(
+            f"cannot place {n} particles of diameter {d_max:g} without overlap in the box"
+        )
+    chosen = sites[rng.choice(len(sites), size=n, replace=False)]
+    gap = max(0.0, (a - d_max) / 2 - 1e-9)
+    jitter = rng.uniform(-1, 1, size=chosen.shape) * gap / math.sqrt(dim)
+    out = chosen + jitter
+    # keep bounded axes inside
+    for ax in range(dim):
+        if not periodic[ax]:
+            out[:, ax] = np.clip(out[:, ax], 0.0, lengths[ax])
+    return lo + np.where(periodic, np.mod(out, lengths), out)
+
+
+def _close_packed(a: float, lengths: np.ndarray, periodic: np.ndarray) -> np.ndarray:
+    """Hexagonal (2D) or fcc (3D) sites with nearest-neighbour distance ≥ a in the region."""
+    dim = len(lengths)
+    if dim == 2:
+        cell = np.array([a, a * math.sqrt(3)])
+        basis = np.array([[0.0, 0.0], [0.5, 0.5]])
+    else:
+        cell = np.full(3, a * math.sqrt(2))
+        basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]], float)
+    counts = []
+    for ax in range(dim):
+        if periodic[ax]:
+            counts.append(int(math.floor(lengths[ax] / cell[ax] + 1e-12)))
+        else:
+            counts.append(int(math.floor(lengths[ax] / cell[ax])) + 1)
+    if min(counts) < 1:
+        return np.empty((0, dim))
+    grids = np.meshgrid(*[np.arange(c) for c in counts], indexing="ij")
+    origins = np.stack([g.ravel() for g in grids], axis=1).astype(float)
+    sites = (origins[:, None, :] + basis[None, :, :]).reshape(-1, dim) * cell
+    inside = np.all((sites <= lengths + 1e-12) | periodic, axis=1)
+    return sites[inside]
+
+
+def _from_file(scene: Scene) -> tuple[np.ndarray, np.ndarray | None]:
+    dim, path = scene.dimension, Path(scene.initial.path)
+    data = np.atleast_2d(np.loadtxt(path))
+    if data.shape[1] not in (dim, 2 * dim):
+        raise ValueError(
+            f"initial.path = {str(path)!r}: expected {dim} or {2 * dim} columns, got {data.shape[1]}"
+        )
+    if len(data) != scene.n_particles:
+        raise ValueError(
+            f"initial.path = {str(path)!r}: {len(data)} rows but the scene has "
+            f"{scene.n_particles} particles"
+        )
+    velocity = data[:, dim:] if data.shape[1] == 2 * dim else None
+    return data[:, :dim].copy(), velocity
+
+
+def _velocity_profile(scene: Scene, position: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    v = scene.initial.velocity
+    n, dim = position.shape
+    velocity = np.zeros((n, dim))
+    y = position[:, 1]
+    if v.profile == "uniform":
+        u = np.full(n, v.scale)
+    elif v.profile == "campbell-chute":
+        init = scene.initial
+        height = (init.spacing * init.rows - init.spacing / 2) if init.spacing else y.max()
+        z = (y - scene.wall_position("lower")) / height
+        u = np.polynomial.polynomial.polyval(z, CAMPBELL_CHUTE_FIT) * v.scale
+    elif v.profile == "linear":
+        if scene.shear is not None:
+            u = scene.shear.rate * (y - scene.box.size[1] / 2)
+        else:
+            lo, hi = scene.wall_position("lower"), scene.wall_position("upper")
+            u_lo, u_hi = scene.wall("lower").velocity, scene.wall("upper").velocity
+            u = u_lo + (u_hi - u_lo) * (y - lo) / (hi - lo)
+    else:
+        u = np.zeros(n)
+    velocity[:, 0] = u
+    if v.perturbation > 0:
+        kick = rng.uniform(-1.0, 1.0, size=(n, dim)) * v.perturbation * np.abs(u)[:, None]
+        velocity += kick
+    return velocity

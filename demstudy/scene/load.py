@@ -1,0 +1,196 @@
+"""Read, override and validate scene files; every problem becomes one ``SceneError``."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from .base import nearest
+from .scene import Scene
+
+
+class SceneError(ValueError):
+    """Invalid scene: the message names each field, its value and what is allowed."""
+
+    def __init__(self, source: str, problems: list[str]):
+        self.source = source
+        self.problems = problems
+        lines = "\n".join(f"  - {p}" for p in problems)
+        super().__init__(f"invalid scene {source}:\n{lines}")
+
+
+def _location(loc: tuple) -> str:
+    parts: list[str] = []
+    for item in loc:
+        if isinstance(item, int):
+            parts[-1:] = [f"{parts[-1]}[{item}]"] if parts else [f"[{item}]"]
+        elif item in ("smooth", "beta", "rough", "coulomb", "campbell-noslip"):
+            continue  # discriminated-union tag: not a key the user wrote
+        elif isinstance(item, str) and ("[" in item or "|" in item or item.startswith("function")):
+            continue  # pydantic's internal union-member labels
+        else:
+            parts.append(str(item))
+    return ".".join(parts) or "(top level)"
+
+
+def _describe(error: dict) -> str:
+    where = _location(error.get("loc", ()))
+    message = error.get("msg", "invalid").removeprefix("Value error, ")
+    value = error.get("input")
+    kind = error.get("type", "")
+    if kind == "missing":
+        return f"{where}: required field is missing"
+    if kind == "union_tag_invalid":
+        tag = error.get("ctx", {}).get("tag")
+        return f"{where}.model = {tag!r}: {message}"
+    if kind in ("model_type",) or isinstance(value, dict):
+        return f"{where}: {message}"
+    shown = repr(value)
+    if len(shown) > 60:
+        shown = shown[:57] + "..."
+    return f"{where} = {shown}: {message}"
+
+
+def validate_scene(data: Mapping[str, Any], source: str = "<scene>") -> Scene:
+    """Validate a scene mapping (as read from TOML); raise ``SceneError`` on any problem."""
+    if not isinstance(data, Mapping):
+        raise SceneError(source, [f"(top level): expected a table, got {type(data).__name__}"])
+    try:
+        return Scene.model_validate(dict(data))
+    except ValidationError as exc:
+        problems = list(dict.fromkeys(_describe(e) for e in exc.errors(include_url=False)))
+        raise SceneError(source, problems) from None
+    except (ValueError, TypeError, ArithmeticError) as exc:  # a rule that tripped on bad input
+        raise SceneError(source, [f"(top level): {exc}"]) from None
+
+
+def parse_value(text: str) -> Any:
+    """A ``--set`` value: a TOML literal (number, bool, string, array, inline table) or a bare
+    string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_overrides(data: dict, overrides: Iterable[str], source: str = "--set") -> dict:
+    """Return a copy of ``data`` with ``key.path=value`` overrides applied.
+
+    Unknown top-level sections are reported with the nearest valid name; the full
+    validation then checks the keys inside.
+    """
+    data = copy.deepcopy(data)
+    problems = []
+    for item in overrides:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            problems.append(f"{item!r}: expected key.path=value, e.g. run.production=20")
+            continue
+        path = key.split(".")
+        if path[0] not in Scene.model_fields:
+            hint = nearest(path[0], sorted(Scene.model_fields))
+            problems.append(
+                f"{key}: unknown section {path[0]!r}" + (f"; did you mean {hint!r}?" if hint else "")
+            )
+            continue
+        node: Any = data
+        for part in path[:-1]:
+            if isinstance(node, list):
+                if not part.isdigit() or int(part) >= len(node):
+                    problems.append(f"{key}: {part!r} is not an index of a list of {len(node)}")
+                    break
+                node = node[int(part)]
+            else:
+                node = node.setdefault(part, {})
+                if not isinstance(node, dict | list):
+                    problems.append(f"{key}: {part!r} is a value, not a table")
+                    break
+        else:
+            last = path[-1]
+            if isinstance(node, list):
+                if last.isdigit() and int(last) < len(node):
+                    node[int(last)] = parse_value(text)
+                else:
+                    problems.append(f"{key}: {last!r} is not an index of a list of {len(node)}")
+            else:
+                node[last] = parse_value(text)
+    if problems:
+        raise SceneError(source, problems)
+    return data
+
+
+def read_scene_data(path: str | Path) -> dict:
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise SceneError(str(path), [f"cannot read the file: {exc.strerror or exc}"]) from None
+    return parse_scene_text(text, str(path))
+
+
+def parse_scene_text(text: str, source: str = "<scene>") -> dict:
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(source, [f"not valid TOML: {exc}"]) from None
+
+
+def load_scene(path: str | Path, overrides: Iterable[str] = ()) -> Scene:
+    """Read a TOML scene, apply ``--set`` overrides, validate; raise ``SceneError`` if invalid."""
+    data = apply_overrides(read_scene_data(path), overrides, source=str(path))
+    return validate_scene(data, str(path))
+
+
+def scene_to_toml(scene: Scene) -> str:
+    """A canonical TOML rendering of a validated scene (stored in every results file)."""
+    return dump_toml(scene.model_dump(mode="json", exclude_none=True))
+
+
+def dump_toml(data: Mapping[str, Any]) -> str:
+    """Minimal TOML writer for scene data (tables, arrays of tables, scalars, arrays)."""
+    lines: list[str] = []
+
+    def scalar(value: Any) -> str:
+        if isinstance(value, bool):
+            return "true" if value else "false"
+        if isinstance(value, int | float):
+            return repr(value)
+        if isinstance(value, str):
+            return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(value, list):
+            return "[" + ", ".join(scalar(v) for v in value) + "]"
+        if isinstance(value, dict):
+            return "{ " + ", ".join(f"{k} = {scalar(v)}" for k, v in value.items()) + " }"
+        raise TypeError(f"cannot write {type(value).__name__} to TOML")
+
+    def table(prefix: str, mapping: Mapping[str, Any], header: str | None) -> None:
+        plain = {k: v for k, v in mapping.items() if not _is_table(v) and not _is_table_array(v)}
+        if header is not None:
+            lines.append("")
+            lines.append(header)
+        for k, v in plain.items():
+            lines.append(f"{k} = {scalar(v)}")
+        for k, v in mapping.items():
+            name = f"{prefix}{k}"
+            if _is_table(v):
+                table(name + ".", v, f"[{name}]")
+            elif _is_table_array(v):
+                for item in v:
+                    table(name + ".", item, f"[[{name}]]")
+
+    table("", data, None)
+    return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def _is_table(value: Any) -> bool:
+    return isinstance(value, dict)
+
+
+def _is_table_array(value: Any) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)

@@ -1,0 +1,238 @@
+"""The root scene model and its cross-field rules.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import model_validator
+
+from .base import StrictModel
+from .schema import (
+    INERTIA_K,
+    MAX_PACKING,
+    Box,
+    Contact,
+    Gravity,
+    Initial,
+    Measure,
+    Meta,
+    Particles,
+    Run,
+    Shear,
+    Soft,
+    Wall,
+)
+
+#: Random sequential placement stalls near these fractions; denser random starts use a
+#: shuffled lattice instead (see demstudy.scene.initial).
+RANDOM_PLACEMENT_LIMIT = {2: 0.80, 3: 0.60}
+
+
+class Scene(StrictModel):
+    """A complete, validated scene (see demstudy.scene.schema for every section)."""
+
+    meta: Meta = Meta()
+    dimension: Literal[2, 3]
+    box: Box
+    particles: Particles
+    contact: Contact
+    walls: list[Wall] = []
+    gravity: Gravity | None = None
+    shear: Shear | None = None
+    initial: Initial = Initial()
+    run: Run
+    soft: Soft = Soft()
+    measure: Measure = Measure()
+
+    # ---- derived quantities -------------------------------------------------------------
+    @property
+    def periodic(self) -> tuple[str, ...]:
+        if self.box.periodic is not None:
+            return tuple(self.box.periodic)
+        axes = ["x"] if self.walls or self.has_open_top else ["x", "y"]
+        return tuple(axes + (["z"] if self.dimension == 3 else []))
+
+    @property
+    def has_open_top(self) -> bool:
+        """y is bounded but has no upper wall (a free surface)."""
+        return bool(self.walls) and self.wall("upper") is None
+
+    @property
+    def y_periodic(self) -> bool:
+        return "y" in self.periodic
+
+    @property
+    def inertia_k(self) -> float:
+        """Reduced moment of inertia K = 4 I / (m d²)."""
+        inertia = self.particles.inertia
+        if inertia is None:
+            return INERTIA_K["disc" if self.dimension == 2 else "sphere"]
+        return INERTIA_K[inertia] if isinstance(inertia, str) else float(inertia)
+
+    @property
+    def box_volume(self) -> float:
+        return math.prod(self.box.size)
+
+    @property
+    def particle_volume(self) -> float:
+        """Volume (area in 2D) of one particle of diameter 1."""
+        return math.pi / 4 if self.dimension == 2 else math.pi / 6
+
+    @property
+    def n_particles(self) -> int:
+        p, init = self.particles, self.initial
+        if init.placement == "lattice":
+            layers = (init.layers or 1) if self.dimension == 3 else 1
+            return init.rows * init.columns * layers
+        if p.count is not None:
+            return p.count
+        if p.solid_fraction is not None:
+            return max(1, round(p.solid_fraction * self.box_volume / self.particle_volume))
+        return 0
+
+    @property
+    def solid_fraction(self) -> float:
+        return self.n_particles * self.particle_volume / self.box_volume
+
+    def wall(self, side: str) -> Wall | None:
+        for wall in self.walls:
+            if wall.side == side:
+                return wall
+        return None
+
+    def wall_position(self, side: str) -> float:
+        wall = self.wall(side)
+        if wall is not None and wall.position is not None:
+            return wall.position
+        return 0.0 if side == "lower" else self.box.size[1]
+
+    @property
+    def gravity_vector(self) -> tuple[float, ...] | None:
+        g = self.gravity
+        if g is None:
+            return None
+        if g.angle is not None:
+            a = math.radians(g.angle)
+            vec = [math.sin(a), -math.cos(a)] + ([0.0] if self.dimension == 3 else [])
+        else:
+            norm = math.sqrt(sum(c * c for c in g.direction))
+            vec = [c / norm for c in g.direction]
+        return tuple(g.magnitude * c for c in vec)
+
+    @property
+    def rotation_matters(self) -> bool:
+        """True when any contact can change a spin (a tangential rule other than smooth)."""
+        rules = [self.contact.tangential] + [w.tangential for w in self.walls]
+        return any(rule.model not in ("smooth", "campbell-noslip") for rule in rules)
+
+    # ---- cross-field rules --------------------------------------------------------------
+    @model_validator(mode="after")
+    def _consistent(self) -> Scene:
+        dim = self.dimension
+        problems: list[str] = []
+        if len(self.box.size) != dim:
+            problems.append(f"box.size = {self.box.size}: needs {dim} lengths for dimension = {dim}")
+        periodic = self.box.periodic
+        if periodic is not None:
+            if dim == 2 and "z" in periodic:
+                problems.append(f"box.periodic = {periodic}: 2D scenes have no z axis")
+            if dim == 3 and "z" not in periodic:
+                problems.append(f"box.periodic = {periodic}: z must be periodic in 3D")
+            if "y" in periodic and self.walls:
+                problems.append(f"box.periodic = {periodic}: y cannot be periodic with walls")
+            if "y" not in periodic and not self.walls:
+                problems.append(f"box.periodic = {periodic}: y is bounded but no wall is given")
+        problems += self._wall_problems()
+        problems += self._particle_problems()
+        if self.shear is not None and (self.walls or not self.y_periodic):
+            problems.append("shear: Lees–Edwards shear needs a y-periodic box without walls")
+        g = self.gravity
+        if g is not None and g.direction is not None and len(g.direction) != dim:
+            problems.append(f"gravity.direction = {g.direction}: needs {dim} components")
+        problems += self._initial_problems()
+        if self.run.sample_interval > self.run.production:
+            problems.append(
+                f"run.sample_interval = {self.run.sample_interval}: longer than "
+                f"run.production = {self.run.production}"
+            )
+        if problems:
+            raise ValueError("; ".join(problems))
+        return self
+
+    def _wall_problems(self) -> list[str]:
+        problems = []
+        sides = [w.side for w in self.walls]
+        for side in ("lower", "upper"):
+            if sides.count(side) > 1:
+                problems.append(f"walls: {sides.count(side)} walls with side = {side!r}; at most 1")
+        if self.walls and self.wall("lower") is None:
+            problems.append("walls: an upper wall needs a lower wall (the open side is the top)")
+        if self.walls and len(self.box.size) > 1:
+            lo, hi = self.wall_position("lower"), self.wall_position("upper")
+            if self.wall("upper") is not None and hi - lo < 2.0:
+                problems.append(f"walls: gap {hi - lo:g} between lower and upper wall is < 2 d")
+        for wall in self.walls:
+            if wall.servo is not None and self.wall("upper") is None:
+                problems.append("walls.servo: normal-stress control needs two walls")
+        return problems
+
+    def _particle_problems(self) -> list[str]:
+        p, init, dim = self.particles, self.initial, self.dimension
+        problems = []
+        if init.placement == "random" and p.count is None and p.solid_fraction is None:
+            problems.append("particles: give count or solid_fraction for placement = 'random'")
+        if init.placement == "lattice" and p.count is not None and p.count != self.n_particles:
+            problems.append(
+                f"particles.count = {p.count}: the lattice holds {self.n_particles} particles"
+            )
+        if len(self.box.size) == dim and self.n_particles > 0:
+            phi = self.solid_fraction
+            if phi >= MAX_PACKING[dim]:
+                problems.append(
+                    f"particles: solid fraction {phi:.4g} exceeds the densest packing "
+                    f"{MAX_PACKING[dim]:.4f} in {dim}D"
+                )
+            elif init.placement == "random" and phi > RANDOM_PLACEMENT_LIMIT[dim]:
+                problems.append(
+                    f"particles: solid fraction {phi:.4g} is above {RANDOM_PLACEMENT_LIMIT[dim]} "
+                    "for placement = 'random'; use placement = 'lattice'"
+                )
+            if self.n_particles > 50_000_000:
+                problems.append(f"particles: {self.n_particles} particles is more than 5e7")
+        return problems
+
+    def _initial_problems(self) -> list[str]:
+        init, dim = self.initial, self.dimension
+        problems = []
+        if init.placement == "lattice" and len(self.box.size) == dim:
+            s = init.spacing
+            if init.columns * s > self.box.size[0] + 1e-9:
+                problems.append(
+                    f"initial: columns × spacing = {init.columns * s:g} exceeds box.size[0] = "
+                    f"{self.box.size[0]:g}"
+                )
+            if dim == 3 and (init.layers or 1) * s > self.box.size[2] + 1e-9:
+                problems.append(
+                    f"initial: layers × spacing = {(init.layers or 1) * s:g} exceeds "
+                    f"box.size[2] = {self.box.size[2]:g}"
+                )
+            if dim == 2 and init.layers is not None:
+                problems.append("initial.layers: 2D lattices have rows and columns only")
+            top = self.wall_position("lower") + init.rows * s
+            if self.wall("upper") is not None and top > self.wall_position("upper") + 1e-9:
+                problems.append(f"initial: rows × spacing = {init.rows * s:g} exceeds the wall gap")
+            if not self.walls and init.rows * s > self.box.size[1] + 1e-9:
+                problems.append(
+                    f"initial: rows × spacing = {init.rows * s:g} exceeds box.size[1] = "
+                    f"{self.box.size[1]:g}"
+                )
+        v = init.velocity
+        if v.profile == "campbell-chute" and (self.gravity is None or self.gravity.angle is None):
+            problems.append("initial.velocity.profile = 'campbell-chute' needs gravity.angle")
+        if v.profile == "linear" and self.shear is None and self.wall("upper") is None:
+            problems.append("initial.velocity.profile = 'linear' needs two walls or shear")
+        return problems
