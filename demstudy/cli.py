@@ -42,7 +42,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene, args.set)
     out = Path(args.out or Path("results") / f"{Path(args.scene).stem}-{args.engine}.h5")
     options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
-                         progress=not args.quiet, keep_frames=args.keep_frames or None)
+                         progress=not args.quiet, keep_frames=args.keep_frames or None,
+                         isolate=True)
     path = get_engine(args.engine).run(scene, options)
     print(f"results: {path}")
     return 0
@@ -52,6 +53,29 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     from .plot import plot_profiles
 
     print(f"figure: {plot_profiles(args.results, args.out)}")
+    return 0
+
+
+def _cmd_analyze(args: argparse.Namespace) -> int:
+    from .decks.contact import contact_setup
+    from .engines.lammps import profile_analysis
+    from .io.dump import read_dump
+    from .io.results import Results, write_results
+    from .scene import scene_to_toml
+
+    scene = load_scene(args.scene, args.set)
+    dt = args.dt if args.dt is not None else contact_setup(scene).timestep
+    analysis = profile_analysis(scene)
+    analysis.run(read_dump(args.dump, scene.dimension, dt=dt, start_time=args.start))
+    analysis.finish()
+    profiles, attrs = analysis.results, analysis.attrs
+    out = Path(args.out or Path(args.dump).with_suffix(".h5"))
+    write_results(out, Results(
+        {"engine": "lammps-dump", "engine_version": "MDAnalysis reader",
+         "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
+         "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(args.dump)},
+        profiles=profiles, profile_attrs=attrs))
+    print(f"results: {out} ({attrs['samples']} frames)")
     return 0
 
 
@@ -101,6 +125,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("results", nargs="+")
     p.add_argument("-o", "--out", default="profiles.png")
     p.set_defaults(func=_cmd_plot)
+
+    p = sub.add_parser("analyze", parents=[overrides],
+                       help="profiles from a LAMMPS dump (read with MDAnalysis)")
+    p.add_argument("dump")
+    p.add_argument("--scene", required=True, help="the scene the dump was made from")
+    p.add_argument("--dt", type=float, help="time step (default: the scene's LAMMPS time step)")
+    p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")
+    p.add_argument("--out", help="results file (default: DUMP with suffix .h5)")
+    p.set_defaults(func=_cmd_analyze)
 
     p = sub.add_parser("calibrate", help="measure e, beta, t_c of binary collisions in LAMMPS")
     p.add_argument("--dim", type=int, choices=[2, 3], default=3)

@@ -32,7 +32,7 @@ def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None
         *[wall_block(scene, wall, setup) for wall in scene.walls],
         gravity_block(scene),
         shear_block(scene),
-        sampling_block(scene),
+        sampling_block(scene, setup),
         *integrate_block(scene, setup),
         run_block(scene, setup, dump),
     ]

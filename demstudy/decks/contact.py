@@ -86,9 +86,13 @@ def contact_setup(scene: Scene) -> ContactSetup:
     kn = choose_stiffness(scene, e, 0.5)
     speed = reference_speed(scene)
     extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
-    if K == 0 and scene.contact.tangential.model != "smooth":
-        raise UnsupportedByEngine("lammps", "particles.inertia", 0,
-                                  "point masses (K = 0) cannot carry a tangential contact")
+    lammps_k = (0.5, 0.4) if scene.dimension == 2 else (0.4,)
+    if scene.rotation_matters and not any(abs(K - k) < 1e-12 for k in lammps_k):
+        raise UnsupportedByEngine(
+            "lammps", "particles.inertia", scene.particles.inertia,
+            f"LAMMPS fixes the moment of inertia: K = 4I/(m d²) must be one of {lammps_k} in "
+            f"{scene.dimension}D (disc 1/2, sphere 2/5) when contacts are rough",
+        )
     pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
                                 **_rule(scene.contact.tangential), **extra)
     walls = {w.side: _wall_contact(w, kn, K, model, speed) for w in scene.walls}

@@ -10,7 +10,13 @@ from .contact import ContactSetup
 from .walls import wall_fix_id
 
 
-def sampling_block(scene: Scene) -> Block:
+def sample_steps(scene: Scene, dt: float) -> int:
+    """Steps between samples (the sampling interval rounded to whole steps)."""
+    return max(1, round(scene.run.sample_interval / dt))
+
+
+def sampling_block(scene: Scene, setup: ContactSetup) -> Block:
+    n = sample_steps(scene, setup.timestep)
     cmds = ["compute ke mobile ke"]
     columns = ["step", "time", "c_ke"]
     if scene.rotation_matters:
@@ -18,10 +24,13 @@ def sampling_block(scene: Scene) -> Block:
         columns.append("c_erot")
     for wall in scene.walls:
         fid = wall_fix_id(wall.side)
-        columns += [f"c_{fid}_force[{i}]" for i in range(1, scene.dimension + 1)]
+        # wall force averaged over every step of each sample interval (contacts are brief)
+        cmds.append(f"fix {fid}_mean all ave/time 1 {n} {n} c_{fid}_force[*]")
+        columns += [f"f_{fid}_mean[{i}]" for i in range(1, scene.dimension + 1)]
     cmds.append("thermo_style custom " + " ".join(columns))
     cmds.append("thermo_modify norm no lost error")
-    return Block("sampling", "energies (translational, rotational) and wall forces", cmds)
+    return Block("sampling", "energies (translational; rotational with sphere inertia) and "
+                 "wall forces averaged over each sample interval", cmds)
 
 
 def steps(duration: float, dt: float) -> int:
@@ -31,7 +40,7 @@ def steps(duration: float, dt: float) -> int:
 def run_block(scene: Scene, setup: ContactSetup, dump: str | None = None) -> Block:
     """Commands that make the deck runnable with ``lmp -in deck.in`` (no Python needed)."""
     dt = setup.timestep
-    n_sample = max(1, round(scene.run.sample_interval / dt))
+    n_sample = sample_steps(scene, dt)
     cmds = [f"thermo {n_sample}"]
     if dump:
         cmds.append(
@@ -42,7 +51,6 @@ def run_block(scene: Scene, setup: ContactSetup, dump: str | None = None) -> Blo
     eq, prod = steps(scene.run.equilibration, dt), steps(scene.run.production, dt)
     if eq:
         cmds.append(f"run {eq}  # equilibration: {scene.run.equilibration:g} time units")
-    cmds.append("reset_timestep 0 time 0.0" if eq else "# (no equilibration)")
     cmds.append(f"run {prod}  # production: {scene.run.production:g} time units")
     return Block("run", f"bare-deck runs, dt = {dt:.6g}, thermo every {n_sample} steps",
                  cmds, stage="run")

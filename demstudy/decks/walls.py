@@ -98,7 +98,8 @@ def shear_block(scene: Scene) -> Block | None:
 
 def integrate_block(scene: Scene, setup: ContactSetup) -> list[Block]:
     if scene.rotation_matters:
-        style = "nve/sphere" + (" disc" if scene.dimension == 2 else "")
+        disc = scene.dimension == 2 and abs(scene.inertia_k - 0.5) < 1e-12
+        style = "nve/sphere" + (" disc" if disc else "")
         comment = "translation and rotation (velocity Verlet)"
     else:
         style = "nve"

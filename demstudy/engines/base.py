@@ -25,6 +25,7 @@ class RunOptions:
     progress: bool = True
     keep_frames: bool | None = None  # None: the scene's measure.keep_frames
     checkpoint_interval: float | None = None  # None: the scene's run.checkpoint_interval
+    isolate: bool = False  # run the engine in a child process (crashes become EngineError)
     extra: dict = field(default_factory=dict)
 
 

@@ -29,7 +29,7 @@ from .._lammps import mpirun_executable, open_lammps
 from ..analysis.profiles import ProfileAnalysis
 from ..decks import Deck, build_deck
 from ..decks.contact import contact_setup
-from ..decks.output import steps
+from ..decks.output import sample_steps, steps
 from ..decks.system import DATA_FILE
 from ..io.frames import Frame
 from ..io.results import Results, write_results
@@ -38,6 +38,7 @@ from .base import EngineError, RunOptions
 
 CHECKPOINT_RESTART = "checkpoint.restart"
 CHECKPOINT_STATE = "checkpoint.pkl"
+WORKER_FLAG = "DEMSTUDY_LAMMPS_WORKER"
 
 
 def profile_analysis(scene: Scene) -> ProfileAnalysis:
@@ -50,8 +51,10 @@ def profile_analysis(scene: Scene) -> ProfileAnalysis:
         hi = scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]
     else:
         lo, hi = 0.0, scene.box.size[axis]
+    shift = scene.shear.rate * period if scene.shear is not None and m.axis == "y" else 0.0
     return ProfileAnalysis(axis=m.axis, bin_width=m.bin_width, lo=lo, hi=hi,
-                           dim=scene.dimension, inertia_factor=scene.inertia_k, period=period)
+                           dim=scene.dimension, inertia_factor=scene.inertia_k, period=period,
+                           image_velocity_shift=shift)
 
 
 class LammpsSession:
@@ -77,10 +80,13 @@ class LammpsSession:
         arr = np.ctypeslib.as_array(data)
         return arr.reshape(-1, count) if count > 1 else arr.copy()
 
-    def global_vector(self, compute_id: str, length: int) -> np.ndarray:
+    def fix_vector(self, fix_id: str, length: int) -> np.ndarray:
+        """Global vector of a fix (e.g. ``fix ave/time``), identical on every rank."""
         lam = sys.modules[type(self.lmp).__module__.split(".")[0]]
-        vec = self.lmp.numpy.extract_compute(compute_id, lam.LMP_STYLE_GLOBAL, lam.LMP_TYPE_VECTOR)
-        return np.array(vec[:length], dtype=float)
+        return np.array([
+            self.lmp.extract_fix(fix_id, lam.LMP_STYLE_GLOBAL, lam.LMP_TYPE_VECTOR, i)
+            for i in range(length)
+        ], dtype=float)
 
     def close(self) -> None:
         self.lmp.close()
@@ -104,8 +110,8 @@ class LammpsEngine:
     name = "lammps"
 
     def run(self, scene: Scene, options: RunOptions) -> Path:
-        if options.np > 1 and os.environ.get("DEMSTUDY_MPI_WORKER") != "1":
-            return _launch_mpi(scene, options)
+        if (options.np > 1 or options.isolate) and os.environ.get(WORKER_FLAG) != "1":
+            return _launch_child(scene, options)
         setup = contact_setup(scene)  # raises UnsupportedByEngine before LAMMPS starts
         deck = build_deck(scene, setup=setup)
         if scene.run.unit != "time":
@@ -126,10 +132,11 @@ class _Driver:
         self.scene, self.deck, self.dt, self.workdir, self.out = scene, deck, dt, workdir, out
         self.options = options
         run = scene.run
-        self.n_sample = max(1, round(run.sample_interval / dt))
+        self.n_sample = sample_steps(scene, dt)
         # equilibration rounded to whole sample intervals so samples fall on dump steps
         self.n_eq = self.n_sample * round(steps(run.equilibration, dt) / self.n_sample)
-        self.n_total = self.n_eq + max(self.n_sample, steps(run.production, dt))
+        n_prod = self.n_sample * max(1, round(steps(run.production, dt) / self.n_sample))
+        self.n_total = self.n_eq + n_prod
         ckpt = options.checkpoint_interval or run.checkpoint_interval
         self.n_ckpt = self.n_sample * max(1, round(ckpt / dt / self.n_sample)) if ckpt else 0
         keep = options.keep_frames
@@ -182,7 +189,7 @@ class _Driver:
         t = state.step * self.dt
         frame = self._frame(session, t)
         walls = {
-            w.side: session.global_vector(f"wall_{w.side}_force", self.scene.dimension)
+            w.side: session.fix_vector(f"wall_{w.side}_mean", self.scene.dimension)
             for w in self.scene.walls
         }
         if session.rank != 0:
@@ -195,7 +202,8 @@ class _Driver:
         state.record("rotational_energy",
                      0.5 * float(np.sum(inertia[:, None] * frame.angular_velocity**2)))
         for side, force in walls.items():
-            state.record(f"wall_force_{side}", -force)  # force of the particles on the wall
+            # force of the particles on the wall, averaged over the interval that just ended
+            state.record(f"wall_force_{side}", -force if state.step > 0 else force * np.nan)
         if production:
             state.profiles.feed(frame)
             if self.keep_frames:
@@ -205,7 +213,7 @@ class _Driver:
             if self.dump is not None:
                 session.command(
                     f"write_dump mobile custom {self.dump} id type radius x y z vx vy vz "
-                    "omegax omegay omegaz modify sort id append yes"
+                    "omegax omegay omegaz modify sort id append yes format float %.17g"
                 )
 
     def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
@@ -228,7 +236,6 @@ class _Driver:
         started = time.perf_counter()
         try:
             self._issue_deck(session, resume=self.options.resume)
-            session.command(f"reset_timestep {state.step}")
             session.command("run 0 post no")
             if state.step == 0:
                 if self.dump is not None and self.dump.exists() and session.rank == 0:
@@ -265,7 +272,8 @@ class _Driver:
                     self._checkpoint(session, state, started)
 
     def _write(self, state: RunState, version: int) -> Path:
-        profiles, profile_attrs = state.profiles.finish()
+        analysis = state.profiles.finish()
+        profiles, profile_attrs = analysis.results, analysis.attrs
         scene = self.scene
         timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
         frames = None
@@ -289,40 +297,52 @@ class _Driver:
         return path
 
 
-# ---------------------------------------------------------------------------- MPI launch
-def _launch_mpi(scene: Scene, options: RunOptions) -> Path:
-    """Re-run this driver on ``options.np`` ranks with mpirun; rank 0 writes the results."""
+# ------------------------------------------------------------------ child process / MPI
+def _launch_child(scene: Scene, options: RunOptions) -> Path:
+    """Run this driver in a child process (on ``options.np`` MPI ranks when np > 1).
+
+    A crash inside LAMMPS (a segfault, an MPI abort) then ends the child, not the caller, and
+    is reported as an ``EngineError``; the checkpoint written so far remains usable.
+    """
     contact_setup(scene)  # refuse unsupported scenes before launching anything
     payload = {
         "scene": scene.model_dump(mode="json"),
         "out": str(Path(options.out).resolve()),
-        "dump": str(options.dump) if options.dump else None,
+        "dump": str(Path(options.dump).resolve()) if options.dump else None,
         "resume": options.resume,
         "progress": options.progress,
         "keep_frames": options.keep_frames,
         "checkpoint_interval": options.checkpoint_interval,
+        "np": options.np,
     }
     out = Path(payload["out"])
     out.parent.mkdir(parents=True, exist_ok=True)
-    job = out.with_suffix(".mpi.json")
+    job = out.with_name(f".{out.name}.job.json")
     job.write_text(json.dumps(payload))
-    env = dict(os.environ, DEMSTUDY_MPI_WORKER="1")
-    cmd = [mpirun_executable(), "-np", str(options.np), sys.executable, "-m",
-           "demstudy.engines.lammps", str(job)]
-    proc = subprocess.run(cmd, env=env, stdin=subprocess.DEVNULL)
-    job.unlink(missing_ok=True)
+    env = dict(os.environ, **{WORKER_FLAG: "1"})
+    cmd = [sys.executable, "-m", "demstudy.engines.lammps", str(job)]
+    if options.np > 1:
+        cmd = [mpirun_executable(), "-np", str(options.np), *cmd]
+    try:
+        proc = subprocess.run(cmd, env=env, stdin=subprocess.DEVNULL)
+    except KeyboardInterrupt:
+        raise EngineError("interrupted: run the same command again with --resume to continue "
+                          "from the last checkpoint") from None
+    finally:
+        job.unlink(missing_ok=True)
     if proc.returncode != 0:
-        raise EngineError(
-            f"MPI run on {options.np} ranks failed (exit {proc.returncode}); see the messages "
-            f"above and {out.with_suffix('.lammps') / 'log.lammps'}"
-        )
+        how = (f"was killed by signal {-proc.returncode}" if proc.returncode < 0
+               else f"failed (exit {proc.returncode})")
+        where = out.with_suffix(".lammps") / "log.lammps"
+        raise EngineError(f"the LAMMPS run on {options.np} rank(s) {how}; see the messages "
+                          f"above and {where}")
     return out
 
 
 def _worker(job: str) -> int:
     payload = json.loads(Path(job).read_text())
     scene = validate_scene(payload["scene"], source=job)
-    options = RunOptions(out=Path(payload["out"]), np=2,
+    options = RunOptions(out=Path(payload["out"]), np=payload["np"],
                          dump=Path(payload["dump"]) if payload["dump"] else None,
                          resume=payload["resume"], progress=payload["progress"],
                          keep_frames=payload["keep_frames"],

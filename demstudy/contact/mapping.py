@@ -1,0 +1,296 @@
+"""Hard-particle collision rules (e, beta, mu) <-> soft LAMMPS ``granular`` contact parameters.
+
+Units: dimensionless particle units, diameter d = 1, mass m = 1, g = 1 when gravity acts; every
+function takes plain numbers (no scene objects), so other units work if used consistently.
+
+Conventions
+-----------
+* ``m_eff`` is the reduced mass of the contact: ``pair_mass(m1, m2)`` (= m/2 for equal
+  particles) for particle-particle contacts, the particle mass m for a particle against a wall.
+* ``K = 4 I / (m d^2)``: discs K = 1/2, spheres K = 2/5 (``inertia_factor``).
+* Normal: LAMMPS ``damping coeff_restitution``. For ``hooke`` it applies the force
+  ``-eta_n * v_n`` with ``eta_n = 2 zeta sqrt(m_eff kn)``, ``zeta = -ln e / sqrt(pi^2 + ln^2 e)``,
+  which gives restitution e exactly. For ``hertz`` (F = kn a delta, a = sqrt(R_eff delta))
+  it uses ``eta_n = sqrt(5) zeta sqrt(m_eff kn a)``; integrating that damped Hertz oscillator
+  (``hertz_contact``) shows it also restitutes with e exactly (to 1e-9) at every speed, and gives
+  the speed-dependent contact time and maximum overlap.
+* Tangential: an uncapped Hookean spring (no tangential damping) gives the constant tangential
+  restitution ``beta = -cos(omega_t t_c)``, ``omega_t^2 = kt (1 + K) / (K m_eff)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Literal
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+Model = Literal["hooke", "hertz"]
+Tangential = Literal["none", "spring", "coulomb"]
+
+UNCAPPED_MU = 1e20
+"""Friction coefficient written to LAMMPS for an uncapped ('spring') tangential contact."""
+
+
+# ---------------------------------------------------------------- masses, radii, inertia
+def pair_mass(m1: float, m2: float) -> float:
+    """Reduced mass m1 m2 / (m1 + m2) of a particle pair (m/2 for equal particles)."""
+    return m1 * m2 / (m1 + m2)
+
+
+def pair_radius(r1: float, r2: float) -> float:
+    """Effective radius r1 r2 / (r1 + r2) of a pair (d/4 for equal particles; wall: r)."""
+    return r1 * r2 / (r1 + r2)
+
+
+def inertia_factor(dim: int) -> float:
+    """K = 4 I / (m d^2) of a uniform disc (dim 2: 1/2) or sphere (dim 3: 2/5)."""
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, not {dim}")
+    return 0.5 if dim == 2 else 0.4
+
+
+# ---------------------------------------------------------------- Hooke normal contact
+def damping_ratio(e: float) -> float:
+    """zeta = -ln e / sqrt(pi^2 + ln^2 e): damping ratio of a linear contact with restitution e."""
+    if not 0.0 < e <= 1.0:
+        raise ValueError(f"restitution must lie in (0, 1], not {e}")
+    le = math.log(e)
+    return -le / math.hypot(math.pi, le)
+
+
+@dataclass(frozen=True)
+class HookeContact:
+    """Damped linear normal contact: gamma_n = damping force per unit normal velocity."""
+
+    kn: float
+    e: float
+    m_eff: float
+    gamma_n: float
+    contact_time: float
+
+
+def hooke_contact(kn: float, e: float, m_eff: float) -> HookeContact:
+    """Exact damping and contact time of LAMMPS ``hooke`` + ``damping coeff_restitution``.
+
+    ``gamma_n = 2 zeta sqrt(m_eff kn)``; ``t_c = pi / sqrt(kn/m_eff - (gamma_n / (2 m_eff))^2)``
+    (the contact ends when the overlap returns to zero; the force may turn slightly attractive
+    just before, as LAMMPS does without ``limit_damping``).
+    """
+    gamma = 2.0 * damping_ratio(e) * math.sqrt(m_eff * kn)
+    omega_d2 = kn / m_eff - (gamma / (2.0 * m_eff)) ** 2
+    return HookeContact(kn, e, m_eff, gamma, math.pi / math.sqrt(omega_d2))
+
+
+def _overlap_factor(e: float) -> float:
+    """delta_max / (v sqrt(m_eff/kn)) = exp(-zeta arccos(zeta) / sqrt(1 - zeta^2))."""
+    z = damping_ratio(e)
+    return math.exp(-z * math.acos(z) / math.sqrt(1.0 - z * z))
+
+
+def hooke_max_overlap(kn: float, e: float, m_eff: float, v: float) -> float:
+    """Exact maximum overlap of a damped linear contact hit at normal speed v."""
+    return v * math.sqrt(m_eff / kn) * _overlap_factor(e)
+
+
+def hooke_kn_for_overlap(overlap: float, v: float, m_eff: float, e: float, d: float = 1.0) -> float:
+    """kn giving maximum overlap ``overlap * d`` at normal impact speed v (damping included)."""
+    return m_eff * (v * _overlap_factor(e) / (overlap * d)) ** 2
+
+
+# ---------------------------------------------------------------- Hertz normal contact
+def hertz_damping_constant(e: float) -> float:
+    """LAMMPS hertz coeff_restitution prefactor sqrt(5) zeta(e) (eta_n = c sqrt(m_eff kn a))."""
+    return math.sqrt(5.0) * damping_ratio(e)
+
+
+@lru_cache(maxsize=256)
+def _hertz_scaled(c: float) -> tuple[float, float, float]:
+    """Solve x'' = -x^1.5 - c x^0.25 x', x(0) = 0, x'(0) = 1: return (e, t_c, x_max)."""
+
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        x = max(y[0], 0.0)
+        return [y[1], -(x**1.5) - c * x**0.25 * y[1]]
+
+    def leave(_t: float, y: np.ndarray) -> float:
+        return y[0]
+
+    leave.terminal = True  # type: ignore[attr-defined]
+    leave.direction = -1  # type: ignore[attr-defined]
+    sol = solve_ivp(rhs, (0.0, 50.0), [0.0, 1.0], events=leave, rtol=1e-11, atol=1e-13,
+                    max_step=0.01, dense_output=True)
+    t_c = float(sol.t_events[0][0])
+    e = -float(sol.y_events[0][0][1])
+    ts = np.linspace(0.0, t_c, 4001)
+    return e, t_c, float(sol.sol(ts)[0].max())
+
+
+@dataclass(frozen=True)
+class HertzContact:
+    """Damped Hertz contact at impact speed v: true e, contact time, maximum overlap."""
+
+    kn: float
+    e: float
+    m_eff: float
+    r_eff: float
+    v: float
+    contact_time: float
+    max_overlap: float
+
+
+def _hertz_scales(kn: float, m_eff: float, r_eff: float, v: float) -> tuple[float, float]:
+    """Overlap scale delta0 = (m v^2 / (kn sqrt R))^(2/5) and time scale delta0 / v."""
+    delta0 = (m_eff * v * v / (kn * math.sqrt(r_eff))) ** 0.4
+    return delta0, delta0 / v
+
+
+def hertz_contact(kn: float, e: float, m_eff: float, r_eff: float, v: float) -> HertzContact:
+    """LAMMPS ``hertz kn e damping coeff_restitution`` hit at normal speed v.
+
+    Force ``kn sqrt(r_eff) delta^1.5 + sqrt(5) zeta sqrt(m_eff kn) (r_eff delta)^(1/4) v_n``.
+    The ODE's own restitution is returned as ``e`` (it equals the input to ~1e-9, at any v);
+    t_c and delta_max scale as v^(-1/5) and v^(4/5).
+    Undamped limit: t_c = 2.9432 delta_max / v, delta_max = (5 m v^2 / (4 kn sqrt R))^(2/5).
+    """
+    e_ode, tc, xmax = _hertz_scaled(round(hertz_damping_constant(e), 14))
+    delta0, tau = _hertz_scales(kn, m_eff, r_eff, v)
+    return HertzContact(kn, e_ode, m_eff, r_eff, v, tc * tau, xmax * delta0)
+
+
+def hertz_kn_for_overlap(overlap: float, v: float, m_eff: float, r_eff: float, e: float,
+                         d: float = 1.0) -> float:
+    """Hertz kn giving maximum overlap ``overlap * d`` at normal speed v, restitution e."""
+    x_max = _hertz_scaled(round(hertz_damping_constant(e), 14))[2]
+    delta0 = overlap * d / x_max
+    return m_eff * v * v / (math.sqrt(r_eff) * delta0**2.5)
+
+
+# ---------------------------------------------------------------- stiffness scales, time step
+def mass_scale(m: float, dim: int) -> float:
+    """rho d^3 in terms of the particle mass: 6 m / pi (spheres); 4 m / pi for discs.
+
+    2D convention: rho is the areal density of LAMMPS ``density/disc`` (m = rho pi d^2/4) and the
+    disc has unit thickness, so "rho d^3" means rho d^2 x (thickness 1) = 4 m / pi.
+    """
+    inertia_factor(dim)
+    return (6.0 if dim == 3 else 4.0) * m / math.pi
+
+
+def kn_from_kstar(kstar: float, shear_rate: float, m: float, dim: int) -> float:
+    """Hooke kn from k* = kn / (rho d^3 gamma_dot^2) (see ``mass_scale`` for rho d^3)."""
+    return kstar * mass_scale(m, dim) * shear_rate**2
+
+
+def kn_from_kappa(kappa: float, pressure: float, dim: int, d: float = 1.0) -> float:
+    """Hooke kn from kappa = kn / (P d) in 3D (P force/area) or kn / P in 2D (P force/length)."""
+    inertia_factor(dim)
+    return kappa * pressure * (d if dim == 3 else 1.0)
+
+
+def timestep(contact_time: float, steps_per_contact: float) -> float:
+    """Time step resolving one contact duration with ``steps_per_contact`` steps."""
+    if steps_per_contact <= 0:
+        raise ValueError("steps_per_contact must be positive")
+    return contact_time / steps_per_contact
+
+
+# ---------------------------------------------------------------- tangential contact
+def tangential_stiffness_for_beta(beta: float, K: float, m_eff: float,
+                                  contact_time: float) -> float:
+    """kt of an uncapped, undamped tangential spring giving tangential restitution beta.
+
+    ``omega_t t_c = arccos(-beta)``, ``kt = K m_eff / (1 + K) omega_t^2``; beta = -1 -> kt = 0
+    (smooth). beta must lie in [-1, 1].
+    """
+    if not -1.0 <= beta <= 1.0:
+        raise ValueError(f"beta must lie in [-1, 1], not {beta}")
+    omega_t = math.acos(-beta) / contact_time
+    return K * m_eff / (1.0 + K) * omega_t**2
+
+
+def spring_beta(kt: float, K: float, m_eff: float, contact_time: float) -> float:
+    """Tangential restitution -cos(omega_t t_c) of an uncapped tangential spring."""
+    return -math.cos(math.sqrt(kt * (1.0 + K) / (K * m_eff)) * contact_time)
+
+
+def walton_beta(mu: float, beta0: float, e: float, K: float, ratio: float) -> float:
+    """Walton's rule: beta = min(beta0, -1 + mu (1 + e) (1 + 1/K) / ratio), ratio = |g_t|/|g_n|.
+
+    The second branch is a collision that slides throughout (Coulomb impulse mu J_n).
+    """
+    if ratio == 0.0:
+        return beta0
+    return min(beta0, -1.0 + mu * (1.0 + e) * (1.0 + 1.0 / K) / ratio)
+
+
+# ---------------------------------------------------------------- the LAMMPS parameter set
+@dataclass(frozen=True)
+class ContactParameters:
+    """One LAMMPS ``granular`` contact (pair or wall), dimensionless particle units.
+
+    ``mu`` None means no Coulomb cap; ``contact_time`` is the damped normal contact time (for
+    hertz at the impact speed the parameters were made for).
+    ``tangential``: 'none' (smooth, no history), 'spring' (constant beta), 'coulomb' (capped).
+    """
+
+    model: Model
+    kn: float
+    restitution: float
+    kt: float
+    mu: float | None
+    tangential: Tangential
+    m_eff: float
+    contact_time: float
+
+    def __post_init__(self) -> None:
+        if self.model not in ("hooke", "hertz"):
+            raise ValueError(f"unknown normal model {self.model!r}")
+        if self.tangential == "none" and (self.kt != 0.0 or self.mu is not None):
+            raise ValueError("smooth contacts take kt = 0 and mu = None")
+        if self.tangential == "spring" and self.mu is not None:
+            raise ValueError("'spring' contacts are uncapped: mu must be None")
+        if self.tangential == "coulomb" and (self.mu is None or self.mu < 0.0):
+            raise ValueError("'coulomb' contacts need mu >= 0")
+        if self.tangential not in ("none", "spring", "coulomb"):
+            raise ValueError(f"unknown tangential model {self.tangential!r}")
+
+    def timestep(self, steps_per_contact: float) -> float:
+        return timestep(self.contact_time, steps_per_contact)
+
+    def granular_args(self) -> str:
+        """Model string after ``pair_coeff * *`` or after ``fix ID group wall/gran granular``."""
+        normal = f"{self.model} {self.kn:.12g} {self.restitution:.12g} damping coeff_restitution"
+        if self.tangential == "none":
+            return f"{normal} tangential linear_nohistory 0.0 0.0"
+        mu = UNCAPPED_MU if self.mu is None else self.mu
+        return f"{normal} tangential linear_history {self.kt:.12g} 0.0 {mu:.12g}"
+
+
+def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | None = None,
+                 mu: float | None = None, beta0: float | None = None, model: Model = "hooke",
+                 r_eff: float | None = None, speed: float | None = None) -> ContactParameters:
+    """Contact parameters for a target (e, beta) or a Walton (e, mu, beta0) collision rule.
+
+    * ``beta`` None or -1 and ``mu`` None: smooth; ``beta`` in (-1, 1] with ``mu`` None: uncapped
+      spring; ``mu`` given: Coulomb cap mu with kt from ``beta0`` (default: ``beta``, else 1).
+    * hertz needs ``r_eff`` and the normal impact ``speed`` at which t_c (hence beta) is matched.
+    """
+    if model == "hooke":
+        tc = hooke_contact(kn, e, m_eff).contact_time
+    else:
+        if r_eff is None or speed is None:
+            raise ValueError("hertz contacts need r_eff and the impact speed")
+        tc = hertz_contact(kn, e, m_eff, r_eff, speed).contact_time
+    if mu is not None:
+        b0 = beta0 if beta0 is not None else (beta if beta is not None else 1.0)
+        if b0 <= -1.0:
+            raise ValueError("a Coulomb contact needs beta0 > -1 (a tangential spring)")
+        kt, tangential = tangential_stiffness_for_beta(b0, K, m_eff, tc), "coulomb"
+    elif beta is None or beta == -1.0:
+        kt, tangential = 0.0, "none"
+    else:
+        kt, tangential = tangential_stiffness_for_beta(beta, K, m_eff, tc), "spring"
+    return ContactParameters(model, kn, e, kt, mu, tangential, m_eff, tc)  # type: ignore[arg-type]

@@ -1,0 +1,167 @@
+"""Analytic checks of demstudy.contact.mapping (no LAMMPS). Units: d = 1, m = 1."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+
+from demstudy.contact import mapping as cm
+
+
+def _oscillator(kn: float, gamma: float, m: float, v: float) -> tuple[float, float, float]:
+    """Independent integration of m x'' = -kn x - gamma x': (e, contact time, max overlap)."""
+
+    def rhs(_t, y):
+        return [y[1], (-kn * y[0] - gamma * y[1]) / m]
+
+    def out(_t, y):
+        return y[0]
+
+    out.terminal, out.direction = True, -1
+    sol = solve_ivp(rhs, (0, 10 * math.pi * math.sqrt(m / kn)), [0.0, v], events=out,
+                    rtol=1e-11, atol=1e-14, dense_output=True)
+    tc = sol.t_events[0][0]
+    xs = sol.sol(np.linspace(0, tc, 20001))[0]
+    return -sol.y_events[0][0][1] / v, tc, xs.max()
+
+
+@pytest.mark.parametrize("e", [0.1, 0.5, 0.9, 0.99, 1.0])
+@pytest.mark.parametrize("m_eff", [0.5, 1.0])
+def test_hooke_contact_matches_damped_oscillator(e, m_eff):
+    c = cm.hooke_contact(1e5, e, m_eff)
+    e_num, tc_num, xmax_num = _oscillator(1e5, c.gamma_n, m_eff, 1.0)
+    assert e_num == pytest.approx(e, abs=1e-8)
+    assert c.contact_time == pytest.approx(tc_num, rel=1e-8)
+    assert cm.hooke_max_overlap(1e5, e, m_eff, 1.0) == pytest.approx(xmax_num, rel=1e-6)
+
+
+def test_hooke_elastic_limits():
+    c = cm.hooke_contact(4.0, 1.0, 1.0)
+    assert c.gamma_n == 0.0 and c.contact_time == pytest.approx(math.pi / 2.0)
+    assert cm.hooke_max_overlap(4.0, 1.0, 1.0, 3.0) == pytest.approx(1.5)
+    # LAMMPS's coeff_restitution prefactor for hooke: -2 ln e / sqrt(pi^2 + ln^2 e)
+    le = math.log(0.6)
+    assert cm.hooke_contact(1e5, 0.6, 0.5).gamma_n == pytest.approx(
+        -2 * le / math.sqrt(math.pi**2 + le**2) * math.sqrt(0.5 * 1e5))
+
+
+@settings(max_examples=40, deadline=None)
+@given(e=st.floats(0.05, 1.0), m_eff=st.floats(0.1, 5.0), overlap=st.floats(1e-4, 0.05),
+       v=st.floats(0.01, 10.0))
+def test_hooke_overlap_round_trip(e, m_eff, overlap, v):
+    kn = cm.hooke_kn_for_overlap(overlap, v, m_eff, e)
+    assert cm.hooke_max_overlap(kn, e, m_eff, v) == pytest.approx(overlap, rel=1e-10)
+
+
+def test_hertz_undamped_matches_hertz_theory():
+    m, R, v, k = 0.5, 0.25, 0.7, 3e6
+    h = cm.hertz_contact(k, 1.0, m, R, v)
+    dmax = (5 * m * v**2 / (4 * k * math.sqrt(R))) ** 0.4
+    assert h.max_overlap == pytest.approx(dmax, rel=1e-6)
+    assert h.contact_time == pytest.approx(2.94327 * dmax / v, rel=1e-5)
+    # t_c ~ v^(-1/5)
+    assert cm.hertz_contact(k, 1.0, m, R, 32 * v).contact_time == pytest.approx(
+        h.contact_time / 2.0, rel=1e-6)
+
+
+@pytest.mark.parametrize("e", [0.3, 0.6, 0.9])
+def test_hertz_coeff_restitution_is_exact_and_speed_independent(e):
+    for v in (0.01, 1.0, 30.0):
+        assert cm.hertz_contact(1e6, e, 0.5, 0.25, v).e == pytest.approx(e, abs=1e-7)
+
+
+def test_hertz_overlap_round_trip():
+    kn = cm.hertz_kn_for_overlap(0.01, 2.0, 1.0, 0.5, 0.8)
+    assert cm.hertz_contact(kn, 0.8, 1.0, 0.5, 2.0).max_overlap == pytest.approx(0.01, rel=1e-6)
+
+
+@pytest.mark.parametrize(("beta", "phase"), [(-1.0, 0.0), (0.0, 0.5), (1.0, 1.0)])
+def test_tangential_stiffness_special_values(beta, phase):
+    K, m, tc = 0.5, 0.5, 0.01
+    kt = cm.tangential_stiffness_for_beta(beta, K, m, tc)
+    assert math.sqrt(kt * (1 + K) / (K * m)) * tc == pytest.approx(phase * math.pi)
+
+
+@settings(max_examples=40, deadline=None)
+@given(beta=st.floats(-1.0, 1.0), K=st.sampled_from([0.4, 0.5]), m=st.floats(0.1, 3.0),
+       tc=st.floats(1e-4, 1.0))
+def test_beta_round_trip(beta, K, m, tc):
+    kt = cm.tangential_stiffness_for_beta(beta, K, m, tc)
+    assert cm.spring_beta(kt, K, m, tc) == pytest.approx(beta, abs=1e-9)
+
+
+def test_hooke_kt_over_kn_is_the_same_for_pairs_and_walls():
+    ratios = []
+    for m_eff in (0.5, 1.0):
+        c = cm.make_contact(kn=1e5, e=0.7, m_eff=m_eff, K=0.5, beta=0.3)
+        ratios.append(c.kt / c.kn)
+    assert ratios[0] == pytest.approx(ratios[1], rel=1e-12)
+
+
+def test_walton_rule():
+    K, e, mu = 0.4, 0.8, 0.2
+    assert cm.walton_beta(mu, 0.5, e, K, 0.1) == 0.5  # sticking
+    slide = cm.walton_beta(mu, 0.5, e, K, 10.0)
+    assert slide == pytest.approx(-1 + mu * 1.8 * 3.5 / 10.0)
+    # Coulomb impulse check: |dg_t| = mu (1 + e) g_n (1 + 1/K) for a sliding impact
+    gn, gt = 1.0, 10.0
+    assert gt * (1 + slide) == pytest.approx(mu * (1 + e) * gn * (1 + 1 / K))
+
+
+def test_granular_args():
+    smooth = cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.5)
+    assert smooth.tangential == "none"
+    assert smooth.granular_args() == (
+        "hooke 100000 0.9 damping coeff_restitution tangential linear_nohistory 0.0 0.0")
+    assert "linear_history" not in smooth.granular_args()
+    assert cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.5, beta=-1.0).tangential == "none"
+    spring = cm.make_contact(kn=1e5, e=0.6, m_eff=0.5, K=0.5, beta=0.4)
+    args = spring.granular_args().split()
+    assert args[:7] == ["hooke", "100000", "0.6", "damping", "coeff_restitution",
+                        "tangential", "linear_history"]
+    assert float(args[7]) == pytest.approx(spring.kt) and args[8:] == ["0.0", "1e+20"]
+    coul = cm.make_contact(kn=1e5, e=0.6, m_eff=0.5, K=0.5, mu=0.3, beta0=0.4)
+    assert coul.tangential == "coulomb" and coul.kt == pytest.approx(spring.kt)
+    assert coul.granular_args().endswith(" 0.0 0.3")
+    hz = cm.make_contact(kn=1e6, e=0.6, m_eff=0.5, K=0.4, beta=0.0, model="hertz",
+                         r_eff=0.25, speed=1.0)
+    assert hz.granular_args().startswith("hertz 1000000 0.6 damping coeff_restitution")
+
+
+def test_contact_parameter_validation():
+    with pytest.raises(ValueError):
+        cm.ContactParameters("hooke", 1e5, 0.9, 1.0, None, "none", 0.5, 0.01)
+    with pytest.raises(ValueError):
+        cm.ContactParameters("hooke", 1e5, 0.9, 1.0, 0.5, "spring", 0.5, 0.01)
+    with pytest.raises(ValueError):
+        cm.ContactParameters("hooke", 1e5, 0.9, 1.0, None, "coulomb", 0.5, 0.01)
+    with pytest.raises(ValueError):
+        cm.ContactParameters("dmt", 1e5, 0.9, 0.0, None, "none", 0.5, 0.01)  # type: ignore[arg-type]
+    with pytest.raises(ValueError):
+        cm.tangential_stiffness_for_beta(1.2, 0.5, 0.5, 0.01)
+    with pytest.raises(ValueError):
+        cm.damping_ratio(0.0)
+    with pytest.raises(ValueError):
+        cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.5, mu=0.3, beta0=-1.0)
+    with pytest.raises(ValueError):
+        cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.5, model="hertz")
+
+
+def test_scales_and_helpers():
+    assert cm.pair_mass(1.0, 1.0) == 0.5 and cm.pair_mass(1.0, 3.0) == 0.75
+    assert cm.pair_radius(0.5, 0.5) == 0.25
+    assert cm.inertia_factor(2) == 0.5 and cm.inertia_factor(3) == 0.4
+    # rho d^3 for a unit sphere of unit mass: rho = 1 / (pi/6)
+    assert cm.mass_scale(1.0, 3) == pytest.approx(6 / math.pi)
+    assert cm.mass_scale(1.0, 2) == pytest.approx(4 / math.pi)
+    assert cm.kn_from_kstar(1e4, 2.0, 1.0, 3) == pytest.approx(1e4 * 6 / math.pi * 4.0)
+    assert cm.kn_from_kappa(1e3, 0.01, 3, d=2.0) == pytest.approx(20.0)
+    assert cm.kn_from_kappa(1e3, 0.01, 2) == pytest.approx(10.0)
+    assert cm.timestep(0.01, 50) == pytest.approx(2e-4)
+    with pytest.raises(ValueError):
+        cm.timestep(0.01, 0)
