@@ -1,0 +1,116 @@
+"""Block averaging and jackknife errors against processes with known statistics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.signal import lfilter
+
+from demstudy.analysis.blocking import BlockAccumulator, blocking_curve, jackknife
+
+
+def ar1(rho: float, n: int, chains: int, seed: int) -> np.ndarray:
+    """(n, chains) stationary AR(1) series x_t = rho x_{t-1} + e_t, e ~ N(0, 1)."""
+    rng = np.random.default_rng(seed)
+    e = rng.normal(size=(n, chains))
+    e[0] *= 1.0 / np.sqrt(1.0 - rho**2)  # start in the stationary distribution
+    return lfilter([1.0], [1.0, -rho], e, axis=0)
+
+
+def ar1_error_of_mean(rho: float, n: int) -> float:
+    """Exact standard error of the mean of n consecutive stationary AR(1) samples."""
+    var_x = 1.0 / (1.0 - rho**2)
+    factor = (1 + rho) / (1 - rho) - 2 * rho * (1 - rho**n) / (n * (1 - rho) ** 2)
+    return float(np.sqrt(var_x * factor / n))
+
+
+def feed(acc: BlockAccumulator, samples: np.ndarray) -> BlockAccumulator:
+    for row in samples:
+        acc.add(row)
+    return acc
+
+
+def test_ar1_error_matches_exact():
+    rho, n, chains = 0.9, 2**16, 64
+    x = ar1(rho, n, chains, seed=11)
+    acc = feed(BlockAccumulator(chains, max_blocks=64), x)
+    est, err = jackknife(acc, lambda m: m)
+    exact = ar1_error_of_mean(rho, n)
+    naive = x.std() / np.sqrt(n)
+    assert exact / naive > 4  # the correlation matters: naive error is 4.4x too small
+    assert np.mean(err) == pytest.approx(exact, rel=0.10)
+    assert np.std(est) == pytest.approx(exact, rel=0.25)  # spread of independent chains
+    assert np.mean(np.abs(err / exact - 1) < 0.25) > 0.8  # per chain, typically within 25 %
+    np.testing.assert_allclose(est, x.mean(0), rtol=1e-12, atol=1e-12)
+
+
+def test_ratio_estimator_of_correlated_series():
+    """Jackknife error of sum(x)/sum(y) with x = 3 y + b, y = 2 + a (a, b AR(1))."""
+    rho, n, chains = 0.8, 2**14, 100
+    a, b = ar1(rho, n, chains, seed=1), ar1(rho, n, chains, seed=2)
+    y = 2.0 + 0.3 * a
+    x = 3.0 * y + b
+    acc = feed(BlockAccumulator(2 * chains, max_blocks=32), np.hstack([x, y]))
+    est, err = jackknife(acc, lambda m: m[:chains] / m[chains:])
+    expected = ar1_error_of_mean(rho, n) / 2.0  # delta method: R - 3 ~ mean(b) / mean(y)
+    assert np.mean(err) == pytest.approx(expected, rel=0.10)
+    assert np.std(est) == pytest.approx(expected, rel=0.25)
+    assert np.mean(est) == pytest.approx(3.0, abs=4 * expected / np.sqrt(chains))
+
+
+def test_linear_jackknife_equals_block_standard_error():
+    rng = np.random.default_rng(3)
+    acc = feed(BlockAccumulator(3, max_blocks=8), rng.normal(size=(8 * 16, 3)))
+    assert acc.n_blocks * acc.block_length == acc.n_samples  # no partial block
+    means = acc.block_sums / acc.block_length
+    _, err = jackknife(acc, lambda m: m)
+    np.testing.assert_allclose(err, means.std(0, ddof=1) / np.sqrt(acc.n_blocks), rtol=1e-12)
+
+
+@settings(max_examples=50, deadline=None)
+@given(n=st.integers(1, 3000), max_blocks=st.sampled_from([4, 6, 16, 64]))
+def test_memory_bounded_and_sums_exact(n, max_blocks):
+    samples = np.arange(2 * n, dtype=float).reshape(n, 2) % 7  # integers: exact sums
+    acc = feed(BlockAccumulator(2, max_blocks=max_blocks), samples)
+    assert acc.n_blocks < max_blocks
+    assert acc.n_samples == n
+    assert acc.block_length & (acc.block_length - 1) == 0  # a power of two
+    assert 0 <= n - acc.n_blocks * acc.block_length < acc.block_length
+    np.testing.assert_array_equal(acc.total, samples.sum(0))
+    if n >= max_blocks:
+        assert acc.n_blocks >= max_blocks // 2 - 1
+
+
+def test_dict_estimator_and_too_few_blocks():
+    acc = BlockAccumulator(2)
+    acc.add([1.0, 2.0])
+    est, err = jackknife(acc, lambda m: {"ratio": m[0] / m[1], "both": m})
+    assert est["ratio"] == 0.5 and np.all(np.isnan(err["both"]))
+    for v in ([3.0, 2.0], [5.0, 2.0]):
+        acc.add(v)
+    est, err = jackknife(acc, lambda m: {"ratio": m[0] / m[1], "both": m})
+    assert est["ratio"] == pytest.approx(1.5) and err["both"].shape == (2,)
+
+
+def test_blocking_curve_rises_to_plateau():
+    rho, n = 0.99, 2**16
+    x = ar1(rho, n, 16, seed=5)
+    acc = feed(BlockAccumulator(16, max_blocks=4096), x)
+    lengths, errors = blocking_curve(acc, lambda m: m)
+    curve = errors.mean(axis=1)
+    exact = ar1_error_of_mean(rho, n)
+    assert lengths[0] == 32 and np.all(np.diff(lengths) > 0)
+    assert curve[0] < 0.75 * exact  # short blocks underestimate
+    plateau = curve[(lengths >= 1024) & (lengths <= 4096)]
+    np.testing.assert_allclose(plateau, exact, rtol=0.3)
+
+
+def test_errors():
+    with pytest.raises(ValueError):
+        BlockAccumulator(2, max_blocks=5)
+    with pytest.raises(ValueError):
+        BlockAccumulator(2).add([1.0, 2.0, 3.0])
+    with pytest.raises(ValueError):
+        jackknife(BlockAccumulator(2), lambda m: m)
