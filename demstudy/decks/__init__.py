@@ -12,6 +12,7 @@ from ..scene.initial import InitialState, build_initial_state
 from .base import Block, Deck, UnsupportedByEngine
 from .contact import ContactSetup, contact_setup, pair_block
 from .output import run_block, sampling_block
+from .servo import has_servo, region_wall_block
 from .system import DATA_FILE, data_file, groups_block, setup_block
 from .walls import bump_positions, gravity_block, integrate_block, shear_block, wall_block
 
@@ -29,7 +30,7 @@ def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None
         setup_block(scene, has_bumps),
         groups_block(has_bumps),
         pair_block(scene, setup),
-        *[wall_block(scene, wall, setup) for wall in scene.walls],
+        *[_wall(scene, wall, setup) for wall in scene.walls],
         gravity_block(scene),
         shear_block(scene),
         sampling_block(scene, setup),
@@ -46,10 +47,25 @@ def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None
             "(beta = -cos(omega_t t_c)); exact for binary collisions, approximate for lasting "
             "contacts"
         )
+    if has_servo(scene):
+        deck.notes.append(
+            "servo walls are plane regions moved from Python between run segments (Campbell's "
+            "rule every servo interval); the periodic width follows the gap by moving the "
+            "box boundaries (fix deform x vel); in a bare lmp run the walls stay fixed"
+        )
     if has_bumps:
         deck.notes.append("bumpy walls: bumps are particles 1e6 times heavier than m, moved "
                           "with the wall by fix move (m_eff = m to 1 part in 1e6)")
     return deck
+
+
+def _wall(scene: Scene, wall, setup: ContactSetup) -> Block:
+    if not has_servo(scene):
+        return wall_block(scene, wall, setup)
+    if wall.kind == "bumpy":
+        raise UnsupportedByEngine("lammps", f"walls[{wall.side}].kind", "bumpy",
+                                  "bumpy walls cannot be combined with the servo in LAMMPS")
+    return region_wall_block(scene, wall, setup)
 
 
 def write_deck(scene: Scene, directory: str | Path, dump: str | None = None) -> Path:

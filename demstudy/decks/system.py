@@ -21,6 +21,8 @@ DENSITY = {2: 4 / math.pi, 3: 6 / math.pi}
 def boundary(scene: Scene) -> str:
     if scene.y_periodic:
         y = "p"
+    elif any(w.servo is not None for w in scene.walls):
+        y = "m"  # servo walls move: the box follows the particles
     elif scene.has_open_top:
         y = "fm"
     else:

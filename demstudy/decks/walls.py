@@ -10,7 +10,7 @@ import numpy as np
 
 from ..scene import Scene
 from ..scene.schema import Wall
-from .base import Block, UnsupportedByEngine, fmt
+from .base import Block, fmt
 from .contact import ContactSetup
 
 BUMP_MASS_FACTOR = 1e6  # bump particles are this much heavier: m_eff = m to 1 part in 1e6
@@ -47,12 +47,6 @@ def bump_positions(scene: Scene) -> np.ndarray | None:
 
 
 def wall_block(scene: Scene, wall: Wall, setup: ContactSetup) -> Block:
-    if wall.servo is not None:
-        raise UnsupportedByEngine(
-            "lammps", f"walls[{wall.side}].servo", wall.servo.model_dump(),
-            "Campbell's normal-stress servo (walls moving with the measured stress, periodic "
-            "width scaled with the gap) is not implemented for LAMMPS yet; use fixed walls",
-        )
     fid = wall_fix_id(wall.side)
     pos = fmt(scene.wall_position(wall.side))
     plane = f"yplane {pos} NULL" if wall.side == "lower" else f"yplane NULL {pos}"
@@ -63,9 +57,9 @@ def wall_block(scene: Scene, wall: Wall, setup: ContactSetup) -> Block:
         # force of the wall on the particles, summed (columns 2-4 of the contacts array)
         f"compute {fid}_force mobile reduce sum f_{fid}[2] f_{fid}[3] f_{fid}[4]",
     ]
-    comment = f"{wall.kind} {wall.side} wall at y = {pos}, e_w = {wall.restitution:g}, " + (
-        f"{wall.tangential.model} tangential" + (f", moving at u = {wall.velocity:g}" if motion else "")
-    )
+    moving = f", moving at u = {wall.velocity:g}" if motion else ""
+    comment = (f"{wall.kind} {wall.side} wall at y = {pos}, e_w = {wall.restitution:g}, "
+               f"{wall.tangential.model} tangential{moving}")
     if wall.kind == "bumpy":
         comment += "; bumps: heavy particles of type 2 moving with the wall"
         v = fmt(wall.velocity)

@@ -29,7 +29,8 @@ from .._lammps import mpirun_executable, open_lammps
 from ..analysis.profiles import ProfileAnalysis
 from ..decks import Deck, build_deck
 from ..decks.contact import contact_setup
-from ..decks.output import sample_steps, steps
+from ..decks.output import WALL_FORCES, sample_steps, segment_steps, steps
+from ..decks.servo import ServoController, has_servo
 from ..decks.system import DATA_FILE
 from ..io.frames import Frame
 from ..io.results import Results, write_results
@@ -41,12 +42,15 @@ CHECKPOINT_STATE = "checkpoint.pkl"
 WORKER_FLAG = "DEMSTUDY_LAMMPS_WORKER"
 
 
-def profile_analysis(scene: Scene) -> ProfileAnalysis:
-    """Profiles along the scene's axis over the region particles can occupy."""
+def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None) -> ProfileAnalysis:
+    """Profiles along the scene's axis over the region particles can occupy (``walls``: the
+    current lower and upper wall positions when walls move)."""
     m = scene.measure
     axis = "xyz".index(m.axis)
     period = scene.box.size[axis] if m.axis in scene.periodic else 0.0
-    if m.axis == "y" and not scene.y_periodic:
+    if m.axis == "y" and walls is not None:
+        lo, hi = walls
+    elif m.axis == "y" and not scene.y_periodic:
         lo = scene.wall_position("lower")
         hi = scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]
     else:
@@ -83,6 +87,9 @@ class LammpsSession:
     def fix_vector(self, fix_id: str, length: int) -> np.ndarray:
         """Global vector of a fix (e.g. ``fix ave/time``), identical on every rank."""
         lam = sys.modules[type(self.lmp).__module__.split(".")[0]]
+        if length == 1:  # a fix averaging one value has a global scalar, not a vector
+            return np.array([self.lmp.extract_fix(fix_id, lam.LMP_STYLE_GLOBAL,
+                                                  lam.LMP_TYPE_SCALAR)], dtype=float)
         return np.array([
             self.lmp.extract_fix(fix_id, lam.LMP_STYLE_GLOBAL, lam.LMP_TYPE_VECTOR, i)
             for i in range(length)
@@ -101,6 +108,21 @@ class RunState:
     frames: dict[str, list] = field(default_factory=dict)
     profiles: ProfileAnalysis | None = None
     wall_seconds: float = 0.0
+    servo: ServoController | None = None
+    # wall forces (on the particles) summed over segments since the last sample / servo update
+    force_sums: dict[str, np.ndarray] = field(default_factory=dict)
+    force_counts: dict[str, int] = field(default_factory=dict)
+
+    def add_forces(self, forces: np.ndarray) -> None:
+        for key in ("sample", "servo"):
+            self.force_sums[key] = self.force_sums.get(key, 0.0) + forces
+            self.force_counts[key] = self.force_counts.get(key, 0) + 1
+
+    def take_forces(self, key: str) -> np.ndarray | None:
+        """Mean wall forces since the last call for ``key`` (None before any segment)."""
+        count = self.force_counts.pop(key, 0)
+        total = self.force_sums.pop(key, None)
+        return None if not count else total / count
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
@@ -167,6 +189,9 @@ class _Driver:
             if state["scene"] != scene_to_toml(self.scene):
                 raise EngineError("--resume: the checkpoint belongs to a different scene")
             return state["run"]
+        if has_servo(self.scene):
+            # bins are laid between the walls where they stand when production starts
+            return RunState(servo=ServoController(self.scene, self.dt))
         return RunState(profiles=profile_analysis(self.scene))
 
     # -- sampling -----------------------------------------------------------------------
@@ -188,23 +213,29 @@ class _Driver:
     def _sample(self, session: LammpsSession, state: RunState, production: bool) -> None:
         t = state.step * self.dt
         frame = self._frame(session, t)
-        walls = {
-            w.side: session.fix_vector(f"wall_{w.side}_mean", self.scene.dimension)
-            for w in self.scene.walls
-        }
         if session.rank != 0:
             return
         dim, K = self.scene.dimension, self.scene.inertia_k
         mass = (2 * frame.radius) ** dim
         inertia = K * mass * frame.radius**2
         state.record("time", t)
+        state.record("momentum", np.sum(mass[:, None] * frame.velocity, axis=0))
         state.record("kinetic_energy", 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)))
         state.record("rotational_energy",
                      0.5 * float(np.sum(inertia[:, None] * frame.angular_velocity**2)))
-        for side, force in walls.items():
+        forces = state.take_forces("sample")
+        for i, wall in enumerate(self.scene.walls):
             # force of the particles on the wall, averaged over the interval that just ended
-            state.record(f"wall_force_{side}", -force if state.step > 0 else force * np.nan)
+            force = -forces[i, :dim] if forces is not None else np.full(dim, np.nan)
+            state.record(f"wall_force_{wall.side}", force)
+        if state.servo is not None:
+            state.servo.advance(t)
+            for key, value in state.servo.state().items():
+                state.record(key, value)
         if production:
+            if state.profiles is None:
+                lower, upper = state.servo.walls["lower"], state.servo.walls["upper"]
+                state.profiles = profile_analysis(self.scene, (lower.y, upper.y))
             state.profiles.feed(frame)
             if self.keep_frames:
                 for key in ("position", "velocity", "angular_velocity", "radius"):
@@ -223,7 +254,7 @@ class _Driver:
             return
         os.replace(f"{restart}.new", restart)
         snapshot = RunState(state.step, state.timeseries, state.frames, state.profiles,
-                            state.wall_seconds + time.perf_counter() - started)
+                            state.wall_seconds + time.perf_counter() - started, state.servo)
         tmp = self.workdir / (CHECKPOINT_STATE + ".new")
         with open(tmp, "wb") as fh:
             pickle.dump({"scene": scene_to_toml(self.scene), "run": snapshot}, fh)
@@ -236,6 +267,8 @@ class _Driver:
         started = time.perf_counter()
         try:
             self._issue_deck(session, resume=self.options.resume)
+            if state.servo is not None and state.step > 0:
+                state.servo.apply(session.command)  # variables are not in restart files
             session.command("run 0 post no")
             if state.step == 0:
                 if self.dump is not None and self.dump.exists() and session.rank == 0:
@@ -257,16 +290,31 @@ class _Driver:
         return self._write(state, version)
 
     def _loop(self, session: LammpsSession, state: RunState, started: float) -> None:
+        servo = state.servo
+        n_servo = servo.n_steps if servo is not None else self.n_sample
+        segment = segment_steps(self.scene, self.dt)
         bar = tqdm(total=self.n_total * self.dt, initial=state.step * self.dt, unit="τ",
                    disable=not self.options.progress or session.rank != 0,
                    bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} τ [{elapsed}<{remaining}]",
                    desc=f"lammps {self.scene.meta.name}")
+        pre = "no"
         with bar:
             while state.step < self.n_total:
-                n = min(self.n_sample, self.n_total - state.step)
-                session.command(f"run {n} pre no post no")
+                n = min(segment, self.n_total - state.step)
+                session.command(f"run {n} pre {pre} post no")
+                pre = "no"
                 state.step += n
-                self._sample(session, state, production=state.step > self.n_eq)
+                walls = self.scene.walls
+                if walls:
+                    forces = session.fix_vector(WALL_FORCES, 3 * len(walls))
+                    state.add_forces(forces.reshape(len(walls), 3))
+                if servo is not None and state.step % n_servo == 0:
+                    mean = state.take_forces("servo")
+                    normal = {w.side: mean[i, 1] for i, w in enumerate(walls)}
+                    servo.update(state.step * self.dt, normal, session.command)
+                    pre = "yes"  # variables and fixes changed: LAMMPS must set up again
+                if state.step % self.n_sample == 0:
+                    self._sample(session, state, production=state.step > self.n_eq)
                 bar.update(n * self.dt)
                 if self.n_ckpt and state.step % self.n_ckpt == 0 and state.step < self.n_total:
                     self._checkpoint(session, state, started)

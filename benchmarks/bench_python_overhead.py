@@ -1,0 +1,74 @@
+"""Python-driven LAMMPS run vs bare ``lmp -in deck.in`` on the same ~30k-sphere chute deck.
+
+The Python run samples (gathers every particle from LAMMPS memory and accumulates exact
+volume-weighted profiles) every ``--sample-every`` steps; the bare run only prints thermo.
+Overhead = t_python / t_bare − 1 (goal ≤ 5 %). Prints a Markdown row for docs/benchmarks.md.
+
+    python benchmarks/bench_python_overhead.py [--steps 2000] [--sample-every 100]
+
+Dimensionless particle units: d = 1, m = 1, g = 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+from demstudy._lammps import lmp_executable
+from demstudy.decks import write_deck
+from demstudy.decks.contact import contact_setup
+from demstudy.engines.base import RunOptions
+from demstudy.engines.lammps import LammpsEngine
+from demstudy.scene import validate_scene
+
+
+def chute_scene(steps: int, sample_every: int, dt: float | None = None) -> dict:
+    """3D chute, 32 × 30 × 32 = 30 720 rough spheres on a rough base at 25°."""
+    scene = {
+        "meta": {"name": "bench-chute-30k"},
+        "dimension": 3,
+        "box": {"size": [35.2, 40.0, 35.2]},
+        "particles": {"inertia": "sphere"},
+        "contact": {"restitution": 0.8, "tangential": {"model": "beta", "beta": 0.0}},
+        "walls": [{"side": "lower", "restitution": 0.8, "tangential": {"model": "rough"}}],
+        "gravity": {"angle": 25.0},
+        "initial": {"placement": "lattice", "rows": 30, "columns": 32, "layers": 32,
+                    "spacing": 1.1, "velocity": {"profile": "uniform", "scale": 1.0,
+                                                 "perturbation": 0.1}},
+        "run": {"equilibration": 0.0, "production": 1.0, "sample_interval": 1.0},
+        "soft": {"stiffness": 1e5, "steps_per_contact": 50},
+    }
+    dt = dt or contact_setup(validate_scene(scene)).timestep
+    scene["run"] = {"equilibration": 0.0, "production": steps * dt,
+                    "sample_interval": sample_every * dt}
+    return scene
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--steps", type=int, default=2000)
+    parser.add_argument("--sample-every", type=int, default=100)
+    args = parser.parse_args()
+    scene = validate_scene(chute_scene(args.steps, args.sample_every))
+    with tempfile.TemporaryDirectory() as tmp:
+        deck = write_deck(scene, Path(tmp) / "bare")
+        t0 = time.perf_counter()
+        subprocess.run([lmp_executable(), "-in", deck.name, "-log", "none", "-screen", "none"],
+                       cwd=deck.parent, check=True)
+        bare = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        LammpsEngine().run(scene, RunOptions(out=Path(tmp) / "py.h5", progress=False))
+        python = time.perf_counter() - t0
+    n = scene.n_particles
+    print(f"machine: {platform.processor() or platform.machine()}, {platform.node()}")
+    overhead = 100 * (python / bare - 1)
+    print(f"| {n} spheres | {args.steps} steps | sample every {args.sample_every} | "
+          f"bare {bare:.2f} s | python {python:.2f} s | overhead {overhead:+.1f} % |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,205 @@
+"""The LAMMPS engine driven from Python: conservation laws, capture paths, errors, resume, MPI.
+
+Dimensionless particle units: d = 1, m = 1, g = 1.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from demstudy.decks.base import UnsupportedByEngine
+from demstudy.engines.base import EngineError, RunOptions
+from demstudy.engines.lammps import LammpsEngine, LammpsSession, _Driver
+from demstudy.io.results import read_results
+from demstudy.scene import load_scene, validate_scene
+
+ROOT = Path(__file__).resolve().parent.parent
+CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
+
+
+def chute(**run) -> object:
+    settings = {"run.equilibration": 2.0, "run.production": 6.0, "run.sample_interval": 0.25}
+    settings.update({f"run.{k}": v for k, v in run.items()})
+    return load_scene(CHUTE, [f"{k}={v}" for k, v in settings.items()])
+
+
+def run(scene, tmp_path: Path, name: str = "run.h5", **options) -> object:
+    path = LammpsEngine().run(scene, RunOptions(out=tmp_path / name, progress=False, **options))
+    return read_results(path)
+
+
+def test_wall_forces_close_the_momentum_balance(tmp_path):
+    """Σ (wall force on the particles) dt = Δp − M g T, component by component: the wall
+    force record, its sign and its time averaging are exact up to O(dt) end terms."""
+    scene = chute()
+    res = run(scene, tmp_path)
+    ts = res.timeseries
+    t, p = ts["time"], ts["momentum"]
+    on_wall = ts["wall_force_lower"][1:]  # force of the particles on the wall
+    interval = np.diff(t)
+    impulse_on_particles = -(on_wall * interval[:, None]).sum(axis=0)
+    g = np.array(scene.gravity_vector)
+    weight_impulse = scene.n_particles * g * (t[-1] - t[0])
+    expected = p[-1] - p[0] - weight_impulse
+    scale = np.abs(weight_impulse).max()
+    assert np.all(np.abs(impulse_on_particles - expected) < 2e-3 * scale), (
+        impulse_on_particles, expected)
+    # the bed presses on the base: the mean normal force is close to the weight N g cos α
+    normal = on_wall[:, 1].mean()
+    assert normal == pytest.approx(-scene.n_particles * math.cos(math.radians(30)), rel=0.25)
+
+
+def test_profiles_cover_every_particle(tmp_path):
+    """Σ_bins ν · (bin area) = N π/4: no particle is lost or counted twice. Soft discs
+    overlap the base by up to ~1e-3 d; the sliver below y = 0 lies outside the bins, so the
+    tolerance is 1e-4 (one lost disc would be 2.5e-2)."""
+    scene = chute()
+    res = run(scene, tmp_path)
+    prof = res.profiles
+    total = np.sum(prof["solid_fraction"]) * res.profile_attrs["bin_width"] * scene.box.size[0]
+    assert total == pytest.approx(scene.n_particles * math.pi / 4, rel=1e-4)
+
+
+def test_in_memory_and_dump_profiles_agree(tmp_path):
+    from demstudy.engines.lammps import profile_analysis
+    from demstudy.io.dump import read_dump
+
+    scene = chute()
+    dump = tmp_path / "frames.dump"
+    res = run(scene, tmp_path, dump=dump)
+    analysis = profile_analysis(scene)
+    analysis.run(read_dump(dump, scene.dimension, dt=res.attrs["timestep"]))
+    analysis.finish()
+    assert analysis.attrs["samples"] == res.profile_attrs["samples"]
+    for key in ("solid_fraction", "velocity", "temperature", "rotational_temperature"):
+        # the dump is text at full precision, read by MDAnalysis in single precision
+        np.testing.assert_allclose(analysis.results[key], res.profiles[key], rtol=1e-5,
+                                   atol=1e-6, err_msg=key)
+
+
+def rolling_pair(**run) -> object:
+    """Two rough discs, one on the other, toppling and rolling down a 20° incline: lasting
+    contacts with loaded tangential springs (pair and wall), and no chaos to amplify
+    round-off."""
+    return validate_scene({
+        "dimension": 2, "box": {"size": [6.0, 10.0]},
+        "contact": {"restitution": 0.6, "tangential": {"model": "beta", "beta": 0.5}},
+        "walls": [{"side": "lower", "restitution": 0.8,
+                   "tangential": {"model": "beta", "beta": 0.5}}],
+        "gravity": {"angle": 20.0},
+        "particles": {},
+        "initial": {"placement": "lattice", "rows": 2, "columns": 1, "spacing": 1.02,
+                    "jitter": False, "velocity": {"profile": "uniform", "scale": 0.3}},
+        "run": {"equilibration": 0.5, "production": 2.0, "sample_interval": 0.25,
+                "checkpoint_interval": 0.5, **run},
+        "soft": {"stiffness": 1e5, "steps_per_contact": 50},
+    })
+
+
+def test_resume_after_interruption_continues_exactly(tmp_path, monkeypatch):
+    """A run interrupted after a checkpoint and resumed ends where the uninterrupted run
+    ends: positions, velocities, spins and contact histories all survive the restart."""
+    scene = rolling_pair()
+    whole = run(scene, tmp_path, "whole.h5", keep_frames=True)
+
+    original = _Driver._sample
+
+    def interrupt(self, session, state, production):
+        original(self, session, state, production)
+        if state.step * self.dt > 1.1:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(_Driver, "_sample", interrupt)
+    with pytest.raises(EngineError, match="--resume"):
+        run(scene, tmp_path, "parts.h5", keep_frames=True)
+    monkeypatch.setattr(_Driver, "_sample", original)
+    assert not (tmp_path / "parts.h5").exists()
+    parts = run(scene, tmp_path, "parts.h5", keep_frames=True, resume=True)
+
+    np.testing.assert_array_equal(whole.timeseries["time"], parts.timeseries["time"])
+    # Restart files are binary-exact, but LAMMPS rebuilds neighbour lists and ghosts, so
+    # round-off differs inside the stiff contacts (k_n = 1e5: 1e-11 in position shows as
+    # 1e-8 in velocity). A lost tangential history would show as ~1e-2 (its force,
+    # m g sin α, acting for 0.25 time units).
+    for key, tol in (("position", 1e-8), ("velocity", 1e-6), ("angular_velocity", 1e-6)):
+        np.testing.assert_allclose(parts.frames[key], whole.frames[key], rtol=0, atol=tol,
+                                   err_msg=key)
+    # the discs were rolling with loaded springs when the run was cut
+    assert np.all(np.abs(whole.frames["angular_velocity"][-1]) > 0.1)
+    np.testing.assert_allclose(parts.profiles["velocity"], whole.profiles["velocity"],
+                               atol=1e-6)
+
+
+def test_resume_refuses_a_changed_scene(tmp_path, monkeypatch):
+    scene = rolling_pair()
+    original = _Driver._sample
+
+    def interrupt(self, session, state, production):
+        original(self, session, state, production)
+        if state.step * self.dt > 0.6:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(_Driver, "_sample", interrupt)
+    with pytest.raises(EngineError):
+        run(scene, tmp_path, "r.h5")
+    monkeypatch.setattr(_Driver, "_sample", original)
+    with pytest.raises(EngineError, match="different scene"):
+        run(rolling_pair(seed=7), tmp_path, "r.h5", resume=True)
+
+
+def test_lammps_errors_name_the_deck_line(tmp_path):
+    session = LammpsSession(tmp_path)
+    session.command("units lj")
+    with pytest.raises(EngineError) as info:
+        session.command("fix broken all no/such/style")
+    assert "deck line: fix broken all no/such/style" in str(info.value)
+    assert "ERROR" in str(info.value)
+    session.close()
+
+
+def test_unsupported_wall_rule_is_refused_before_lammps_starts(tmp_path):
+    scene = load_scene(ROOT / "inputs" / "campbell1982" / "couette-noslip.toml")
+    with pytest.raises(UnsupportedByEngine, match="campbell-noslip"):
+        LammpsEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))
+    assert not (tmp_path / "x.lammps").exists()
+
+
+def test_elastic_smooth_gas_conserves_energy(tmp_path):
+    """e = 1, smooth, no walls, no gravity: a soft elastic gas keeps its kinetic energy up
+    to the O((dt/t_c)²) error of velocity Verlet. A sample taken during a contact misses the
+    elastic energy stored in it, so KE may dip there but never rise above E0."""
+    scene = validate_scene({
+        "dimension": 3, "box": {"size": [8.0, 8.0, 8.0]},
+        "particles": {"count": 60}, "contact": {"restitution": 1.0},
+        "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+        "run": {"equilibration": 0.0, "production": 4.0, "sample_interval": 0.5},
+        "soft": {"stiffness": 1e5, "steps_per_contact": 100},
+    })
+    res = run(scene, tmp_path)
+    ke = res.timeseries["kinetic_energy"] / res.timeseries["kinetic_energy"][0]
+    assert np.all(ke < 1 + 1e-4), ke
+    assert np.mean(np.abs(ke - 1) < 1e-4) >= 0.5, ke  # dilute: most samples are contact-free
+    p = res.timeseries["momentum"]
+    assert np.abs(p - p[0]).max() < 1e-9 * scene.n_particles
+
+
+def test_isolated_run_reports_failure_as_engine_error(tmp_path):
+    scene = chute()
+    bad = tmp_path / "not-a-dir"
+    bad.write_text("a file where the results folder should be")
+    with pytest.raises((EngineError, OSError)):
+        LammpsEngine().run(scene, RunOptions(out=bad / "run.h5", progress=False, isolate=True))
+
+
+@pytest.mark.slow
+def test_mpi_two_ranks_matches_particle_count(tmp_path):
+    scene = chute()
+    res = run(scene, tmp_path, np=2)
+    prof = res.profiles
+    total = np.sum(prof["solid_fraction"]) * res.profile_attrs["bin_width"] * scene.box.size[0]
+    assert total == pytest.approx(scene.n_particles * math.pi / 4, rel=1e-4)
+    assert res.profile_attrs["samples"] == 24
