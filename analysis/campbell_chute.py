@@ -39,11 +39,13 @@ def main(argv: list[str] | None = None) -> int:
     prof, ts = res.profiles, res.timeseries
     y, nu, u = prof["y"], prof["solid_fraction"], prof["velocity"][:, 0]
     n = scene.n_particles
+    alpha = scene.gravity.angle
     # H = twice the mass-mean height of the centres (Campbell's definition of the depth)
     mean_height = float(np.sum(y * nu) / np.sum(nu))
     production = ts["time"] >= res.attrs["equilibration_end"]
     ke = ts["kinetic_energy"][production] / n
-    print(f"scene:   {SCENE.relative_to(ROOT)} ({n} discs, {scene.gravity.angle:g}°)")
+    force = np.nanmean(ts["wall_force_lower"][production], axis=0)
+    print(f"scene:   {SCENE.relative_to(ROOT)} ({n} discs, {alpha:g}°)")
     print(f"results: {h5}")
     print(f"figure:  {fig}")
     print(f"wall time {res.attrs['wall_seconds']:.1f} s; dt = {res.attrs['timestep']:.3g}; "
@@ -52,6 +54,12 @@ def main(argv: list[str] | None = None) -> int:
           f"min {ke.min():.3f}, max {ke.max():.3f} (m g d)")
     print(f"H = 2 × mass-mean height = {2 * mean_height:.2f} d; "
           f"slip velocity u(y≈0.5) = {u[0]:.2f}, max u = {u.max():.2f} (√(g d))")
+    print(f"base: shear/normal force {abs(force[0] / force[1]):.3f} "
+          f"(steady flow needs tan α = {np.tan(np.radians(alpha)):.3f}); normal force "
+          f"{abs(force[1]):.2f} vs weight·cos α = {n * np.cos(np.radians(alpha)):.2f}")
+    verdict = "steady" if res.attrs["steady"] else "NOT steady"
+    print(f"convergence (Campbell: KE within ~20 % with no trend): {verdict}, "
+          f"KE trend {100 * res.attrs['kinetic_energy_trend']:+.0f} % over production")
     return 0
 
 

@@ -31,6 +31,9 @@ def plot_profiles(paths: Sequence[str | Path], out: str | Path) -> Path:
             raise ValueError(f"{path}: the results file holds no profiles")
         y = prof["y"]
         label = f"{res.attrs.get('scene_name', Path(path).stem)} ({res.attrs.get('engine')})"
+        if "steady" in res.attrs and not res.attrs["steady"]:
+            trend = 100 * res.attrs["kinetic_energy_trend"]
+            label += f"\nNOT STEADY: kinetic energy changed {trend:+.0f} % over production"
         occupied = prof["solid_fraction"] > 1e-3
         for ax, (key, title) in zip(axes, PANELS, strict=True):
             if key not in prof:

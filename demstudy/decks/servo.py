@@ -149,4 +149,6 @@ class ServoController:
 
     def state(self) -> dict[str, float]:
         return {"gap": self.gap, "width": self.width,
+                "wall_position_lower": self.walls["lower"].y,
+                "wall_position_upper": self.walls["upper"].y,
                 "wall_velocity_upper": self.walls["upper"].vx}

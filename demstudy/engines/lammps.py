@@ -27,6 +27,7 @@ from tqdm import tqdm
 
 from .._lammps import mpirun_executable, open_lammps
 from ..analysis.profiles import ProfileAnalysis
+from ..analysis.steady import energy_trend, is_steady
 from ..decks import Deck, build_deck
 from ..decks.contact import contact_setup
 from ..decks.output import WALL_FORCES, sample_steps, segment_steps, steps
@@ -327,8 +328,12 @@ class _Driver:
         frames = None
         if state.frames:
             frames = {k: np.asarray(v) for k, v in state.frames.items()}
+        prod = timeseries["time"] >= self.n_eq * self.dt
+        trend = energy_trend(timeseries["time"][prod], timeseries["kinetic_energy"][prod])
         attrs = {
             "engine": "lammps",
+            "kinetic_energy_trend": trend,
+            "steady": is_steady(trend),
             "engine_version": f"LAMMPS {version}",
             "scene_toml": scene_to_toml(scene),
             "scene_name": scene.meta.name,
