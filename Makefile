@@ -16,7 +16,7 @@ $(STAMP): $(SOURCES)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet "scikit-build-core>=0.10" "nanobind>=2.4"
-	$(PY) -m pip install --quiet --no-build-isolation -C editable.mode=inplace -e ".[test]"
+	$(PY) -m pip install --quiet --no-build-isolation -e ".[test]"
 	touch $(STAMP)
 
 install: $(STAMP)

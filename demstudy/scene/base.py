@@ -17,7 +17,10 @@ def nearest(name: str, allowed: list[str]) -> str | None:
 class StrictModel(BaseModel):
     """Base of every scene section: frozen, no unknown keys, helpful messages."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+    # allow_inf_nan=False: TOML has nan and inf literals; no scene number may be non-finite
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, validate_default=True, allow_inf_nan=False
+    )
 
     @model_validator(mode="before")
     @classmethod

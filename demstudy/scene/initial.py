@@ -34,12 +34,13 @@ class InitialState:
         return self.diameter ** self.position.shape[1]
 
 
-def y_range(scene: Scene) -> tuple[float, float]:
-    """The interval available to particle centres along y."""
+def y_range(scene: Scene, radius: float = 0.5) -> tuple[float, float]:
+    """The interval available to the centres of particles of ``radius`` along y."""
     if scene.y_periodic:
         return 0.0, scene.box.size[1]
-    lo = scene.wall_position("lower") + 0.5 + MARGIN
-    hi = (scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]) - 0.5 - MARGIN
+    lo = scene.wall_position("lower") + radius + MARGIN
+    top = scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]
+    hi = top - radius - MARGIN
     return lo, hi
 
 
@@ -50,7 +51,7 @@ def build_initial_state(scene: Scene) -> InitialState:
     diameter = 1.0 + spread * (rng.random(n) - 0.5) if spread > 0 else np.ones(n)
     init = scene.initial
     if init.placement == "lattice":
-        position = _campbell_lattice(scene, rng)
+        position = _campbell_lattice(scene, rng, d_max=1.0 + spread / 2)
     elif init.placement == "file":
         position, velocity = _from_file(scene)
     else:
@@ -63,15 +64,16 @@ def build_initial_state(scene: Scene) -> InitialState:
     if temperature > 0:
         mass = diameter**dim
         noise = rng.normal(size=(n, dim)) * np.sqrt(temperature / mass)[:, None]
-        velocity = velocity + noise - noise.mean(axis=0)
+        # remove the noise's momentum (mass-weighted: diameters may differ)
+        velocity = velocity + noise - (mass[:, None] * noise).sum(axis=0) / mass.sum()
         inertia = scene.inertia_k * mass * diameter**2 / 4
         if scene.rotation_matters and scene.inertia_k > 0:
             angular = rng.normal(size=(n, spin_dofs)) * np.sqrt(temperature / inertia)[:, None]
     return InitialState(position, velocity, angular, diameter)
 
 
-def _campbell_lattice(scene: Scene, rng: np.random.Generator) -> np.ndarray:
-    """Campbell's COL007: square (cubic) lattice jittered by at most the gap (s − 1)/2."""
+def _campbell_lattice(scene: Scene, rng: np.random.Generator, d_max: float = 1.0) -> np.ndarray:
+    """Campbell's COL007: square (cubic) lattice jittered by at most the gap (s − d_max)/2."""
     init, dim = scene.initial, scene.dimension
     s = init.spacing
     layers = (init.layers or 1) if dim == 3 else 1
@@ -84,10 +86,10 @@ def _campbell_lattice(scene: Scene, rng: np.random.Generator) -> np.ndarray:
         pos.append(s / 2 + s * deps.ravel())
     position = np.stack(pos, axis=1)
     if init.jitter:
-        gap = (s - 1.0) / 2 - MARGIN / 2
+        gap = max(0.0, (s - d_max) / 2 - MARGIN / 2)
         position += gap * rng.uniform(-1.0, 1.0, size=position.shape)
     # order by row then column, as Campbell numbered his particles
-    order = np.lexsort([position[:, 0], np.round(position[:, 1] / s)])
+    order = np.lexsort([position[:, 0], np.floor((position[:, 1] - lower) / s)])
     return position[order]
 
 
@@ -95,7 +97,7 @@ def _random_placement(scene: Scene, rng: np.random.Generator, d_max: float) -> n
     """Random non-overlapping centres: random sequential addition when dilute, otherwise a
     random subset of a close-packed lattice (hexagonal / fcc), jittered within its gaps."""
     dim, n = scene.dimension, scene.n_particles
-    lo_y, hi_y = y_range(scene)
+    lo_y, hi_y = y_range(scene, radius=d_max / 2)
     lo = np.array([0.0, lo_y] + ([0.0] if dim == 3 else []))
     hi = np.array([scene.box.size[0], hi_y] + ([scene.box.size[2]] if dim == 3 else []))
     periodic = np.array([True, scene.y_periodic] + ([True] if dim == 3 else []))

@@ -24,14 +24,22 @@ class SceneError(ValueError):
         super().__init__(f"invalid scene {source}:\n{lines}")
 
 
+_TANGENTIAL_TAGS = ("smooth", "beta", "rough", "coulomb", "campbell-noslip")
+
+
 def _location(loc: tuple) -> str:
     parts: list[str] = []
+    previous = None
     for item in loc:
+        after, previous = previous, item
         if isinstance(item, int):
             parts[-1:] = [f"{parts[-1]}[{item}]"] if parts else [f"[{item}]"]
-        elif item in ("smooth", "beta", "rough", "coulomb", "campbell-noslip"):
-            continue  # discriminated-union tag: not a key the user wrote
-        elif isinstance(item, str) and ("[" in item or "|" in item or item.startswith("function")):
+        elif after == "tangential" and item in _TANGENTIAL_TAGS:
+            continue  # discriminated-union tag (not the field `beta` inside model = 'beta')
+        elif isinstance(item, str) and (
+            "[" in item or "|" in item or item.startswith(("function", "constrained-"))
+            or item in ("float", "int", "str", "bool")
+        ):
             continue  # pydantic's internal union-member labels
         else:
             parts.append(str(item))
@@ -162,7 +170,7 @@ def dump_toml(data: Mapping[str, Any]) -> str:
         if isinstance(value, int | float):
             return repr(value)
         if isinstance(value, str):
-            return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+            return _toml_string(value)
         if isinstance(value, list):
             return "[" + ", ".join(scalar(v) for v in value) + "]"
         if isinstance(value, dict):
@@ -186,6 +194,23 @@ def dump_toml(data: Mapping[str, Any]) -> str:
 
     table("", data, None)
     return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def _toml_string(text: str) -> str:
+    """A TOML basic string: quote, backslash and control characters escaped (newlines too)."""
+    out = []
+    for ch in text:
+        if ch in '"\\':
+            out.append("\\" + ch)
+        elif ch == "\n":
+            out.append("\\n")
+        elif ch == "\t":
+            out.append("\\t")
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04x}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
 
 
 def _is_table(value: Any) -> bool:

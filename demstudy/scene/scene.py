@@ -172,9 +172,21 @@ class Scene(StrictModel):
         if self.walls and self.wall("lower") is None:
             problems.append("walls: an upper wall needs a lower wall (the open side is the top)")
         if self.walls and len(self.box.size) > 1:
+            ly = self.box.size[1]
+            for i, wall in enumerate(self.walls):
+                if wall.position is not None and not 0.0 <= wall.position <= ly:
+                    problems.append(
+                        f"walls[{i}].position = {wall.position:g}: outside the box; allowed "
+                        f"0 <= position <= box.size[1] = {ly:g}"
+                    )
             lo, hi = self.wall_position("lower"), self.wall_position("upper")
             if self.wall("upper") is not None and hi - lo < 2.0:
                 problems.append(f"walls: gap {hi - lo:g} between lower and upper wall is < 2 d")
+            elif self.wall("upper") is None and hi - lo < 2.0:
+                problems.append(
+                    f"walls: the lower wall at y = {lo:g} leaves {hi - lo:g} < 2 d below the "
+                    f"top of the box (box.size[1] = {ly:g})"
+                )
         for wall in self.walls:
             if wall.servo is not None and self.wall("upper") is None:
                 problems.append("walls.servo: normal-stress control needs two walls")
@@ -182,7 +194,13 @@ class Scene(StrictModel):
 
     def _particle_problems(self) -> list[str]:
         p, init, dim = self.particles, self.initial, self.dimension
+        d_max = 1.0 + p.diameter_spread / 2
         problems = []
+        if init.placement == "lattice" and init.spacing is not None and init.spacing <= d_max:
+            problems.append(
+                f"initial.spacing = {init.spacing:g}: must exceed the largest diameter "
+                f"1 + particles.diameter_spread/2 = {d_max:g}"
+            )
         if init.placement == "random" and p.count is None and p.solid_fraction is None:
             problems.append("particles: give count or solid_fraction for placement = 'random'")
         if init.placement == "lattice" and p.count is not None and p.count != self.n_particles:
@@ -196,10 +214,15 @@ class Scene(StrictModel):
                     f"particles: solid fraction {phi:.4g} exceeds the densest packing "
                     f"{MAX_PACKING[dim]:.4f} in {dim}D"
                 )
-            elif init.placement == "random" and phi > RANDOM_PLACEMENT_LIMIT[dim]:
+            elif init.placement == "random" and phi * d_max**dim > RANDOM_PLACEMENT_LIMIT[dim]:
+                spread = (
+                    f" (as if all had the largest diameter {d_max:g}: {phi * d_max**dim:.4g})"
+                    if d_max > 1.0 else ""
+                )
                 problems.append(
-                    f"particles: solid fraction {phi:.4g} is above {RANDOM_PLACEMENT_LIMIT[dim]} "
-                    "for placement = 'random'; use placement = 'lattice'"
+                    f"particles: solid fraction {phi:.4g}{spread} is above "
+                    f"{RANDOM_PLACEMENT_LIMIT[dim]} for placement = 'random'; use placement = "
+                    "'lattice'" + (" or a smaller diameter_spread" if spread else "")
                 )
             if self.n_particles > 50_000_000:
                 problems.append(f"particles: {self.n_particles} particles is more than 5e7")

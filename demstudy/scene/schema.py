@@ -159,10 +159,21 @@ class Bumps(StrictModel):
 
 class Servo(StrictModel):
     """Campbell's normal-stress control: walls move normal to the flow so that the measured
-    wall stress matches ``normal_stress`` (force per area in 3D, per length in 2D)."""
+    wall stress matches ``normal_stress`` (force per area in 3D, per length in 2D).
+
+    Every update (``interval_collisions`` × N collisions for event-driven engines,
+    ``interval_time`` for time-stepped ones) each servo wall's normal velocity becomes
+    v ← ½ v ± gain · clamp(σ_measured − σ_n, −σ_n, σ_n) (outwards when pushed harder than
+    σ_n), Campbell's relaxation rule; his unit gain (lengths in radii) is gain = 0.25 in
+    particle units (stress in m v²/d² per unit length in 2D). ``scale_width`` keeps
+    the periodic width proportional to the gap; ``hold_shear_rate`` scales the upper wall's
+    speed with the gap so that (u_upper − u_lower)/gap stays constant.
+    """
 
     normal_stress: PositiveFloat
     interval_collisions: PositiveFloat = 3.0
+    interval_time: PositiveFloat | None = None
+    gain: PositiveFloat = 0.25
     scale_width: bool = True
     hold_shear_rate: bool = True
 
