@@ -6,6 +6,7 @@ discs, so a particle of diameter 1 has mass 1; masses scale with volume).
 
 from __future__ import annotations
 
+import io
 import math
 
 import numpy as np
@@ -57,32 +58,33 @@ def data_file(scene: Scene, state: InitialState, bumps: np.ndarray | None) -> st
     ]
     if scene.shear is not None:
         lines.append("0 0 0 xy xz yz")
-    lines += ["", "Atoms # sphere", ""]
-    pos3 = np.zeros((n, 3))
-    pos3[:, :dim] = state.position
+    # columns: id type diameter density x y z (bumps: type 2, 1e6 times denser)
+    pos = np.zeros((n + nb, 3))
+    pos[:n, :dim] = state.position
+    diameter = np.concatenate([state.diameter, np.zeros(nb)])
+    if nb:
+        pos[n:, :dim] = bumps[:, :dim]
+        diameter[n:] = bumps[:, dim]
     rho = DENSITY[3]  # 2D discs are re-densified with `set density/disc` after reading
-    for i in range(n):
-        x, y, zz = pos3[i]
-        lines.append(f"{i + 1} 1 {state.diameter[i]:.15g} {rho:.15g} {x:.15g} {y:.15g} {zz:.15g}")
-    for j in range(nb):
-        b = np.zeros(4)
-        b[: bumps.shape[1]] = bumps[j]
-        x, y, zz, d = (b[0], b[1], b[2], b[3]) if dim == 3 else (b[0], b[1], 0.0, b[2])
-        lines.append(f"{n + j + 1} 2 {d:.15g} {rho * 1e6:.15g} {x:.15g} {y:.15g} {zz:.15g}")
-    lines += ["", "Velocities", ""]
-    vel = np.zeros((n, 3))
-    vel[:, :dim] = state.velocity
-    omega = np.zeros((n, 3))
+    ids = np.arange(1, n + nb + 1)
+    types = np.where(ids > n, 2, 1)
+    density = np.where(ids > n, rho * 1e6, rho)
+    atoms = np.column_stack([ids, types, diameter, density, pos])
+    vel = np.zeros((n + nb, 6))
+    vel[:n, :dim] = state.velocity
     if dim == 2:
-        omega[:, 2] = state.angular_velocity[:, 0]
+        vel[:n, 5] = state.angular_velocity[:, 0]
     else:
-        omega[:] = state.angular_velocity
-    for i in range(n):
-        v, w = vel[i], omega[i]
-        lines.append(f"{i + 1} " + " ".join(f"{c:.15g}" for c in (*v, *w)))
-    for j in range(nb):
-        lines.append(f"{n + j + 1} 0 0 0 0 0 0")
+        vel[:n, 3:] = state.angular_velocity
+    lines += ["", "Atoms # sphere", "", _table(atoms, "%d %d" + " %.17g" * 5)]
+    lines += ["", "Velocities", "", _table(np.column_stack([ids, vel]), "%d" + " %.17g" * 6)]
     return "\n".join(lines) + "\n"
+
+
+def _table(rows: np.ndarray, fmt_row: str) -> str:
+    buffer = io.StringIO()
+    np.savetxt(buffer, rows, fmt=fmt_row)
+    return buffer.getvalue().rstrip("\n")
 
 
 def setup_block(scene: Scene, has_bumps: bool) -> Block:

@@ -1,0 +1,71 @@
+"""The command line: clear errors without tracebacks, exit codes, decks that run in bare LAMMPS.
+
+Dimensionless particle units: d = 1, m = 1, g = 1.
+"""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from demstudy._lammps import lmp_executable, mpirun_executable
+from demstudy.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
+SHORT = ["--set", "run.equilibration=0.5", "--set", "run.production=1", "--set",
+         "run.sample_interval=0.25"]
+
+
+def test_validate_reports_field_value_and_allowed(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(CHUTE.read_text().replace("restitution = 0.6", "restitution = 1.6"))
+    assert main(["validate", str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "contact.restitution = 1.6" in err and "less than or equal to 1" in err
+    assert "Traceback" not in err
+
+
+def test_validate_suggests_nearest_key(tmp_path, capsys):
+    assert main(["validate", str(CHUTE), "--set", "run.prodction=3"]) == 1
+    assert "did you mean 'production'" in capsys.readouterr().err
+
+
+def test_unsupported_scene_is_refused_with_exit_2(tmp_path, capsys):
+    scene = ROOT / "inputs" / "campbell1982" / "couette-noslip.toml"
+    code = main(["run", str(scene), "--out", str(tmp_path / "x.h5"), "-q"])
+    err = capsys.readouterr().err
+    assert code == 2 and "unsupported by lammps" in err and "campbell-noslip" in err
+
+
+def test_run_and_plot_end_to_end(tmp_path, capsys):
+    out = tmp_path / "chute.h5"
+    assert main(["run", str(CHUTE), "--out", str(out), "-q", *SHORT]) == 0
+    assert out.exists() and not list(tmp_path.glob(".*.tmp-*"))
+    fig = tmp_path / "fig.png"
+    assert main(["plot", str(out), str(out), "-o", str(fig)]) == 0
+    assert fig.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_written_deck_runs_in_bare_lammps(tmp_path, ranks):
+    assert main(["deck", str(CHUTE), "-o", str(tmp_path), *SHORT]) == 0
+    cmd = [lmp_executable(), "-in", "deck.in", "-log", "none"]
+    if ranks > 1:
+        cmd = [mpirun_executable(), "-np", str(ranks), *cmd]
+    proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "ERROR" not in proc.stdout
+    assert f"on {ranks} procs" in proc.stdout
+    assert "Total wall time" in proc.stdout
+
+
+def test_calibrate_prints_measured_restitution(capsys):
+    code = main(["calibrate", "--dim", "2", "--kind", "wall", "--e", "0.8", "--beta", "0.0",
+                 "--speeds", "1.0", "--angles", "0", "30"])
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[2:]]
+    assert code == 0 and len(rows) == 2
+    assert all(abs(float(r[6]) - 0.8) < 5e-3 for r in rows)  # measured e
+    assert abs(float(rows[1][8])) < 1e-2  # measured β at 30° (target 0)
