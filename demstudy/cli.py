@@ -22,8 +22,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             print(exc, file=sys.stderr)
             failed += 1
             continue
-        print(f"ok: {path} ({scene.dimension}D, {scene.n_particles} particles, "
-              f"solid fraction {scene.solid_fraction:.4g})")
+        where = "open top" if scene.has_open_top else f"solid fraction {scene.solid_fraction:.4g}"
+        print(f"ok: {path} ({scene.dimension}D, {scene.n_particles} particles, {where})")
     return 1 if failed else 0
 
 

@@ -130,7 +130,11 @@ def test_deform_only_with_shear(make, dim):
     assert "deform" not in deck_of(make(dim)).render()
     deck = deck_of(make(dim, shear={"rate": 0.5}))
     assert with_prefix(deck, "fix lees_edwards") == [
-        "fix lees_edwards all deform 1 xy erate 0.5 remap v flip yes"]
+        "fix lees_edwards all deform 1 xy variable v_lees_edwards_tilt v_lees_edwards_rate "
+        "remap v flip yes"]
+    # the tilt grows at γ̇ L_y = 0.5 × 10 from the moment the fix is defined
+    assert "variable lees_edwards_rate equal 5" in deck.commands()
+    assert "variable lees_edwards_tilt equal 5*(time-v_lees_edwards_t0)" in deck.commands()
     assert "0 0 0 xy xz yz" in data_file(deck), "a triclinic box for Lees-Edwards"
     assert with_prefix(deck, "boundary") == ["boundary p p p"]
 
@@ -348,45 +352,31 @@ def test_run_lengths_in_steps(make):
 
 
 # ---------------------------------------------------------------- what LAMMPS cannot do
-@pytest.mark.parametrize(("name", "field"), [
-    ("couette-rough", "servo"),
-    ("couette-noslip", "walls.tangential.model"),
-])
-def test_campbell_couette_validates_but_is_unsupported(name, field):
-    scene = load_scene(ROOT / f"inputs/campbell1982/{name}.toml")
+def test_campbell_noslip_couette_validates_but_is_unsupported():
+    scene = load_scene(ROOT / "inputs/campbell1982/couette-noslip.toml")
     with pytest.raises(UnsupportedByEngine) as info:
         build_deck(scene)
+    field = "walls.tangential.model"
     assert field in info.value.field_name and field in str(info.value)
     assert info.value.engine == "lammps"
 
 
-@pytest.mark.parametrize(("changes", "field"), [
-    ({"walls": [LOWER, {**UPPER, "servo": {"normal_stress": 0.01}}]}, "servo"),
-    ({"walls": [{**LOWER, "tangential": {"model": "campbell-noslip"}}]},
-     "walls.tangential.model"),
-    ({"contact": {"law": {"model": "campbell-exp"}}}, "contact.law.model"),
-    ({"particles": {"inertia": 0.0}, "contact": {"tangential": ROUGH}}, "particles.inertia"),
-    ({"soft": {"hardness": {"k_star": 1e4}}}, "soft.hardness.k_star"),
-])
-def test_unsupported_effects_name_the_field(make, changes, field):
+def test_servo_without_interval_time_is_unsupported():
+    data = load_scene(ROOT / "inputs/campbell1982/couette-rough.toml").model_dump(mode="json")
+    for wall in data["walls"]:
+        wall["servo"].pop("interval_time")
+    scene = validate_scene(data)
     with pytest.raises(UnsupportedByEngine) as info:
-        build_deck(make(**changes))
-    assert field in info.value.field_name
+        build_deck(scene)
+    assert "servo.interval_time" in info.value.field_name
 
 
-# ---------------------------------------------------------------- the input scenes
-RUNNABLE = ["campbell1982/chute-30.toml", "malik2008/poiseuille-phi0.01.toml",
-            "shear/lees-edwards-2d.toml", "cooling/hcs-3d.toml"]
+def test_collision_counted_runs_are_unsupported(make):
+    with pytest.raises(UnsupportedByEngine, match="run.unit"):
+        build_deck(make(run={"equilibration": 1.0, "production": 2.0, "unit": "collisions"}))
 
 
-@pytest.mark.parametrize("name", RUNNABLE)
-def test_input_decks(name):
-    scene = load_scene(ROOT / "inputs" / name)
-    deck = build_deck(scene)
-    text = deck.render(scene.meta.name)
-    assert ("fix gravity" in text) == (scene.gravity is not None)
-    assert ("deform" in text) == (scene.shear is not None)
-    assert ("enforce2d" in text) == (scene.dimension == 2)
-    assert ("nve/sphere" in text) == scene.rotation_matters
-    assert text.count("wall/gran") == len(scene.walls)
-    assert f"{scene.n_particles} atoms" in data_file(deck)
+def test_campbell_rough_couette_runs_on_servo_walls():
+    deck = build_deck(load_scene(ROOT / "inputs/campbell1982/couette-rough.toml"))
+    assert deck.effects().count("wall:lower") == 1 and deck.effects().count("wall:upper") == 1
+    assert "wall/gran/region" in deck.render()

@@ -22,6 +22,9 @@ __all__ = ["Block", "Deck", "UnsupportedByEngine", "build_deck", "write_deck"]
 def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None = None,
                setup: ContactSetup | None = None) -> Deck:
     """Compose the deck; raises ``UnsupportedByEngine`` for effects LAMMPS cannot express."""
+    if scene.run.unit != "time":
+        raise UnsupportedByEngine("lammps", "run.unit", scene.run.unit,
+                                  "soft contacts have no collision count: give times")
     setup = setup or contact_setup(scene)
     state = state or build_initial_state(scene)
     bumps = bump_positions(scene)

@@ -84,9 +84,18 @@ def shear_block(scene: Scene) -> Block | None:
     if scene.shear is None:
         return None
     rate = fmt(scene.shear.rate)
+    tilt_rate = fmt(scene.shear.rate * scene.box.size[1])
+    # `xy erate` leaves the tilt unchanged in the 22Jul2025 wheel: drive the tilt by a
+    # variable instead, counted from the time this fix is defined (also after a restart)
     return Block(
         "lees-edwards", f"simple shear at rate {rate}: tilting triclinic box, velocities remapped",
-        [f"fix lees_edwards all deform 1 xy erate {rate} remap v flip yes"],
+        [
+            "variable lees_edwards_t0 equal $(time)",
+            f"variable lees_edwards_tilt equal {tilt_rate}*(time-v_lees_edwards_t0)",
+            f"variable lees_edwards_rate equal {tilt_rate}",
+            "fix lees_edwards all deform 1 xy variable v_lees_edwards_tilt v_lees_edwards_rate "
+            "remap v flip yes",
+        ],
     )
 
 

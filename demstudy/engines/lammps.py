@@ -136,10 +136,7 @@ class LammpsEngine:
         if (options.np > 1 or options.isolate) and os.environ.get(WORKER_FLAG) != "1":
             return _launch_child(scene, options)
         setup = contact_setup(scene)  # raises UnsupportedByEngine before LAMMPS starts
-        deck = build_deck(scene, setup=setup)
-        if scene.run.unit != "time":
-            raise EngineError("run.unit = 'collisions' is not supported by lammps: soft "
-                              "contacts have no collision count; give times")
+        deck = build_deck(scene, setup=setup)  # so does every effect LAMMPS cannot express
         out = Path(options.out).resolve()
         workdir = out.with_suffix(".lammps")
         workdir.mkdir(parents=True, exist_ok=True)
@@ -229,6 +226,8 @@ class _Driver:
             # force of the particles on the wall, averaged over the interval that just ended
             force = -forces[i, :dim] if forces is not None else np.full(dim, np.nan)
             state.record(f"wall_force_{wall.side}", force)
+        if self.scene.shear is not None:
+            state.record("tilt", frame.tilt)  # Lees–Edwards offset of the upper image
         if state.servo is not None:
             state.servo.advance(t)
             for key, value in state.servo.state().items():
@@ -357,7 +356,7 @@ def _launch_child(scene: Scene, options: RunOptions) -> Path:
     A crash inside LAMMPS (a segfault, an MPI abort) then ends the child, not the caller, and
     is reported as an ``EngineError``; the checkpoint written so far remains usable.
     """
-    contact_setup(scene)  # refuse unsupported scenes before launching anything
+    build_deck(scene)  # refuse unsupported scenes before launching anything
     payload = {
         "scene": scene.model_dump(mode="json"),
         "out": str(Path(options.out).resolve()),
@@ -376,16 +375,22 @@ def _launch_child(scene: Scene, options: RunOptions) -> Path:
     cmd = [sys.executable, "-m", "demstudy.engines.lammps", str(job)]
     if options.np > 1:
         cmd = [mpirun_executable(), "-np", str(options.np), *cmd]
+    proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL)
     try:
-        proc = subprocess.run(cmd, env=env, stdin=subprocess.DEVNULL)
+        returncode = proc.wait()
     except KeyboardInterrupt:
+        # the child got the same SIGINT: let it finish its segment and write a checkpoint
+        try:
+            proc.wait(timeout=300)
+        except (subprocess.TimeoutExpired, KeyboardInterrupt):
+            proc.kill()
         raise EngineError("interrupted: run the same command again with --resume to continue "
                           "from the last checkpoint") from None
     finally:
         job.unlink(missing_ok=True)
-    if proc.returncode != 0:
-        how = (f"was killed by signal {-proc.returncode}" if proc.returncode < 0
-               else f"failed (exit {proc.returncode})")
+    if returncode != 0:
+        how = (f"was killed by signal {-returncode}" if returncode < 0
+               else f"failed (exit {returncode})")
         where = out.with_suffix(".lammps") / "log.lammps"
         raise EngineError(f"the LAMMPS run on {options.np} rank(s) {how}; see the messages "
                           f"above and {where}")

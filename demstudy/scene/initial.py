@@ -38,8 +38,8 @@ def y_range(scene: Scene, radius: float = 0.5) -> tuple[float, float]:
     """The interval available to the centres of particles of ``radius`` along y."""
     if scene.y_periodic:
         return 0.0, scene.box.size[1]
-    lo = scene.wall_position("lower") + radius + MARGIN
-    top = scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]
+    lo = scene.wall_surface("lower") + radius + MARGIN
+    top = scene.wall_surface("upper") if scene.wall("upper") else scene.box.size[1]
     hi = top - radius - MARGIN
     return lo, hi
 
@@ -80,7 +80,7 @@ def _campbell_lattice(scene: Scene, rng: np.random.Generator, d_max: float = 1.0
     cols, rows, deps = np.meshgrid(
         np.arange(init.columns), np.arange(init.rows), np.arange(layers), indexing="ij"
     )
-    lower = 0.0 if scene.y_periodic else scene.wall_position("lower")
+    lower = 0.0 if scene.y_periodic else scene.wall_surface("lower")
     pos = [s / 2 + s * cols.ravel(), lower + s / 2 + s * rows.ravel()]
     if dim == 3:
         pos.append(s / 2 + s * deps.ravel())
@@ -109,7 +109,9 @@ def _random_placement(scene: Scene, rng: np.random.Generator, d_max: float) -> n
     return _lattice_subset(n, lo, hi, periodic, d_max, rng)
 
 
-def _sequential_addition(n, lo, hi, periodic, d_max, rng, max_tries: int = 200) -> np.ndarray | None:
+def _sequential_addition(
+    n, lo, hi, periodic, d_max, rng, max_tries: int = 200
+) -> np.ndarray | None:
     lengths = hi - lo
     accepted = np.empty((0, len(lo)))
     remaining = n
@@ -191,7 +193,8 @@ def _from_file(scene: Scene) -> tuple[np.ndarray, np.ndarray | None]:
     data = np.atleast_2d(np.loadtxt(path))
     if data.shape[1] not in (dim, 2 * dim):
         raise ValueError(
-            f"initial.path = {str(path)!r}: expected {dim} or {2 * dim} columns, got {data.shape[1]}"
+            f"initial.path = {str(path)!r}: expected {dim} or {2 * dim} columns, "
+            f"got {data.shape[1]}"
         )
     if len(data) != scene.n_particles:
         raise ValueError(
@@ -212,7 +215,7 @@ def _velocity_profile(scene: Scene, position: np.ndarray, rng: np.random.Generat
     elif v.profile == "campbell-chute":
         init = scene.initial
         height = (init.spacing * init.rows - init.spacing / 2) if init.spacing else y.max()
-        z = (y - scene.wall_position("lower")) / height
+        z = (y - scene.wall_surface("lower")) / height
         u = np.polynomial.polynomial.polyval(z, CAMPBELL_CHUTE_FIT) * v.scale
     elif v.profile == "linear":
         if scene.shear is not None:

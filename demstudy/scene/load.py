@@ -104,7 +104,8 @@ def apply_overrides(data: dict, overrides: Iterable[str], source: str = "--set")
         if path[0] not in Scene.model_fields:
             hint = nearest(path[0], sorted(Scene.model_fields))
             problems.append(
-                f"{key}: unknown section {path[0]!r}" + (f"; did you mean {hint!r}?" if hint else "")
+                f"{key}: unknown section {path[0]!r}"
+                + (f"; did you mean {hint!r}?" if hint else "")
             )
             continue
         node: Any = data

@@ -110,6 +110,16 @@ class Scene(StrictModel):
             return wall.position
         return 0.0 if side == "lower" else self.box.size[1]
 
+    def wall_surface(self, side: str) -> float:
+        """Where particles meet the wall: its plane, or the tops of its bumps (random bumps
+        stand up to a quarter diameter proud of the plane)."""
+        wall = self.wall(side)
+        y = self.wall_position(side)
+        if wall is None or wall.bumps is None:
+            return y
+        reach = wall.bumps.diameter * (0.75 if wall.bumps.pattern == "random" else 0.5)
+        return y + reach if side == "lower" else y - reach
+
     @property
     def gravity_vector(self) -> tuple[float, ...] | None:
         g = self.gravity
@@ -135,7 +145,9 @@ class Scene(StrictModel):
         dim = self.dimension
         problems: list[str] = []
         if len(self.box.size) != dim:
-            problems.append(f"box.size = {self.box.size}: needs {dim} lengths for dimension = {dim}")
+            problems.append(
+                f"box.size = {self.box.size}: needs {dim} lengths for dimension = {dim}"
+            )
         periodic = self.box.periodic
         if periodic is not None:
             if dim == 2 and "z" in periodic:
@@ -245,8 +257,8 @@ class Scene(StrictModel):
                 )
             if dim == 2 and init.layers is not None:
                 problems.append("initial.layers: 2D lattices have rows and columns only")
-            top = self.wall_position("lower") + init.rows * s
-            if self.wall("upper") is not None and top > self.wall_position("upper") + 1e-9:
+            top = self.wall_surface("lower") + init.rows * s
+            if self.wall("upper") is not None and top > self.wall_surface("upper") + 1e-9:
                 problems.append(f"initial: rows × spacing = {init.rows * s:g} exceeds the wall gap")
             if not self.walls and init.rows * s > self.box.size[1] + 1e-9:
                 problems.append(

@@ -90,7 +90,8 @@ class Coulomb(StrictModel):
 
 
 class NoSlip(StrictModel):
-    """Campbell's "no-slip" wall: the centre takes the wall's tangential velocity, spin unchanged."""
+    """Campbell's "no-slip" wall: the centre takes the wall's tangential velocity; the spin is
+    unchanged."""
 
     model: Literal["campbell-noslip"]
 
@@ -139,7 +140,9 @@ class Particles(StrictModel):
 
     count: PositiveInt | None = None
     solid_fraction: float | None = Field(default=None, gt=0.0, lt=1.0)
-    inertia: Literal["disc", "sphere", "shell", "point"] | Annotated[float, Field(ge=0, le=1)] | None = None
+    inertia: (
+        Literal["disc", "sphere", "shell", "point"] | Annotated[float, Field(ge=0, le=1)] | None
+    ) = None
     diameter_spread: float = Field(default=0.0, ge=0.0, lt=0.5)
 
     @model_validator(mode="after")
