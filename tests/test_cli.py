@@ -8,6 +8,7 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from demstudy._lammps import lmp_executable, mpirun_executable
@@ -69,3 +70,29 @@ def test_calibrate_prints_measured_restitution(capsys):
     assert code == 0 and len(rows) == 2
     assert all(abs(float(r[6]) - 0.8) < 5e-3 for r in rows)  # measured e
     assert abs(float(rows[1][8])) < 1e-2  # measured β at 30° (target 0)
+
+
+def test_bare_lees_edwards_deck_tilts_at_the_shear_rate(tmp_path):
+    """Two runs (equilibration, production) in a bare deck: the tilt must grow at γ̇ L_y
+    through both, although the second `run` re-initialises fix deform."""
+    scene = ROOT / "inputs" / "shear" / "lees-edwards-2d.toml"
+    overrides = ["--set", "run.equilibration=0.3", "--set", "run.production=0.4", "--set",
+                 "run.sample_interval=0.1"]
+    assert main(["deck", str(scene), "-o", str(tmp_path), *overrides]) == 0
+    proc = subprocess.run([lmp_executable(), "-in", "deck.in", "-log", "none"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:]
+    rows = []
+    for block in proc.stdout.split("Step")[1:]:
+        for line in block.splitlines()[1:]:
+            parts = line.split()
+            if len(parts) >= 3 and parts[0].isdigit():
+                rows.append((float(parts[1]), float(parts[-1])))
+    time, tilt = np.array(rows).T
+    from demstudy.scene import load_scene
+
+    sc = load_scene(scene)
+    lx, ly, rate = sc.box.size[0], sc.box.size[1], sc.shear.rate
+    offset = np.mod(tilt - rate * ly * time + lx / 2, lx) - lx / 2  # flips: modulo L_x
+    np.testing.assert_allclose(offset, 0.0, atol=1e-3)
+    assert time.max() > 0.6

@@ -37,6 +37,8 @@ def sampling_block(scene: Scene, setup: ContactSetup) -> Block:
         cmds.append(f"fix {WALL_FORCES} all ave/time 1 {n} {n} {forces}")
         count = len(scene.walls) * 3
         columns += [f"f_{WALL_FORCES}[{i}]" for i in range(1, count + 1)]
+    if scene.shear is not None:
+        columns.append("xy")  # the Lees–Edwards tilt
     cmds.append("thermo_style custom " + " ".join(columns))
     cmds.append("thermo_modify norm no lost error")
     return Block("sampling", "energies (translational; rotational with sphere inertia) and "
@@ -61,6 +63,9 @@ def run_block(scene: Scene, setup: ContactSetup, dump: str | None = None) -> Blo
     eq, prod = steps(scene.run.equilibration, dt), steps(scene.run.production, dt)
     if eq:
         cmds.append(f"run {eq}  # equilibration: {scene.run.equilibration:g} time units")
+        if scene.shear is not None:
+            # the next run re-initialises fix deform: count the tilt from now again
+            cmds.append("variable lees_edwards_t0 equal $(time)")
     cmds.append(f"run {prod}  # production: {scene.run.production:g} time units")
     return Block("run", f"bare-deck runs, dt = {dt:.6g}, thermo every {n_sample} steps",
                  cmds, stage="run")

@@ -247,9 +247,18 @@ class _Driver:
                     "omegax omegay omegaz modify sort id append yes format float %.17g"
                 )
 
+    def _rebase_shear(self, session: LammpsSession, state: RunState) -> None:
+        """Re-anchor the Lees–Edwards tilt variable after LAMMPS re-initialised fix deform.
+
+        Every init (``write_restart``, ``run … pre yes``) makes fix deform take the current
+        tilt as its start, so the tilt increment must count from that moment again."""
+        if self.scene.shear is not None:
+            session.command(f"variable lees_edwards_t0 equal {state.step * self.dt:.17g}")
+
     def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
         restart = self.workdir / CHECKPOINT_RESTART
         session.command(f"write_restart {restart}.new")
+        self._rebase_shear(session, state)  # write_restart re-initialises LAMMPS
         if session.rank != 0:
             return
         os.replace(f"{restart}.new", restart)
@@ -301,6 +310,8 @@ class _Driver:
         with bar:
             while state.step < self.n_total:
                 n = min(segment, self.n_total - state.step)
+                if pre == "yes":
+                    self._rebase_shear(session, state)
                 session.command(f"run {n} pre {pre} post no")
                 pre = "no"
                 state.step += n
