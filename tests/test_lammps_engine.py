@@ -32,6 +32,23 @@ def run(scene, tmp_path: Path, name: str = "run.h5", **options) -> object:
     return read_results(path)
 
 
+def run_interrupted(scene, tmp_path: Path, name: str, monkeypatch, after: float,
+                    **options) -> None:
+    """Run until the first sample after time ``after``, then interrupt as Ctrl-C would."""
+    original = _Driver._sample
+
+    def interrupt(self, session, state, production):
+        original(self, session, state, production)
+        if state.step * self.dt > after:
+            raise KeyboardInterrupt
+
+    with monkeypatch.context() as patch:
+        patch.setattr(_Driver, "_sample", interrupt)
+        with pytest.raises(EngineError, match="--resume"):
+            run(scene, tmp_path, name, **options)
+    assert not (tmp_path / name).exists()
+
+
 def test_wall_forces_close_the_momentum_balance(tmp_path):
     """Σ (wall force on the particles) dt = Δp − M g T, component by component: the wall
     force record, its sign and its time averaging are exact up to O(dt) end terms."""
@@ -105,19 +122,7 @@ def test_resume_after_interruption_continues_exactly(tmp_path, monkeypatch):
     ends: positions, velocities, spins and contact histories all survive the restart."""
     scene = rolling_pair()
     whole = run(scene, tmp_path, "whole.h5", keep_frames=True)
-
-    original = _Driver._sample
-
-    def interrupt(self, session, state, production):
-        original(self, session, state, production)
-        if state.step * self.dt > 1.1:
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(_Driver, "_sample", interrupt)
-    with pytest.raises(EngineError, match="--resume"):
-        run(scene, tmp_path, "parts.h5", keep_frames=True)
-    monkeypatch.setattr(_Driver, "_sample", original)
-    assert not (tmp_path / "parts.h5").exists()
+    run_interrupted(scene, tmp_path, "parts.h5", monkeypatch, 1.1, keep_frames=True)
     parts = run(scene, tmp_path, "parts.h5", keep_frames=True, resume=True)
 
     np.testing.assert_array_equal(whole.timeseries["time"], parts.timeseries["time"])
@@ -136,17 +141,7 @@ def test_resume_after_interruption_continues_exactly(tmp_path, monkeypatch):
 
 def test_resume_refuses_a_changed_scene(tmp_path, monkeypatch):
     scene = rolling_pair()
-    original = _Driver._sample
-
-    def interrupt(self, session, state, production):
-        original(self, session, state, production)
-        if state.step * self.dt > 0.6:
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(_Driver, "_sample", interrupt)
-    with pytest.raises(EngineError):
-        run(scene, tmp_path, "r.h5")
-    monkeypatch.setattr(_Driver, "_sample", original)
+    run_interrupted(scene, tmp_path, "r.h5", monkeypatch, 0.6)
     with pytest.raises(EngineError, match="different scene"):
         run(rolling_pair(seed=7), tmp_path, "r.h5", resume=True)
 
@@ -217,17 +212,7 @@ def test_lees_edwards_resume_continues_the_tilt(tmp_path, monkeypatch):
         "soft": {"stiffness": 1e4, "steps_per_contact": 50},
     })
     whole = run(scene, tmp_path, "whole.h5")
-    original = _Driver._sample
-
-    def interrupt(self, session, state, production):
-        original(self, session, state, production)
-        if state.step * self.dt > 3.2:
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(_Driver, "_sample", interrupt)
-    with pytest.raises(EngineError):
-        run(scene, tmp_path, "parts.h5")
-    monkeypatch.setattr(_Driver, "_sample", original)
+    run_interrupted(scene, tmp_path, "parts.h5", monkeypatch, 3.2)
     parts = run(scene, tmp_path, "parts.h5", resume=True)
     np.testing.assert_allclose(parts.timeseries["tilt"], whole.timeseries["tilt"], atol=1e-9)
     # tilt = γ̇ L_y t, flipped back by L_x past L_x/2, across checkpoints (write_restart

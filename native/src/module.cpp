@@ -27,6 +27,19 @@ void check(bool ok, const std::string& what) {
     if (!ok) throw nb::value_error(what.c_str());
 }
 
+// The bin grid and the output arrays, shared by both accumulators.
+void check_grid(std::int64_t nbins, double width, double period, const Out1& out_volume,
+                const Out2& out_sums, std::int64_t nv) {
+    check(nbins > 0, "nbins must be positive");
+    check(width > 0.0, "width must be positive");
+    check(period >= 0.0, "period must be >= 0 (0 = not periodic)");
+    check(static_cast<std::int64_t>(out_volume.shape(0)) == nbins,
+          "out_volume must have shape (nbins,)");
+    check(static_cast<std::int64_t>(out_sums.shape(0)) == nbins &&
+              static_cast<std::int64_t>(out_sums.shape(1)) == nv,
+          "out_sums must have shape (nbins, number of values)");
+}
+
 std::int64_t accumulate(In1 coord, In1 radius, In2 values, double lo, double width,
                         std::int64_t nbins, int dim, double period, Out1 out_volume,
                         Out2 out_sums) {
@@ -35,14 +48,7 @@ std::int64_t accumulate(In1 coord, In1 radius, In2 values, double lo, double wid
     const std::int64_t nv = static_cast<std::int64_t>(values.shape(1));
     check(static_cast<std::int64_t>(radius.shape(0)) == n, "radius must have shape (N,)");
     check(static_cast<std::int64_t>(values.shape(0)) == n, "values must have shape (N, F)");
-    check(nbins > 0, "nbins must be positive");
-    check(width > 0.0, "width must be positive");
-    check(period >= 0.0, "period must be >= 0 (0 = not periodic)");
-    check(static_cast<std::int64_t>(out_volume.shape(0)) == nbins,
-          "out_volume must have shape (nbins,)");
-    check(static_cast<std::int64_t>(out_sums.shape(0)) == nbins &&
-              static_cast<std::int64_t>(out_sums.shape(1)) == nv,
-          "out_sums must have shape (nbins, F)");
+    check_grid(nbins, width, period, out_volume, out_sums, nv);
     const double* c = coord.data();
     const double* r = radius.data();
     const double* v = values.data();
@@ -66,14 +72,7 @@ std::int64_t profile(In1 coord, In1 radius, In2 velocity, In2 omega, double iner
     check(static_cast<std::int64_t>(omega.shape(0)) == n &&
               static_cast<std::int64_t>(omega.shape(1)) == nrot,
           "angular velocity must have shape (N, 1) in 2D or (N, 3) in 3D");
-    check(nbins > 0, "nbins must be positive");
-    check(width > 0.0, "width must be positive");
-    check(period >= 0.0, "period must be >= 0 (0 = not periodic)");
-    check(static_cast<std::int64_t>(out_volume.shape(0)) == nbins,
-          "out_volume must have shape (nbins,)");
-    check(static_cast<std::int64_t>(out_sums.shape(0)) == nbins &&
-              static_cast<std::int64_t>(out_sums.shape(1)) == nv,
-          "out_sums must have shape (nbins, profile_nvalues(dim))");
+    check_grid(nbins, width, period, out_volume, out_sums, nv);
     const double* c = coord.data();
     const double* r = radius.data();
     const double* v = velocity.data();
