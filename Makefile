@@ -8,7 +8,10 @@ PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.demstudy-installed
-SOURCES := pyproject.toml CMakeLists.txt $(wildcard native/src/*.cpp native/include/*.hpp)
+# the editable install maps every module at install time: reinstall (a few seconds, the C++
+# build is cached in build/) whenever a source file is newer than the stamp
+SOURCES := pyproject.toml CMakeLists.txt $(wildcard native/src/*.cpp native/include/*.hpp) \
+           $(shell find demstudy -name '*.py' 2>/dev/null)
 
 .PHONY: run test install lint bench clean
 

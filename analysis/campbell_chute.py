@@ -42,7 +42,7 @@ def main(argv: list[str] | None = None) -> int:
     alpha = scene.gravity.angle
     # H = twice the mass-mean height of the centres (Campbell's definition of the depth)
     mean_height = float(np.sum(y * nu) / np.sum(nu))
-    production = ts["time"] >= res.attrs["equilibration_end"]
+    production = ts["time"] > res.attrs["equilibration_end"]  # samples after equilibration
     ke = ts["kinetic_energy"][production] / n
     force = np.nanmean(ts["wall_force_lower"][production], axis=0)
     print(f"scene:   {SCENE.relative_to(ROOT)} ({n} discs, {alpha:g}°)")

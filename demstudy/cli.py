@@ -43,7 +43,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     out = Path(args.out or Path("results") / f"{Path(args.scene).stem}-{args.engine}.h5")
     options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
                          progress=not args.quiet, keep_frames=args.keep_frames or None,
-                         isolate=True)
+                         isolate=True, wall_limit=args.wall_limit)
     path = get_engine(args.engine).run(scene, options)
     print(f"results: {path}")
     return 0
@@ -118,6 +118,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dump", type=Path, help="also write a LAMMPS custom dump of the samples")
     p.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     p.add_argument("--keep-frames", action="store_true", help="store every sampled frame")
+    p.add_argument("--wall-limit", type=float, metavar="SECONDS",
+                   help="checkpoint and stop after this much wall-clock time (then --resume)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_run)
 

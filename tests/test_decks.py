@@ -219,19 +219,48 @@ def test_bumps_only_for_bumpy_walls(make, dim):
     flat = deck_of(make(dim, walls=[LOWER]))
     text = flat.render()
     for absent in ("group bumps", "pair_coeff 1 2", "neigh_modify exclude type 2 2",
-                   "fix bumps_lower", "type 2"):
+                   "fix bumps_lower", "type 2", "bumps_lower_force"):
         assert absent not in text, absent
     assert "1 atom types" in data_file(flat)
     bumpy = deck_of(make(dim, walls=[{**LOWER, "kind": "bumpy", "bumps": {"spacing": 2.0}}]))
     commands = bumpy.commands()
-    assert "group bumps type 2" in commands and "neigh_modify exclude type 2 2" in commands
+    assert "group bumps_lower type 2" in commands
+    assert "neigh_modify exclude type 2 2" in commands
     assert len(with_prefix(bumpy, "pair_coeff 1 2")) == 1
-    assert with_prefix(bumpy, "fix bumps_lower") == ["fix bumps_lower bumps move linear 0 0.0 0.0"]
+    assert with_prefix(bumpy, "fix bumps_lower") == [
+        "fix bumps_lower_move bumps_lower move linear 0 0.0 0.0"]
+    # the bumps' reaction is part of the wall force
+    assert "compute bumps_lower_force bumps_lower reduce sum fx fy fz" in commands
+    assert "c_bumps_lower_force[*]" in with_prefix(bumpy, "fix wall_forces")[0]
     data = data_file(bumpy)
     n_bumps = 5 if dim == 2 else 25  # 10 / 2.0 per periodic direction
     assert "2 atom types" in data and f"{12 + n_bumps} atoms" in data
     atoms = data.split("Atoms # sphere")[1].split("Velocities")[0].split("\n")
     assert sum(line.split()[1:2] == ["2"] for line in atoms if line.strip()) == n_bumps
+
+
+def test_two_bumpy_walls_have_their_own_types_rules_and_motion(make):
+    lower = {**LOWER, "kind": "bumpy", "bumps": {}, "restitution": 0.5,
+             "tangential": {"model": "smooth"}}
+    upper = {**UPPER, "kind": "bumpy", "bumps": {}, "restitution": 0.95, "velocity": 1.0,
+             "tangential": {"model": "rough"}}
+    deck = deck_of(make(walls=[lower, upper]))
+    commands = deck.commands()
+    assert "group bumps_lower type 2" in commands and "group bumps_upper type 3" in commands
+    (pair_lower,) = with_prefix(deck, "pair_coeff 1 2")
+    (pair_upper,) = with_prefix(deck, "pair_coeff 1 3")
+    assert " 0.5 " in pair_lower and "linear_nohistory" in pair_lower
+    assert " 0.95 " in pair_upper and "linear_history" in pair_upper
+    assert with_prefix(deck, "neigh_modify exclude") == [
+        "neigh_modify exclude type 2 2", "neigh_modify exclude type 2 3",
+        "neigh_modify exclude type 3 3"]
+    assert "fix bumps_lower_move bumps_lower move linear 0 0.0 0.0" in commands
+    assert "fix bumps_upper_move bumps_upper move linear 1 0.0 0.0" in commands
+    data = data_file(deck)
+    assert "3 atom types" in data
+    # the box holds the bump centres, which sit on the wall planes
+    lo, hi = map(float, next(x for x in data.splitlines() if "ylo" in x).split()[:2])
+    assert lo < 0.0 and hi > 10.0
 
 
 def test_bumpy_wall_pair_uses_the_wall_contact(make):

@@ -10,11 +10,12 @@ from pathlib import Path
 from ..scene import Scene
 from ..scene.initial import InitialState, build_initial_state
 from .base import Block, Deck, UnsupportedByEngine
+from .bumps import bump_rows
 from .contact import ContactSetup, contact_setup, pair_block
 from .output import run_block, sampling_block
 from .servo import has_servo, region_wall_block
 from .system import DATA_FILE, data_file, groups_block, setup_block
-from .walls import bump_positions, gravity_block, integrate_block, shear_block, wall_block
+from .walls import gravity_block, integrate_block, shear_block, wall_block
 
 __all__ = ["Block", "Deck", "UnsupportedByEngine", "build_deck", "write_deck"]
 
@@ -27,11 +28,10 @@ def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None
                                   "soft contacts have no collision count: give times")
     setup = setup or contact_setup(scene)
     state = state or build_initial_state(scene)
-    bumps = bump_positions(scene)
-    has_bumps = bumps is not None
+    bumps = bump_rows(scene)
     blocks: list[Block | None] = [
-        setup_block(scene, has_bumps),
-        groups_block(has_bumps),
+        setup_block(scene, bumps),
+        groups_block(bumps),
         pair_block(scene, setup),
         *[_wall(scene, wall, setup) for wall in scene.walls],
         gravity_block(scene),
@@ -54,9 +54,9 @@ def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None
         deck.notes.append(
             "servo walls are plane regions moved from Python between run segments (Campbell's "
             "rule every servo interval); the periodic width follows the gap by moving the "
-            "box boundaries (fix deform x vel); in a bare lmp run the walls stay fixed"
+            "box boundaries (fix deform x variable); in a bare lmp run the walls stay fixed"
         )
-    if has_bumps:
+    if bumps:
         deck.notes.append("bumpy walls: bumps are particles 1e6 times heavier than m, moved "
                           "with the wall by fix move (m_eff = m to 1 part in 1e6)")
     return deck

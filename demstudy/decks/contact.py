@@ -13,6 +13,7 @@ from ..contact import mapping
 from ..scene import Scene
 from ..scene.schema import Wall
 from .base import Block, UnsupportedByEngine
+from .bumps import bump_type, bumpy_walls
 
 #: Default hardness: at most this overlap (in d) at the reference speed.
 DEFAULT_OVERLAP = 0.005
@@ -57,22 +58,42 @@ def _rule(rule) -> dict:
 
 
 def choose_stiffness(scene: Scene, e: float, m_eff: float) -> float:
+    """k_n from ``soft.stiffness``, a hardness target, or by default an overlap of
+    DEFAULT_OVERLAP at the reference speed (Hooke: force/length; Hertz: force/length^3/2)."""
     soft = scene.soft
     if soft.stiffness is not None:
         return soft.stiffness
     h = soft.hardness
-    if h is None:
-        return mapping.hooke_kn_for_overlap(DEFAULT_OVERLAP, reference_speed(scene), m_eff, e)
-    if h.overlap is not None:
+    overlap, speed = DEFAULT_OVERLAP, reference_speed(scene)
+    if h is not None and h.overlap is not None:
+        overlap, speed = h.overlap, h.impact_speed
+    elif h is not None:
         if soft.model == "hertz":
-            return mapping.hertz_kn_for_overlap(h.overlap, h.impact_speed, m_eff, 0.25, e)
-        return mapping.hooke_kn_for_overlap(h.overlap, h.impact_speed, m_eff, e)
-    if h.k_star is not None:
-        if scene.shear is None:
-            raise UnsupportedByEngine("lammps", "soft.hardness.k_star", h.k_star,
-                                      "k* = k/(ρ d³ γ̇²) needs a shear rate ([shear])")
-        return mapping.kn_from_kstar(h.k_star, scene.shear.rate, 1.0, scene.dimension)
-    return mapping.kn_from_kappa(h.kappa, h.pressure, scene.dimension)
+            raise UnsupportedByEngine(
+                "lammps", "soft.hardness", h.model_dump(exclude_none=True),
+                "k* and κ define a Hooke stiffness; for Hertz give overlap and impact_speed",
+            )
+        if h.k_star is not None:
+            if scene.shear is None:
+                raise UnsupportedByEngine("lammps", "soft.hardness.k_star", h.k_star,
+                                          "k* = k/(ρ d³ γ̇²) needs a shear rate ([shear])")
+            return mapping.kn_from_kstar(h.k_star, scene.shear.rate, 1.0, scene.dimension)
+        return mapping.kn_from_kappa(h.kappa, h.pressure, scene.dimension)
+    if soft.model == "hertz":
+        return mapping.hertz_kn_for_overlap(overlap, speed, m_eff, 0.25, e)
+    return mapping.hooke_kn_for_overlap(overlap, speed, m_eff, e)
+
+
+def shortest_contact_time(scene: Scene, kn: float, speed: float) -> float:
+    """Contact time of the lightest contacts: the two smallest particles of a polydisperse
+    scene (d_min = 1 − spread/2, m ∝ d^dim), and the smallest particle on a wall."""
+    d_min = 1.0 - scene.particles.diameter_spread / 2
+    m_min = d_min**scene.dimension
+    cases = [(scene.contact.restitution, m_min / 2, d_min / 4)]
+    cases += [(w.restitution, m_min, d_min / 2) for w in scene.walls]
+    if scene.soft.model == "hertz":
+        return min(mapping.hertz_contact(kn, e, m, r, speed).contact_time for e, m, r in cases)
+    return min(mapping.hooke_contact(kn, e, m).contact_time for e, m, _ in cases)
 
 
 def contact_setup(scene: Scene) -> ContactSetup:
@@ -85,6 +106,8 @@ def contact_setup(scene: Scene) -> ContactSetup:
     K, e, model = scene.inertia_k, scene.contact.restitution, scene.soft.model
     kn = choose_stiffness(scene, e, 0.5)
     speed = reference_speed(scene)
+    if scene.soft.hardness is not None and scene.soft.hardness.impact_speed is not None:
+        speed = max(speed, scene.soft.hardness.impact_speed)  # Hertz t_c shrinks with speed
     extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
     lammps_k = (0.5, 0.4) if scene.dimension == 2 else (0.4,)
     if scene.rotation_matters and not any(abs(K - k) < 1e-12 for k in lammps_k):
@@ -96,8 +119,7 @@ def contact_setup(scene: Scene) -> ContactSetup:
     pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
                                 **_rule(scene.contact.tangential), **extra)
     walls = {w.side: _wall_contact(w, kn, K, model, speed) for w in scene.walls}
-    steps = scene.soft.steps_per_contact
-    dt = min([pair.timestep(steps)] + [c.timestep(steps) for c in walls.values()])
+    dt = mapping.timestep(shortest_contact_time(scene, kn, speed), scene.soft.steps_per_contact)
     return ContactSetup(pair, walls, dt, kn)
 
 
@@ -110,12 +132,14 @@ def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float):
 def pair_block(scene: Scene, setup: ContactSetup) -> Block:
     p = setup.pair
     cmds = ["pair_style granular", f"pair_coeff * * {p.granular_args()}"]
-    if any(w.kind == "bumpy" for w in scene.walls):
-        # bump particles (type 2) collide with the wall's rule and m_eff = m (they are heavy)
-        wall = next(w for w in scene.walls if w.kind == "bumpy")
-        cmds.append(f"pair_coeff 1 2 {setup.walls[wall.side].granular_args()}")
-        cmds.append("pair_coeff 2 2 " + p.granular_args())  # unused: excluded below
-        cmds.append("neigh_modify exclude type 2 2")
+    bumpy = bumpy_walls(scene)
+    for wall in bumpy:
+        # each wall's bumps collide with that wall's rule, with m_eff = m (they are heavy)
+        kind = bump_type(scene, wall.side)
+        cmds.append(f"pair_coeff 1 {kind} {setup.walls[wall.side].granular_args()}")
+    types = [bump_type(scene, w.side) for w in bumpy]
+    for i, a in enumerate(types):  # bumps never interact with bumps
+        cmds += [f"neigh_modify exclude type {a} {b}" for b in types[i:]]
     cmds += ["neighbor 0.3 bin", "neigh_modify delay 0 every 1 check yes"]
     comment = (
         f"{p.model} contacts, k_n = {p.kn:.6g}, e = {p.restitution:g}, "

@@ -7,7 +7,7 @@ import math
 from ..scene import Scene
 from .base import Block
 from .contact import ContactSetup
-from .walls import wall_fix_id
+from .walls import wall_force_sources
 
 WALL_FORCES = "wall_forces"
 
@@ -17,26 +17,20 @@ def sample_steps(scene: Scene, dt: float) -> int:
     return max(1, round(scene.run.sample_interval / dt))
 
 
-def segment_steps(scene: Scene, dt: float) -> int:
-    """Steps of one run segment of the Python driver: one sample interval (servo updates
-    are rounded to whole sample intervals)."""
-    return sample_steps(scene, dt)
-
-
 def sampling_block(scene: Scene, setup: ContactSetup) -> Block:
-    n = segment_steps(scene, setup.timestep)
+    n = sample_steps(scene, setup.timestep)  # the Python driver's segment
     cmds = ["compute ke mobile ke"]
     columns = ["step", "time", "c_ke"]
     if scene.rotation_matters:
         cmds.append("compute erot mobile erotate/sphere")
         columns.append("c_erot")
-    if scene.walls:
+    sources = wall_force_sources(scene)
+    if sources:
         # wall forces averaged over every step of each run segment (contacts are brief);
         # one fix for all walls: each ave/time fix costs a few microseconds per step
-        forces = " ".join(f"c_{wall_fix_id(w.side)}_force[*]" for w in scene.walls)
+        forces = " ".join(f"c_{compute}[*]" for _side, compute, _sign in sources)
         cmds.append(f"fix {WALL_FORCES} all ave/time 1 {n} {n} {forces}")
-        count = len(scene.walls) * 3
-        columns += [f"f_{WALL_FORCES}[{i}]" for i in range(1, count + 1)]
+        columns += [f"f_{WALL_FORCES}[{i}]" for i in range(1, 3 * len(sources) + 1)]
     if scene.shear is not None:
         columns.append("xy")  # the Lees–Edwards tilt
     cmds.append("thermo_style custom " + " ".join(columns))

@@ -6,7 +6,7 @@ variables; between run segments the controller measures the mean normal stress o
 (``fix ave/time`` over the servo interval), applies Campbell's rule
 v ← ½ v ± gain · clamp(σ − σ_n, −σ_n, σ_n), and redefines the variables so that the wall
 positions stay continuous. With ``scale_width`` the periodic width follows the gap
-(``fix deform x vel``, boundaries only, as in Campbell's code); with ``hold_shear_rate`` the
+(``fix deform x variable``, boundaries only, as in Campbell's code); with ``hold_shear_rate`` the
 upper wall's speed is rescaled with the gap. In a bare ``lmp -in deck.in`` run nobody drives
 the variables: the walls then stay at their initial positions (the deck says so).
 """
@@ -76,22 +76,25 @@ class WallMotion:
 
 
 class ServoController:
-    """State and update rule of Campbell's servo, issuing LAMMPS commands through ``command``."""
+    """State and update rule of Campbell's servo, issuing LAMMPS commands through ``command``.
+
+    Each servo wall uses its own σ_n and gain; all share one update interval (the scene
+    validation enforces it). ``update`` computes new wall velocities; ``apply`` issues the
+    variables that realise the motion from the current time on and must be followed by a
+    LAMMPS initialisation (``run … pre yes``), which also re-reads the box for fix deform.
+    """
 
     def __init__(self, scene: Scene, dt: float):
         self.scene = scene
-        self.dt = dt
         self.n_steps = servo_interval_steps(scene, dt)
         self.walls = {
             w.side: WallMotion(w.side, scene.wall_position(w.side), 0.0, 0.0, w.velocity)
             for w in scene.walls
         }
-        servo = next(w.servo for w in scene.walls if w.servo is not None)
-        self.sigma_n, self.gain = servo.normal_stress, servo.gain
-        self.scale_width, self.hold_shear_rate = servo.scale_width, servo.hold_shear_rate
+        first = next(w.servo for w in scene.walls if w.servo is not None)
+        self.scale_width, self.hold_shear_rate = first.scale_width, first.hold_shear_rate
         self.gap0 = self.gap
-        self.width = scene.box.size[0]
-        self.shape = self.width / self.gap0
+        self.shape = scene.box.size[0] / self.gap0  # width / gap, held when scale_width
         lower, upper = self.walls["lower"], self.walls["upper"]
         self.shear_rate = (upper.vx - lower.vx) / self.gap0
         self.t_last = 0.0
@@ -100,43 +103,43 @@ class ServoController:
     def gap(self) -> float:
         return self.walls["upper"].y - self.walls["lower"].y
 
-    def area(self, width: float) -> float:
-        return width * (self.scene.box.size[2] if self.scene.dimension == 3 else 1.0)
+    @property
+    def width_rate(self) -> float:
+        if not self.scale_width:
+            return 0.0
+        return self.shape * (self.walls["upper"].vy - self.walls["lower"].vy)
 
     def advance(self, t: float) -> None:
-        """Move the bookkeeping of the wall positions and the width to time ``t``."""
+        """Move the bookkeeping of the wall positions to time ``t``."""
         dt = t - self.t_last
-        rate = self.walls["upper"].vy - self.walls["lower"].vy
         for wall in self.walls.values():
             wall.y += wall.vy * dt
             wall.x += wall.vx * dt
-        if self.scale_width:
-            self.width += self.shape * rate * dt
         self.t_last = t
 
-    def update(self, t: float, normal_force: dict[str, float], command) -> None:
-        """One servo step at time ``t``; ``normal_force[side]`` is the interval-mean y force
-        of that wall on the particles."""
+    def update(self, t: float, normal_force: dict[str, float], width: float) -> None:
+        """One servo step at time ``t``: ``normal_force[side]`` is the interval-mean y force of
+        that wall on the particles, ``width`` the current periodic length along x."""
         self.advance(t)
-        area = self.area(self.width)
+        area = width * (self.scene.box.size[2] if self.scene.dimension == 3 else 1.0)
         for side, wall in self.walls.items():
-            w = self.scene.wall(side)
-            if w.servo is None:
+            servo = self.scene.wall(side).servo
+            if servo is None:
                 continue
             # stress the particles exert on this wall (positive = pushing it outwards)
             sigma = (normal_force[side] if side == "lower" else -normal_force[side]) / area
-            excess = max(-self.sigma_n, min(self.sigma_n, sigma - self.sigma_n))
+            sigma_n = servo.normal_stress
+            excess = max(-sigma_n, min(sigma_n, sigma - sigma_n))
             outward = -1.0 if side == "lower" else 1.0
-            wall.vy = 0.5 * wall.vy + outward * self.gain * excess
+            wall.vy = 0.5 * wall.vy + outward * servo.gain * excess
             if not math.isfinite(wall.vy):
                 raise FloatingPointError(f"servo: non-finite wall velocity at t = {t}")
         if self.hold_shear_rate:
             lower, upper = self.walls["lower"], self.walls["upper"]
             upper.vx = lower.vx + self.shear_rate * self.gap
-        self.apply(command)
 
     def apply(self, command) -> None:
-        """Issue the variable and deform commands that realise the current wall motion."""
+        """Issue the commands that realise the current wall motion from ``t_last`` on."""
         t = self.t_last
         for side, wall in self.walls.items():
             fid = wall_fix_id(side)
@@ -144,11 +147,16 @@ class ServoController:
             command(f"variable {fid}_dx equal {wall.x:.17g}+{wall.vx:.17g}*(time-{t:.17g})")
             command(f"variable {fid}_dy equal {y0:.17g}+{wall.vy:.17g}*(time-{t:.17g})")
         if self.scale_width:
-            rate = self.walls["upper"].vy - self.walls["lower"].vy
-            command(f"fix servo_width all deform 1 x vel {self.shape * rate:.17g} remap none")
+            # the periodic boundaries move (no remap): images approach at the width rate;
+            # a variable counted from now, since fix deform takes the box at each init
+            rate = self.width_rate
+            command(f"variable servo_dw equal {rate:.17g}*(time-{t:.17g})")
+            command(f"variable servo_dw_rate equal {rate:.17g}")
+            command("fix servo_width all deform 1 x variable v_servo_dw v_servo_dw_rate "
+                    "remap none")
 
     def state(self) -> dict[str, float]:
-        return {"gap": self.gap, "width": self.width,
+        return {"gap": self.gap,
                 "wall_position_lower": self.walls["lower"].y,
                 "wall_position_upper": self.walls["upper"].y,
                 "wall_velocity_upper": self.walls["upper"].vx}

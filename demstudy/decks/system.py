@@ -14,6 +14,7 @@ import numpy as np
 from ..scene import Scene
 from ..scene.initial import InitialState
 from .base import Block, fmt
+from .bumps import MASS_FACTOR, BumpRow, bump_padding, n_atom_types
 
 DATA_FILE = "initial.data"
 DENSITY = {2: 4 / math.pi, 3: 6 / math.pi}
@@ -39,36 +40,38 @@ def y_bounds(scene: Scene) -> tuple[float, float]:
     return lo, hi
 
 
-def data_file(scene: Scene, state: InitialState, bumps: np.ndarray | None) -> str:
+def data_file(scene: Scene, state: InitialState, bumps: list[BumpRow]) -> str:
     """LAMMPS data file (atom_style sphere) holding the initial state and any wall bumps."""
     dim = scene.dimension
     n = len(state.position)
-    nb = 0 if bumps is None else len(bumps)
+    bump_xyz = [row.centres for row in bumps]
+    nb = sum(len(c) for c in bump_xyz)
     lo_y, hi_y = y_bounds(scene)
+    pad = 0.0 if scene.y_periodic else bump_padding(scene)  # bumps sit on the wall planes
     z = (0.0, scene.box.size[2]) if dim == 3 else (-0.5, 0.5)
     lines = [
         "demstudy initial state (dimensionless particle units: d = 1, m = 1)",
         "",
         f"{n + nb} atoms",
-        f"{2 if nb else 1} atom types",
+        f"{n_atom_types(scene)} atom types",
         "",
         f"0 {fmt(scene.box.size[0])} xlo xhi",
-        f"{fmt(lo_y)} {fmt(hi_y)} ylo yhi",
+        f"{fmt(lo_y - pad)} {fmt(hi_y + pad)} ylo yhi",
         f"{fmt(z[0])} {fmt(z[1])} zlo zhi",
     ]
     if scene.shear is not None:
         lines.append("0 0 0 xy xz yz")
-    # columns: id type diameter density x y z (bumps: type 2, 1e6 times denser)
+    # columns: id type diameter density x y z (bumps: their wall's type, 1e6 times denser)
     pos = np.zeros((n + nb, 3))
     pos[:n, :dim] = state.position
-    diameter = np.concatenate([state.diameter, np.zeros(nb)])
     if nb:
-        pos[n:, :dim] = bumps[:, :dim]
-        diameter[n:] = bumps[:, dim]
+        pos[n:, :dim] = np.vstack(bump_xyz)
+    diameter = np.concatenate([state.diameter] + [np.full(len(r.centres), r.diameter)
+                                                  for r in bumps])
+    types = np.concatenate([np.ones(n)] + [np.full(len(r.centres), r.atom_type) for r in bumps])
     rho = DENSITY[3]  # 2D discs are re-densified with `set density/disc` after reading
+    density = np.where(types > 1, rho * MASS_FACTOR, rho)
     ids = np.arange(1, n + nb + 1)
-    types = np.where(ids > n, 2, 1)
-    density = np.where(ids > n, rho * 1e6, rho)
     atoms = np.column_stack([ids, types, diameter, density, pos])
     vel = np.zeros((n + nb, 6))
     vel[:n, :dim] = state.velocity
@@ -87,7 +90,7 @@ def _table(rows: np.ndarray, fmt_row: str) -> str:
     return buffer.getvalue().rstrip("\n")
 
 
-def setup_block(scene: Scene, has_bumps: bool) -> Block:
+def setup_block(scene: Scene, bumps: list[BumpRow]) -> Block:
     dim = scene.dimension
     cmds = [
         "units lj",
@@ -101,8 +104,8 @@ def setup_block(scene: Scene, has_bumps: bool) -> Block:
     if dim == 2:
         # read_data gives sphere masses; discs need m = ρ π r² with ρ = 4/π
         cmds.append(f"set type 1 density/disc {DENSITY[2]:.15g}")
-        if has_bumps:
-            cmds.append(f"set type 2 density/disc {DENSITY[2] * 1e6:.15g}")
+        cmds += [f"set type {row.atom_type} density/disc {DENSITY[2] * MASS_FACTOR:.15g}"
+                 for row in bumps]
     comment = (
         f"{'discs' if dim == 2 else 'spheres'}, {scene.n_particles} particles, "
         f"box {' x '.join(f'{s:g}' for s in scene.box.size)}, boundary {boundary(scene)}"
@@ -110,8 +113,7 @@ def setup_block(scene: Scene, has_bumps: bool) -> Block:
     return Block("system", comment, cmds, stage="setup")
 
 
-def groups_block(has_bumps: bool) -> Block:
+def groups_block(bumps: list[BumpRow]) -> Block:
     cmds = ["group mobile type 1"]
-    if has_bumps:
-        cmds.append("group bumps type 2")
-    return Block("groups", "mobile particles" + (" and wall bumps" if has_bumps else ""), cmds)
+    cmds += [f"group {row.group} type {row.atom_type}" for row in bumps]
+    return Block("groups", "mobile particles" + (" and wall bumps" if bumps else ""), cmds)

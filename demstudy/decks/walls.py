@@ -1,4 +1,5 @@
-"""Walls normal to y: flat granular planes, bumpy walls of heavy prescribed-motion particles.
+"""Walls normal to y (flat granular planes, with bumps for bumpy walls), gravity, shear and
+integration blocks.
 
 Dimensionless particle units: d = 1, m = 1. Each wall is its own fix so that its contact
 (m_eff = m, its own e_w and β_w) and its motion belong to it alone.
@@ -6,44 +7,27 @@ Dimensionless particle units: d = 1, m = 1. Each wall is its own fix so that its
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..scene import Scene
 from ..scene.schema import Wall
 from .base import Block, fmt
+from .bumps import bump_type
 from .contact import ContactSetup
-
-BUMP_MASS_FACTOR = 1e6  # bump particles are this much heavier: m_eff = m to 1 part in 1e6
 
 
 def wall_fix_id(side: str) -> str:
     return f"wall_{side}"
 
 
-def bump_positions(scene: Scene) -> np.ndarray | None:
-    """Centres (and diameters, last column) of all bump particles, or None."""
-    rows = []
-    rng = np.random.default_rng(scene.run.seed + 7)
+def wall_force_sources(scene: Scene) -> list[tuple[str, str, float]]:
+    """(side, compute ID, sign) of every force a wall exerts on the particles: the plane's
+    force on the particles (+1), and for bumpy walls minus the particles' force on the
+    bumps (−1). The driver sums them per wall."""
+    sources = []
     for wall in scene.walls:
-        if wall.kind != "bumpy":
-            continue
-        b = wall.bumps
-        y0 = scene.wall_position(wall.side)
-        nx = max(1, round(scene.box.size[0] / b.spacing))
-        xs = (np.arange(nx) + 0.5) * scene.box.size[0] / nx
-        if scene.dimension == 3:
-            nz = max(1, round(scene.box.size[2] / b.spacing))
-            zs = (np.arange(nz) + 0.5) * scene.box.size[2] / nz
-            gx, gz = np.meshgrid(xs, zs, indexing="ij")
-            pts = np.stack([gx.ravel(), np.full(gx.size, y0), gz.ravel()], axis=1)
-        else:
-            pts = np.stack([xs, np.full(nx, y0)], axis=1)
-        if b.pattern == "random":
-            # centres scattered by up to a quarter diameter normal to the wall (never inside it)
-            sign = 1.0 if wall.side == "lower" else -1.0
-            pts[:, 1] += sign * rng.uniform(0.0, 0.25 * b.diameter, len(pts))
-        rows.append(np.column_stack([pts, np.full(len(pts), b.diameter)]))
-    return np.vstack(rows) if rows else None
+        sources.append((wall.side, f"{wall_fix_id(wall.side)}_force", 1.0))
+        if wall.kind == "bumpy":
+            sources.append((wall.side, f"bumps_{wall.side}_force", -1.0))
+    return sources
 
 
 def wall_block(scene: Scene, wall: Wall, setup: ContactSetup) -> Block:
@@ -61,9 +45,14 @@ def wall_block(scene: Scene, wall: Wall, setup: ContactSetup) -> Block:
     comment = (f"{wall.kind} {wall.side} wall at y = {pos}, e_w = {wall.restitution:g}, "
                f"{wall.tangential.model} tangential{moving}")
     if wall.kind == "bumpy":
-        comment += "; bumps: heavy particles of type 2 moving with the wall"
-        v = fmt(wall.velocity)
-        cmds.append(f"fix bumps_{wall.side} bumps move linear {v} 0.0 0.0")
+        kind = bump_type(scene, wall.side)
+        comment += f"; bumps: heavy particles of type {kind} moving with the wall"
+        group = f"bumps_{wall.side}"
+        cmds += [
+            f"fix {group}_move {group} move linear {fmt(wall.velocity)} 0.0 0.0",
+            # the particles' force on the bumps (pair forces only: bumps feel no gravity)
+            f"compute {group}_force {group} reduce sum fx fy fz",
+        ]
     return Block(f"wall:{wall.side}", comment, cmds)
 
 

@@ -26,6 +26,7 @@ class RunOptions:
     keep_frames: bool | None = None  # None: the scene's measure.keep_frames
     checkpoint_interval: float | None = None  # None: the scene's run.checkpoint_interval
     isolate: bool = False  # run the engine in a child process (crashes become EngineError)
+    wall_limit: float | None = None  # seconds: checkpoint and stop when exceeded (resumable)
     extra: dict = field(default_factory=dict)
 
 

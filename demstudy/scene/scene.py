@@ -202,6 +202,13 @@ class Scene(StrictModel):
         for wall in self.walls:
             if wall.servo is not None and self.wall("upper") is None:
                 problems.append("walls.servo: normal-stress control needs two walls")
+        servos = [w.servo for w in self.walls if w.servo is not None]
+        shared = ("interval_collisions", "interval_time", "scale_width", "hold_shear_rate")
+        for key in shared:
+            values = {getattr(s, key) for s in servos}
+            if len(values) > 1:
+                problems.append(f"walls.servo.{key}: servo walls update together and must "
+                                f"share it (got {sorted(values, key=str)})")
         return problems
 
     def _particle_problems(self) -> list[str]:

@@ -1,0 +1,328 @@
+"""The run loop: segments of one sample interval, in-memory sampling, servo, checkpoints.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (``units lj``).
+
+Every rank runs this loop with identical bookkeeping (so commands issued between segments are
+the same everywhere); rank 0 alone accumulates profiles, keeps frames and writes files.
+A stop request (Ctrl-C, or the wall-clock limit) is honoured at the end of a segment, after
+all bookkeeping, when every rank agrees (MPI_Allreduce), so the checkpoint is consistent.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import pickle
+import signal
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ...analysis.profiles import ProfileAnalysis
+from ...analysis.steady import energy_trend, is_steady
+from ...decks import Deck
+from ...decks.output import WALL_FORCES, sample_steps, steps
+from ...decks.servo import ServoController, has_servo
+from ...decks.system import DATA_FILE
+from ...decks.walls import wall_force_sources
+from ...io.frames import Frame
+from ...io.results import Results, write_results
+from ...scene import Scene, scene_to_toml
+from ..base import EngineError, RunOptions
+from .session import LammpsSession, quoted
+
+CHECKPOINT_RESTART = "checkpoint.restart"
+CHECKPOINT_STATE = "checkpoint.pkl"
+
+
+def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None) -> ProfileAnalysis:
+    """Profiles along the scene's axis over the region particles can occupy (``walls``: the
+    current lower and upper wall positions when walls move)."""
+    m = scene.measure
+    axis = "xyz".index(m.axis)
+    period = scene.box.size[axis] if m.axis in scene.periodic else 0.0
+    if m.axis == "y" and walls is not None:
+        lo, hi = walls
+    elif m.axis == "y" and not scene.y_periodic:
+        lo = scene.wall_position("lower")
+        hi = scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]
+    else:
+        lo, hi = 0.0, scene.box.size[axis]
+    shift = scene.shear.rate * period if scene.shear is not None and m.axis == "y" else 0.0
+    return ProfileAnalysis(axis=m.axis, bin_width=m.bin_width, lo=lo, hi=hi,
+                           dim=scene.dimension, inertia_factor=scene.inertia_k, period=period,
+                           image_velocity_shift=shift)
+
+
+@dataclass
+class RunState:
+    """Everything needed to continue a run: counters, timeseries, accumulators."""
+
+    step: int = 0
+    timeseries: dict[str, list] = field(default_factory=dict)
+    frames: dict[str, list] = field(default_factory=dict)
+    profiles: ProfileAnalysis | None = None
+    wall_seconds: float = 0.0
+    servo: ServoController | None = None
+    dump_size: int = 0
+    # wall forces (on the particles) summed over segments since the last sample / servo update
+    force_sums: dict[str, np.ndarray] = field(default_factory=dict)
+    force_counts: dict[str, int] = field(default_factory=dict)
+
+    def record(self, key: str, value) -> None:
+        self.timeseries.setdefault(key, []).append(value)
+
+    def add_forces(self, forces: np.ndarray) -> None:
+        for key in ("sample", "servo"):
+            self.force_sums[key] = self.force_sums.get(key, 0.0) + forces
+            self.force_counts[key] = self.force_counts.get(key, 0) + 1
+
+    def take_forces(self, key: str) -> np.ndarray | None:
+        """Mean wall forces since the last call for ``key`` (None before any segment)."""
+        count = self.force_counts.pop(key, 0)
+        total = self.force_sums.pop(key, None)
+        return None if not count else total / count
+
+
+class Driver:
+    def __init__(self, scene: Scene, deck: Deck, dt: float, workdir: Path, out: Path,
+                 options: RunOptions):
+        self.scene, self.deck, self.dt, self.workdir, self.out = scene, deck, dt, workdir, out
+        self.options = options
+        run = scene.run
+        self.n_sample = sample_steps(scene, dt)
+        # equilibration and production in whole sample intervals
+        self.n_eq = self.n_sample * round(steps(run.equilibration, dt) / self.n_sample)
+        n_prod = self.n_sample * max(1, round(steps(run.production, dt) / self.n_sample))
+        self.n_total = self.n_eq + n_prod
+        ckpt = options.checkpoint_interval or run.checkpoint_interval
+        self.n_ckpt = self.n_sample * max(1, round(ckpt / dt / self.n_sample)) if ckpt else 0
+        keep = options.keep_frames
+        self.keep_frames = scene.measure.keep_frames if keep is None else keep
+        self.dump = Path(options.dump).resolve() if options.dump else None
+        self.sources = wall_force_sources(scene)
+        self.stop_reason: str | None = None
+
+    # -- set-up -------------------------------------------------------------------------
+    def _issue_deck(self, session: LammpsSession, resume: bool) -> None:
+        for cmd in self.deck.commands("setup"):
+            if cmd.startswith("read_data"):
+                cmd = (f"read_restart {quoted(self.workdir / CHECKPOINT_RESTART)}" if resume
+                       else f"read_data {quoted(self.workdir / DATA_FILE)}")
+            elif resume and cmd.startswith("set "):
+                continue  # masses are in the restart file
+            session.command(cmd)
+        for cmd in self.deck.commands("physics"):
+            session.command(cmd)
+        session.command("thermo 0")
+
+    def _load_state(self) -> RunState:
+        if self.options.resume:
+            path = self.workdir / CHECKPOINT_STATE
+            if not path.exists() or not (self.workdir / CHECKPOINT_RESTART).exists():
+                raise EngineError(f"--resume: no checkpoint in {self.workdir}")
+            with open(path, "rb") as fh:
+                saved = pickle.load(fh)
+            if saved["scene"] != scene_to_toml(self.scene):
+                raise EngineError("--resume: the checkpoint belongs to a different scene")
+            return saved["run"]
+        if has_servo(self.scene):
+            # bins are laid between the walls where they stand when production starts
+            return RunState(servo=ServoController(self.scene, self.dt))
+        return RunState(profiles=profile_analysis(self.scene))
+
+    def _reanchor(self, session: LammpsSession, state: RunState) -> None:
+        """Re-issue the time-anchored variables before LAMMPS initialises again.
+
+        At every initialisation (``run … pre yes``, ``write_restart``, ``read_restart``) fix
+        deform takes the current box as its start, so the Lees–Edwards tilt and the servo's
+        width change must count from that moment; the servo's walls are re-anchored too."""
+        t = state.step * self.dt
+        if self.scene.shear is not None:
+            session.command(f"variable lees_edwards_t0 equal {t:.17g}")
+        if state.servo is not None:
+            state.servo.advance(t)
+            state.servo.apply(session.command)
+
+    # -- sampling -----------------------------------------------------------------------
+    def _frame(self, session: LammpsSession, t: float) -> Frame:
+        dim = self.scene.dimension
+        mobile = session.gather("type", 1, integer=True) == 1
+        x = session.gather("x", 3)[mobile, :dim]
+        v = session.gather("v", 3)[mobile, :dim]
+        omega = session.gather("omega", 3)[mobile]
+        radius = session.gather("radius", 1)[mobile]
+        boxlo, boxhi, xy, *_ = session.lmp.extract_box()
+        return Frame(time=t, box_lo=np.array(boxlo[:dim]), box_hi=np.array(boxhi[:dim]),
+                     position=x, velocity=v,
+                     angular_velocity=omega[:, 2:3] if dim == 2 else omega,
+                     radius=radius, tilt=float(xy))
+
+    def _wall_forces(self, forces: np.ndarray) -> np.ndarray:
+        """(n_walls, 3) force of each wall on the particles from the per-source vectors."""
+        walls = [w.side for w in self.scene.walls]
+        total = np.zeros((len(walls), 3))
+        for (side, _compute, sign), row in zip(self.sources, forces, strict=True):
+            total[walls.index(side)] += sign * row
+        return total
+
+    def _sample(self, session: LammpsSession, state: RunState, production: bool) -> None:
+        t = state.step * self.dt
+        frame = self._frame(session, t)  # collective: every rank gathers
+        if production and self.dump is not None:  # collective too
+            session.command(
+                f"write_dump mobile custom {quoted(self.dump)} id type radius x y z vx vy vz "
+                "omegax omegay omegaz modify sort id append yes format float %.17g"
+            )
+        dim, K = self.scene.dimension, self.scene.inertia_k
+        mass = (2 * frame.radius) ** dim
+        inertia = K * mass * frame.radius**2
+        state.record("time", t)
+        state.record("momentum", np.sum(mass[:, None] * frame.velocity, axis=0))
+        state.record("kinetic_energy", 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)))
+        state.record("rotational_energy",
+                     0.5 * float(np.sum(inertia[:, None] * frame.angular_velocity**2)))
+        forces = state.take_forces("sample")
+        for i, wall in enumerate(self.scene.walls):
+            # force of the particles on the wall, averaged over the interval that just ended
+            force = -forces[i, :dim] if forces is not None else np.full(dim, np.nan)
+            state.record(f"wall_force_{wall.side}", force)
+        if self.scene.shear is not None:
+            state.record("tilt", frame.tilt)  # Lees–Edwards offset of the upper image
+        if state.servo is not None:
+            state.servo.advance(t)
+            for key, value in state.servo.state().items():
+                state.record(key, value)
+            state.record("width", float(frame.lengths[0]))
+        if not production or session.rank != 0:
+            return
+        if state.profiles is None:
+            lower, upper = state.servo.walls["lower"], state.servo.walls["upper"]
+            state.profiles = profile_analysis(self.scene, (lower.y, upper.y))
+        state.profiles.feed(frame)
+        if self.keep_frames:
+            for key in ("position", "velocity", "angular_velocity", "radius"):
+                state.frames.setdefault(key, []).append(getattr(frame, key).copy())
+            state.frames.setdefault("time", []).append(t)
+
+    def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
+        restart = self.workdir / CHECKPOINT_RESTART
+        session.command(f"write_restart {quoted(str(restart) + '.new')}")
+        if session.rank != 0:
+            return
+        os.replace(f"{restart}.new", restart)
+        if self.dump is not None and self.dump.exists():
+            state.dump_size = self.dump.stat().st_size
+        snapshot = dataclasses.replace(
+            state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
+        tmp = self.workdir / (CHECKPOINT_STATE + ".new")
+        with open(tmp, "wb") as fh:
+            pickle.dump({"scene": scene_to_toml(self.scene), "run": snapshot}, fh)
+        os.replace(tmp, self.workdir / CHECKPOINT_STATE)
+
+    # -- main loop ----------------------------------------------------------------------
+    def _request_stop(self, _signum=None, _frame=None) -> None:
+        self.stop_reason = "interrupted"
+
+    def run(self) -> Path:
+        state = self._load_state()
+        session = LammpsSession(self.workdir)
+        started = time.perf_counter()
+        handler = None
+        if threading.current_thread() is threading.main_thread():
+            handler = signal.signal(signal.SIGINT, self._request_stop)
+        try:
+            self._issue_deck(session, resume=self.options.resume)
+            if self.options.resume:
+                self._reanchor(session, state)  # variables are not in restart files
+                if self.dump is not None and session.rank == 0 and self.dump.exists():
+                    os.truncate(self.dump, state.dump_size)  # drop frames after the checkpoint
+            elif self.dump is not None and session.rank == 0:
+                self.dump.unlink(missing_ok=True)
+            session.command("run 0 post no")
+            if state.step == 0:
+                self._sample(session, state, production=False)  # the initial state
+            self._loop(session, state, started)
+        except KeyboardInterrupt:  # no handler (not the main thread): keep the last checkpoint
+            raise EngineError("interrupted: run again with --resume to continue from the last "
+                              "checkpoint (if any)") from None
+        finally:
+            if handler is not None:
+                signal.signal(signal.SIGINT, handler)
+            version = session.lmp.version()
+            session.close()
+        if session.rank != 0:
+            return self.out
+        state.wall_seconds += time.perf_counter() - started
+        return self._write(state, version)
+
+    def _loop(self, session: LammpsSession, state: RunState, started: float) -> None:
+        servo = state.servo
+        limit = self.options.wall_limit
+        bar = tqdm(total=self.n_total * self.dt, initial=state.step * self.dt, unit="τ",
+                   disable=not self.options.progress or session.rank != 0,
+                   bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} τ [{elapsed}<{remaining}]",
+                   desc=f"lammps {self.scene.meta.name}")
+        initialise = False
+        with bar:
+            while state.step < self.n_total:
+                if initialise:
+                    self._reanchor(session, state)
+                session.command(f"run {self.n_sample} pre {'yes' if initialise else 'no'} "
+                                "post no")
+                initialise = False
+                state.step += self.n_sample
+                if self.sources:
+                    forces = session.fix_vector(WALL_FORCES, 3 * len(self.sources))
+                    state.add_forces(self._wall_forces(forces.reshape(-1, 3)))
+                if servo is not None and state.step % servo.n_steps == 0:
+                    mean = state.take_forces("servo")
+                    normal = {w.side: mean[i, 1] for i, w in enumerate(self.scene.walls)}
+                    servo.update(state.step * self.dt, normal, session.box_lengths()[0])
+                    initialise = True  # new wall motion: re-anchor, LAMMPS sets up again
+                self._sample(session, state, production=state.step > self.n_eq)
+                bar.update(self.n_sample * self.dt)
+                if limit is not None and time.perf_counter() - started > limit:
+                    self.stop_reason = self.stop_reason or "wall-clock limit"
+                stop = session.any_rank(self.stop_reason is not None)
+                checkpoint = self.n_ckpt and state.step % self.n_ckpt == 0
+                if (stop or checkpoint) and state.step < self.n_total:
+                    self._checkpoint(session, state, started)
+                    initialise = True  # write_restart re-initialised LAMMPS
+                if stop and state.step < self.n_total:
+                    raise EngineError(
+                        f"stopped ({self.stop_reason or 'on another rank'}) at t = "
+                        f"{state.step * self.dt:.6g} after a checkpoint: run the same command "
+                        "again with --resume to continue")
+
+    def _write(self, state: RunState, version: int) -> Path:
+        analysis = state.profiles.finish()
+        scene = self.scene
+        timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
+        frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
+        production = timeseries["time"] > self.n_eq * self.dt + 0.5 * self.dt
+        trend = energy_trend(timeseries["time"][production],
+                             timeseries["kinetic_energy"][production])
+        attrs = {
+            "engine": "lammps",
+            "engine_version": f"LAMMPS {version}",
+            "scene_toml": scene_to_toml(scene),
+            "scene_name": scene.meta.name,
+            "seed": scene.run.seed,
+            "wall_seconds": state.wall_seconds,
+            "timestep": self.dt,
+            "equilibration_end": self.n_eq * self.dt,
+            "kinetic_energy_trend": trend,
+            "steady": is_steady(trend),
+            "deck": self.deck.render(scene.meta.name),
+            "approximations": "\n".join(self.deck.notes),
+        }
+        path = write_results(self.out, Results(attrs, timeseries, analysis.results,
+                                               analysis.attrs, frames))
+        for name in (CHECKPOINT_RESTART, CHECKPOINT_STATE):
+            (self.workdir / name).unlink(missing_ok=True)
+        return path

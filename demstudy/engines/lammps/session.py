@@ -1,0 +1,75 @@
+"""One LAMMPS instance driven command by command, plus the little MPI the driver needs.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (``units lj``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..._lammps import open_lammps, preload_mpi
+from ..base import EngineError
+
+# MPICH ABI handles (the runtime is the `mpich` wheel's): MPI_COMM_WORLD, MPI_INT, MPI_MAX
+_MPI_COMM_WORLD, _MPI_INT, _MPI_MAX = 0x44000000, 0x4C000405, 0x58000001
+
+
+def quoted(path: Path | str) -> str:
+    """A path for a LAMMPS command line (spaces allowed)."""
+    return '"' + str(path).replace('"', '\\"') + '"'
+
+
+class LammpsSession:
+    """One LAMMPS instance; errors come back as ``EngineError`` naming the deck line."""
+
+    def __init__(self, workdir: Path, screen: bool = False):
+        self.workdir = workdir
+        self.lmp = open_lammps(screen=screen, log=workdir / "log.lammps")
+        self.rank = int(self.lmp.extract_setting("world_rank"))
+        self.nprocs = int(self.lmp.extract_setting("world_size"))
+        self._lam = sys.modules[type(self.lmp).__module__.split(".")[0]]
+
+    def command(self, cmd: str) -> None:
+        try:
+            self.lmp.command(cmd)
+        except Exception as exc:  # LAMMPS raises a bare Exception with its error message
+            message = str(exc).strip() or type(exc).__name__
+            raise EngineError(f"LAMMPS error: {message}\n  deck line: {cmd}") from None
+
+    def gather(self, name: str, count: int, integer: bool = False) -> np.ndarray:
+        """A per-atom property of all atoms, ordered by atom ID, on every rank."""
+        data = self.lmp.gather_atoms(name, 0 if integer else 1, count)
+        if data is None:
+            raise EngineError(f"LAMMPS could not gather per-atom {name!r}")
+        arr = np.ctypeslib.as_array(data)
+        return arr.reshape(-1, count) if count > 1 else arr.copy()
+
+    def fix_vector(self, fix_id: str, length: int) -> np.ndarray:
+        """Global vector of a fix (e.g. ``fix ave/time``), identical on every rank."""
+        style, kind = self._lam.LMP_STYLE_GLOBAL, self._lam.LMP_TYPE_VECTOR
+        if length == 1:  # a fix averaging one value has a global scalar, not a vector
+            return np.array([self.lmp.extract_fix(fix_id, style, self._lam.LMP_TYPE_SCALAR)])
+        return np.array([self.lmp.extract_fix(fix_id, style, kind, i) for i in range(length)])
+
+    def box_lengths(self) -> np.ndarray:
+        boxlo, boxhi, *_ = self.lmp.extract_box()
+        return np.asarray(boxhi) - np.asarray(boxlo)
+
+    def any_rank(self, flag: bool) -> bool:
+        """True on every rank if ``flag`` is true on any rank (MPI_Allreduce with MPI_MAX)."""
+        if self.nprocs == 1:
+            return flag
+        lib = ctypes.CDLL(str(preload_mpi()), mode=ctypes.RTLD_GLOBAL)
+        send, recv = ctypes.c_int(int(flag)), ctypes.c_int(0)
+        status = lib.MPI_Allreduce(ctypes.byref(send), ctypes.byref(recv), 1, _MPI_INT,
+                                   _MPI_MAX, _MPI_COMM_WORLD)
+        if status != 0:
+            raise EngineError(f"MPI_Allreduce failed with code {status}")
+        return bool(recv.value)
+
+    def close(self) -> None:
+        self.lmp.close()
