@@ -47,7 +47,7 @@ def plot_profiles(paths: Sequence[str | Path], out: str | Path) -> Path:
             ax.set_xlabel(title)
             ax.grid(alpha=0.3)
     axes[0].set_ylabel(f"{res.profile_attrs.get('axis', 'y')} (particle diameters)")
-    axes[0].legend(fontsize=8)
+    axes[0].legend(fontsize=8, loc="upper right")
     fig.suptitle("profiles in particle units: d = 1, m = 1, g = 1 (with gravity)", fontsize=9)
     fig.tight_layout()
     out = Path(out)

@@ -14,6 +14,7 @@ import dataclasses
 import os
 import pickle
 import signal
+import sys
 import threading
 import time
 from dataclasses import dataclass, field
@@ -263,8 +264,10 @@ class Driver:
     def _loop(self, session: LammpsSession, state: RunState, started: float) -> None:
         servo = state.servo
         limit = self.options.wall_limit
-        bar = tqdm(total=self.n_total * self.dt, initial=state.step * self.dt, unit="τ",
+        # counted in steps (exact), shown in time units; sparse updates when not on a terminal
+        bar = tqdm(total=self.n_total, initial=state.step, unit_scale=self.dt, unit="τ",
                    disable=not self.options.progress or session.rank != 0,
+                   mininterval=0.5 if sys.stderr.isatty() else 30.0,
                    bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} τ [{elapsed}<{remaining}]",
                    desc=f"lammps {self.scene.meta.name}")
         initialise = False
@@ -285,7 +288,7 @@ class Driver:
                     servo.update(state.step * self.dt, normal, session.box_lengths()[0])
                     initialise = True  # new wall motion: re-anchor, LAMMPS sets up again
                 self._sample(session, state, production=state.step > self.n_eq)
-                bar.update(self.n_sample * self.dt)
+                bar.update(self.n_sample)
                 if limit is not None and time.perf_counter() - started > limit:
                     self.stop_reason = self.stop_reason or "wall-clock limit"
                 stop = session.any_rank(self.stop_reason is not None)
