@@ -1,7 +1,9 @@
 """Contact model of a scene: pair and wall parameters, stiffness and time step.
 
-Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. Stiffness k_n is in
-m v_ref²/d² where v_ref is the scene's reference speed (see ``reference_speed``).
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise the wall speed
+or shear rate sets the time unit τ). k_n is a force per length, m/τ², for Hooke contacts and a
+force per length^3/2 for Hertz; by default it is chosen so that an impact at the scene's
+reference speed (``reference_speed``) overlaps by DEFAULT_OVERLAP.
 """
 
 from __future__ import annotations

@@ -53,7 +53,7 @@ class Scene(StrictModel):
     def periodic(self) -> tuple[str, ...]:
         if self.box.periodic is not None:
             return tuple(self.box.periodic)
-        axes = ["x"] if self.walls or self.has_open_top else ["x", "y"]
+        axes = ["x"] if self.walls else ["x", "y"]
         return tuple(axes + (["z"] if self.dimension == 3 else []))
 
     @property

@@ -320,9 +320,6 @@ class Soft(StrictModel):
             raise ValueError("give stiffness or hardness, not both")
         return self
 
-    def resolved_stiffness(self) -> float | None:
-        return self.stiffness if self.hardness is None else None
-
 
 #: Statistics the engines compute today (issue 4 extends the list).
 Statistic = Literal["profiles"]
