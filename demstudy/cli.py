@@ -59,19 +59,22 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from .decks.contact import contact_setup
     from .engines.lammps import profile_analysis
-    from .io.dump import read_dump
+    from .io.dump import has_fast_columns, read_dump, read_dump_fast
     from .io.results import Results, write_results
     from .scene import scene_to_toml
 
     scene = load_scene(args.scene, args.set)
     dt = args.dt if args.dt is not None else contact_setup(scene).timestep
     analysis = profile_analysis(scene)
-    analysis.run(read_dump(args.dump, scene.dimension, dt=dt, start_time=args.start))
+    fast = args.reader == "fast" or (args.reader == "auto" and has_fast_columns(args.dump))
+    reader = read_dump_fast if fast else read_dump
+    analysis.run(reader(args.dump, scene.dimension, dt=dt, start_time=args.start))
     analysis.finish()
     profiles, attrs = analysis.results, analysis.attrs
     out = Path(args.out or Path(args.dump).with_suffix(".h5"))
     write_results(out, Results(
-        {"engine": "lammps-dump", "engine_version": "MDAnalysis reader",
+        {"engine": "lammps-dump",
+         "engine_version": "numpy fast reader" if fast else "MDAnalysis reader",
          "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
          "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(args.dump)},
         profiles=profiles, profile_attrs=attrs))
@@ -112,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", parents=[overrides], help="run a scene")
     p.add_argument("scene")
-    p.add_argument("--engine", default="lammps", choices=["lammps"])
+    p.add_argument("--engine", default="lammps", choices=["lammps", "edmd"])
     p.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
     p.add_argument("--out", help="results file (default results/<scene>-<engine>.h5)")
     p.add_argument("--dump", type=Path, help="also write a LAMMPS custom dump of the samples")
@@ -135,6 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt", type=float, help="time step (default: the scene's LAMMPS time step)")
     p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")
     p.add_argument("--out", help="results file (default: DUMP with suffix .h5)")
+    p.add_argument("--reader", choices=["auto", "fast", "mdanalysis"], default="auto",
+                   help="auto: the numpy fast path for demstudy's dumps, MDAnalysis otherwise")
     p.set_defaults(func=_cmd_analyze)
 
     p = sub.add_parser("calibrate", help="measure e, beta, t_c of binary collisions in LAMMPS")

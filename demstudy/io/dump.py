@@ -1,4 +1,4 @@
-"""LAMMPS custom dumps read with MDAnalysis, turned into ``Frame`` objects.
+"""LAMMPS custom dumps turned into ``Frame`` objects: MDAnalysis (general) or numpy (fast).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. The dump must hold the
 columns ``id type radius x y z vx vy vz`` (+ ``omegax omegay omegaz``), as written by
@@ -17,15 +17,19 @@ import numpy as np
 
 from .frames import Frame
 
-_BOUNDS = re.compile(rb"ITEM: BOX BOUNDS[^\n]*\n([^\n]*)\n([^\n]*)\n([^\n]*)\n")
+_BOUNDS = re.compile(rb"ITEM: BOX BOUNDS([^\n]*)\n([^\n]*)\n([^\n]*)\n([^\n]*)\n")
 
 
-def box_bounds(path: str | Path) -> np.ndarray:
-    """(n_frames, 3, 2) box bounds (lo, hi per axis), one entry per frame, from the headers."""
-    data = Path(path).read_bytes()
-    rows = [[[float(v) for v in line.split()[:2]] for line in m.groups()]
-            for m in _BOUNDS.finditer(data)]
-    return np.array(rows, dtype=float)
+def box_headers(path: str | Path) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """Per frame: the header's lower bounds as written (MDAnalysis subtracts these), the box
+    (3, 2) and the xy tilt (see ``_box_from_header``)."""
+    headers = []
+    for m in _BOUNDS.finditer(Path(path).read_bytes()):
+        lines = list(m.groups()[1:])
+        box, tilt = _box_from_header(m.group(1).split(), lines)
+        written_lo = np.array([float(line.split()[0]) for line in lines])
+        headers.append((written_lo, box, tilt))
+    return headers
 
 
 def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
@@ -38,7 +42,7 @@ def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
         warnings.simplefilter("ignore")  # masses guessed / no dt: we use our own
         universe = mda.Universe(str(path), format="LAMMPSDUMP", additional_columns=extra,
                                 lammps_coordinate_convention="unscaled")
-    bounds = box_bounds(path)
+    headers = box_headers(path)
     types = universe.atoms.types.astype(int)
     order = np.argsort(universe.atoms.ids)
     mobile = order[types[order] == mobile_type]
@@ -52,12 +56,107 @@ def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             ts = universe.trajectory[index]
-        lo, hi = bounds[index, :, 0], bounds[index, :, 1]
-        pos = ts.positions.astype(float)[mobile] + lo
+        written_lo, box, tilt = headers[index]
+        pos = ts.positions.astype(float)[mobile] + written_lo
         omega = np.column_stack([ts.data[c] for c in extra[1:]]).astype(float)[mobile]
         yield Frame(
-            time=time, box_lo=lo[:dim].copy(), box_hi=hi[:dim].copy(),
+            time=time, box_lo=box[:dim, 0].copy(), box_hi=box[:dim, 1].copy(),
             position=pos[:, :dim], velocity=ts.velocities.astype(float)[mobile, :dim],
             angular_velocity=omega[:, 2:3] if dim == 2 else omega,
-            radius=np.asarray(ts.data["radius"], float)[mobile],
+            radius=np.asarray(ts.data["radius"], float)[mobile], tilt=tilt,
         )
+
+
+_FAST_COLUMNS = ("id", "type", "radius", "x", "y", "z", "vx", "vy", "vz",
+                 "omegax", "omegay", "omegaz")
+
+
+def _box_from_header(words: list[bytes], lines: list[bytes]) -> tuple[np.ndarray, float]:
+    """(3, 2) box (lo, hi per axis) and the xy tilt from a ``BOX BOUNDS`` header.
+
+    Orthogonal boxes: the lines hold ``lo hi``. Triclinic boxes (``xy xz yz`` in the header,
+    Lees-Edwards): the lines hold ``lo_bound hi_bound tilt``; the bounds are turned back
+    into ``xlo, xhi`` as in the LAMMPS dump documentation and the xy tilt is returned.
+    """
+    rows = np.array([[float(v) for v in line.split()] for line in lines])
+    if b"xy" not in words:
+        return rows[:, :2].copy(), 0.0
+    xy, xz, yz = rows[:, 2]
+    box = rows[:, :2].copy()
+    box[0, 0] -= min(0.0, xy, xz, xy + xz)
+    box[0, 1] -= max(0.0, xy, xz, xy + xz)
+    box[1, 0] -= min(0.0, yz)
+    box[1, 1] -= max(0.0, yz)
+    return box, float(xy)
+
+
+def has_fast_columns(path: str | Path) -> bool:
+    """True when the dump's first frame has the columns ``read_dump_fast`` needs."""
+    with open(path, "rb") as fh:
+        for line in fh:
+            if line.startswith(b"ITEM: ATOMS"):
+                names = line.decode().split()[2:]
+                return all(c in names for c in _FAST_COLUMNS)
+    return False
+
+
+def read_dump_fast(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
+                   start_time: float = 0.0) -> Iterator[Frame]:
+    """Frames of a demstudy custom dump, parsed with numpy (same frames as :func:`read_dump`).
+
+    Fast path for the dumps demstudy writes (``write_dump ... custom ... id type radius
+    x y z vx vy vz omegax omegay omegaz``, unscaled coordinates, any column order as long
+    as these columns are present): one frame is read at a time (memory flat in the number
+    of frames) and its atom block is parsed in one ``numpy.fromstring`` call, in double
+    precision (MDAnalysis stores single precision). Atoms are sorted by id and only atoms of
+    ``mobile_type`` are kept; time = step × dt, frames before ``start_time`` are skipped.
+    Both readers decode a triclinic (Lees-Edwards) header: ``box_lo``, ``box_hi`` are the box
+    edges (not the bounding box) and ``Frame.tilt`` is the xy tilt.
+    """
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    with open(path, "rb") as fh:
+        while True:
+            line = fh.readline()
+            if not line:
+                return
+            if not line.startswith(b"ITEM: TIMESTEP"):
+                if line.strip():
+                    raise ValueError(f"{path}: expected 'ITEM: TIMESTEP', got {line[:60]!r}")
+                continue
+            step = int(fh.readline())
+            if not fh.readline().startswith(b"ITEM: NUMBER OF ATOMS"):
+                raise ValueError(f"{path}: missing 'ITEM: NUMBER OF ATOMS' at step {step}")
+            n = int(fh.readline())
+            header = fh.readline()
+            if not header.startswith(b"ITEM: BOX BOUNDS"):
+                raise ValueError(f"{path}: missing 'ITEM: BOX BOUNDS' at step {step}")
+            box, tilt = _box_from_header(header.split()[3:],
+                                         [fh.readline() for _ in range(3)])
+            atoms = fh.readline()
+            if not atoms.startswith(b"ITEM: ATOMS"):
+                raise ValueError(f"{path}: missing 'ITEM: ATOMS' at step {step}")
+            names = atoms.decode().split()[2:]
+            missing = [c for c in _FAST_COLUMNS if c not in names]
+            if missing:
+                raise ValueError(f"{path}: the fast reader needs columns {missing} "
+                                 "(use read_dump for other dumps)")
+            block = b"".join(fh.readline() for _ in range(n))
+            time = step * dt
+            if time < start_time - 1e-12:
+                continue
+            data = np.fromstring(block, dtype=np.float64, sep=" ")
+            if data.size != n * len(names):
+                raise ValueError(f"{path}: truncated or malformed atom block at step {step}")
+            data = data.reshape(n, len(names))
+            col = {c: names.index(c) for c in _FAST_COLUMNS}
+            data = data[np.argsort(data[:, col["id"]], kind="stable")]
+            data = data[data[:, col["type"]] == mobile_type]
+            omega = data[:, [col["omegax"], col["omegay"], col["omegaz"]]]
+            yield Frame(
+                time=time, box_lo=box[:dim, 0].copy(), box_hi=box[:dim, 1].copy(),
+                position=np.ascontiguousarray(data[:, [col[c] for c in "xyz"[:dim]]]),
+                velocity=np.ascontiguousarray(data[:, [col[f"v{c}"] for c in "xyz"[:dim]]]),
+                angular_velocity=np.ascontiguousarray(omega[:, 2:3] if dim == 2 else omega),
+                radius=data[:, col["radius"]].copy(), tilt=tilt,
+            )

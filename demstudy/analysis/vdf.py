@@ -1,0 +1,339 @@
+"""Velocity distributions per bin along y: Campbell's X1...X5, Malik's C/sigma, moments.
+
+Dimensionless particle units: d = 1, m = 1. Axes: x flow, y wall-normal (the bin axis),
+z spanwise (3D). A particle belongs to the bin (Campbell's "strip") of its *centre*; bin
+statistics are number-weighted over all samples of the run (equal weight per particle and
+frame, Campbell's area weighting for equal discs).
+
+Components (``attrs["components"]``): the translational velocities ``u, v[, w]``, the spins
+``omega_z`` (2D) or ``omega_x, omega_y, omega_z`` (3D), and ``sqrtj_omega_*`` = sqrt(j) omega
+with j = I/m = K r^2 (the rotational velocity whose square is Campbell's beta omega^2 in units
+of R = 1: it enters X5 so that every degree of freedom has the dimension of a velocity^2).
+
+Moments (one pass, exact): per bin and component, the pooled mean, variance
+<c'^2>, skewness <c'^3>/<c'^2>^(3/2) and kurtosis <c'^4>/<c'^2>^2 of c' = c - <c>, with <c>
+the run mean of the bin (population moments, 1/N). Power sums are taken about a per-bin
+shift (the first frame's bin mean) to limit cancellation. A Maxwellian gives skewness 0 and
+kurtosis 3 for every component; a uniform distribution gives kurtosis 9/5.
+
+Histograms need the bin means and variances of the whole run, so they use **two passes**:
+the first pass (``reference=None``) gives the moments above; the second pass
+(``reference=first.results``) histograms the frames against those stored per-bin means and
+variances (:func:`velocity_distributions` does both for a re-iterable frame source). No
+running moments are used. With M the reference mean and S the variance of the bin:
+
+* Campbell (thesis §4, "VDF"; 50 bins of 0.1 on [0, 5], P = count / (N_bin * 0.1) with
+  N_bin all samples of the bin, those beyond X = 5 included):
+  X1 = |u - M_u| / sqrt(S_u), X2 = |v - M_v| / sqrt(S_v), X3 = |omega_z - M| / sqrt(S),
+  X4 = [sum_a (c_a - M_a)^2 / sum_a S_a]^(1/2) over the dim translational components,
+  X5 = the same over the translational and the sqrt(j) omega components (dim + n_rot).
+  Maxwellian references, folded onto X >= 0 (the digest's NOTE: the factor 2 is needed for
+  a normalised density on [0, inf)): a chi distribution with k degrees of freedom,
+  P_k(X) = 2 a^(k/2) / Gamma(k/2) X^(k-1) exp(-a X^2), a = k/2, i.e. k = 1, 1, 1, 2, 3 and
+  a = 1/2, 1/2, 1/2, 1, 3/2 in 2D (Campbell's values) and k = 1, 1, 1, 3, 6 in 3D. X4 and X5
+  follow P_k only if the components share one variance (equipartition), as Campbell assumes.
+  ``X_reference`` is P_k averaged over each histogram bin (exact, from the chi CDF), the
+  quantity to compare histograms with; ``X_reference_centre`` is P_k at the bin centres.
+* Malik (2008, §4.6): per component (translational and spin, not the sqrt(j) ones) the signed
+  x = (c - M)/sqrt(S), 100 bins of 0.1 on [-5, 5]; ``malik_pdf`` = count / (N_bin * 0.1)
+  (normalised density) and ``malik_P`` = malik_pdf / P0 with P0 the mean of the two bins
+  adjacent to x = 0 (Malik's "P(0) = 1" scaling; his estimator of P(0) is not stated).
+  References: ``gaussian`` = exp(-x^2/2) at the bin centres, ``gaussian_binned`` = the
+  normal density averaged over each bin and scaled by the same P0 rule.
+
+Errors (``*_err``): delete-one-block jackknife over time blocks of the per-frame sums
+(:class:`~demstudy.analysis.blocking.BlockAccumulator`); memory is flat in the number of
+frames. The bin mean includes any mean-velocity gradient across the bin, which widens the
+distributions (see :mod:`demstudy.analysis.profiles` for the size of the effect).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.special import erf, gammainc, gammaln
+
+from demstudy import UNITS_NOTE
+from demstudy.analysis.base import AnalysisBase
+from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.io.frames import Frame
+
+__all__ = ["VelocityDistribution", "folded_maxwellian", "velocity_distributions"]
+
+X_NAMES = ("X1", "X2", "X3", "X4", "X5")
+
+
+def folded_maxwellian(x: ArrayLike, k: int) -> np.ndarray:
+    """Chi density with k degrees of freedom in Campbell's scaling (<X^2> = 1), X >= 0:
+    2 a^(k/2) / Gamma(k/2) X^(k-1) exp(-a X^2), a = k/2 (k = 1: 2 sqrt(a/pi) exp(-a X^2))."""
+    x = np.asarray(x, float)
+    a = k / 2
+    log = np.log(2.0) + a * np.log(a) - gammaln(a) - a * x**2
+    with np.errstate(divide="ignore"):
+        return np.exp(log) * x ** (k - 1)
+
+
+def _chi_cdf(x: np.ndarray, k: int) -> np.ndarray:
+    return gammainc(k / 2, k / 2 * np.asarray(x, float) ** 2)
+
+
+class VelocityDistribution(AnalysisBase):
+    """Per-bin velocity moments and (second pass) Campbell / Malik velocity histograms.
+
+    Parameters
+    ----------
+    dim: 2 (discs) or 3 (spheres).
+    edges: bin edges along y; None means ``n_bins`` equal bins over the first frame's box.
+    n_bins: number of bins when ``edges`` is None.
+    inertia_factor: K = 4 I / (m d^2) (j = K r^2); None means a solid disc (1/2) or sphere
+        (2/5).
+    reference: None (first pass: moments only) or the ``results`` of a first pass over the
+        same frames with the same edges (second pass: histograms too).
+    period: y period (> 0: centres are wrapped into ``[edges[0], edges[0] + period)``).
+    image_velocity_shift: x velocity of the periodic image at y + period (Lees-Edwards:
+        shear rate × period), added per period a centre is wrapped upwards.
+    x_bins, x_width: Campbell's histogram (50 bins of 0.1); Malik's uses 2 x_bins on
+        [-x_bins x_width, x_bins x_width].
+    max_blocks: bound on the stored time blocks.
+    """
+
+    def __init__(
+        self,
+        dim: int = 2,
+        edges: ArrayLike | None = None,
+        n_bins: int = 1,
+        inertia_factor: float | None = None,
+        reference: Mapping[str, Any] | None = None,
+        period: float = 0.0,
+        image_velocity_shift: float = 0.0,
+        x_bins: int = 50,
+        x_width: float = 0.1,
+        max_blocks: int = 64,
+        verbose: bool = False,
+    ) -> None:
+        super().__init__(verbose=verbose)
+        if dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        self.dim = dim
+        self.n_rot = 1 if dim == 2 else 3
+        self.inertia_factor = float(
+            inertia_factor if inertia_factor is not None else (0.5 if dim == 2 else 0.4)
+        )
+        self._edges = None if edges is None else np.asarray(edges, float)
+        if self._edges is not None and (self._edges.ndim != 1 or self._edges.size < 2
+                                        or np.any(np.diff(self._edges) <= 0)):
+            raise ValueError("edges must be increasing with at least 2 entries")
+        self._n_bins = int(n_bins)
+        self.period = float(period)
+        self.image_velocity_shift = float(image_velocity_shift)
+        if self.image_velocity_shift and not self.period:
+            raise ValueError("image_velocity_shift needs a periodic y (period > 0)")
+        self.nx, self.dx = int(x_bins), float(x_width)
+        self.max_blocks = int(max_blocks)
+        rot = ["omega_z"] if dim == 2 else ["omega_x", "omega_y", "omega_z"]
+        self.components = ["u", "v", "w"][:dim] + rot + [f"sqrtj_{c}" for c in rot]
+        self.n_comp = len(self.components)
+        self.n_malik = dim + self.n_rot  # translational and spin components
+        # Campbell's X: component indices for X1..X3 and the sets for X4, X5
+        self._x3 = dim + self.n_rot - 1  # omega_z
+        self._trans = list(range(dim))
+        self._total = self._trans + list(range(dim + self.n_rot, self.n_comp))
+        self.dof = (1, 1, 1, dim, dim + self.n_rot)
+        self.reference = None
+        if reference is not None:
+            self.reference = {
+                "mean": np.asarray(reference["mean"], float),
+                "variance": np.asarray(reference["variance"], float),
+                "edges": np.asarray(reference["edges"], float),
+            }
+            if self.reference["mean"].shape[1] != self.n_comp:
+                raise ValueError("reference has other components (dim mismatch?)")
+
+    # -- layout ------------------------------------------------------------------------
+    def _layout(self) -> None:
+        c = self.n_comp
+        self._c_n = 0
+        self._c_pow = [slice(1 + k * c, 1 + (k + 1) * c) for k in range(4)]
+        stop = 1 + 4 * c
+        self._c_x = slice(stop, stop + (5 * self.nx if self.reference else 0))
+        self._c_m = slice(self._c_x.stop,
+                          self._c_x.stop + (self.n_malik * 2 * self.nx if self.reference else 0))
+        self.n_values = self._c_m.stop
+
+    def _prepare(self) -> None:
+        frame = self.first_frame
+        assert frame is not None
+        if frame.dim != self.dim:
+            raise ValueError(f"frame is {frame.dim}D, analysis is {self.dim}D")
+        if self._edges is None:
+            lo = float(np.asarray(frame.box_lo, float)[1])
+            hi = lo + self.period if self.period else float(np.asarray(frame.box_hi, float)[1])
+            self._edges = np.linspace(lo, hi, self._n_bins + 1)
+        self.edges = self._edges
+        self.n_bins = self.edges.size - 1
+        if self.reference is not None:
+            ref_edges = self.reference["edges"]
+            if ref_edges.shape != self.edges.shape or not np.allclose(
+                ref_edges, self.edges, rtol=0, atol=1e-12
+            ):
+                raise ValueError("the reference was computed on other bin edges")
+            var = self.reference["variance"]
+            self._ref_mean = self.reference["mean"]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                self._ref_inv_sd = np.where(var > 0, 1.0 / np.sqrt(var), np.nan)
+                self._ref_inv_var4 = 1.0 / var[:, self._trans].sum(1)
+                self._ref_inv_var5 = 1.0 / var[:, self._total].sum(1)
+        self._layout()
+        self._acc = BlockAccumulator(self.n_bins * self.n_values, self.max_blocks)
+        bins, comps = self._assign(frame)
+        counts = np.bincount(bins, minlength=self.n_bins).astype(float)
+        sums = np.zeros((self.n_bins, self.n_comp))
+        np.add.at(sums, bins, comps)
+        with np.errstate(invalid="ignore"):
+            self._shift = np.where(counts[:, None] > 0, sums / counts[:, None], 0.0)
+
+    def _assign(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+        """Bin index and component matrix of the particles whose centre lies in a bin."""
+        pos = np.asarray(frame.position, float)
+        vel = np.array(frame.velocity, float)
+        omega = np.asarray(frame.angular_velocity, float)
+        omega = omega[:, None] if omega.ndim == 1 else omega
+        radius = np.asarray(frame.radius, float)
+        y = pos[:, 1]
+        if self.period:
+            turns = np.floor((y - self.edges[0]) / self.period)
+            y = y - turns * self.period
+            if self.image_velocity_shift:
+                vel[:, 0] -= turns * self.image_velocity_shift
+        bins = np.searchsorted(self.edges, y, side="right") - 1
+        keep = (bins >= 0) & (bins < self.n_bins)
+        sqrt_j = np.sqrt(self.inertia_factor) * radius
+        comps = np.concatenate([vel, omega, sqrt_j[:, None] * omega], axis=1)
+        return bins[keep], comps[keep]
+
+    def _single_frame(self, frame: Frame) -> None:
+        bins, comps = self._assign(frame)
+        nb, nv = self.n_bins, self.n_values
+        sample = np.zeros((nb, nv))
+        sample[:, 0] = np.bincount(bins, minlength=nb)
+        dev = comps - self._shift[bins]
+        power = np.ones_like(dev)
+        for k in range(4):
+            power *= dev
+            for c in range(self.n_comp):
+                sample[:, self._c_pow[k].start + c] = np.bincount(
+                    bins, weights=power[:, c], minlength=nb)
+        if self.reference is not None:
+            self._histograms(bins, comps, sample)
+        self._acc.add(sample.reshape(-1))
+
+    def _histograms(self, bins: np.ndarray, comps: np.ndarray, sample: np.ndarray) -> None:
+        nx, dx = self.nx, self.dx
+        dev = comps - self._ref_mean[bins]
+        scaled = dev * self._ref_inv_sd[bins]
+        x4 = np.sqrt((dev[:, self._trans] ** 2).sum(1) * self._ref_inv_var4[bins])
+        x5 = np.sqrt((dev[:, self._total] ** 2).sum(1) * self._ref_inv_var5[bins])
+        xs = np.stack([np.abs(scaled[:, 0]), np.abs(scaled[:, 1]), np.abs(scaled[:, self._x3]),
+                       x4, x5], axis=1)
+        self._bincount_into(sample[:, self._c_x], bins, xs / dx, nx)
+        signed = scaled[:, : self.n_malik] / dx + nx
+        self._bincount_into(sample[:, self._c_m], bins, signed, 2 * nx)
+
+    @staticmethod
+    def _bincount_into(out: np.ndarray, bins: np.ndarray, values: np.ndarray, width: int) -> None:
+        """Histogram columns of ``values`` (already in bin units) per bin into ``out``."""
+        nb, ncol = out.shape[0], values.shape[1]
+        with np.errstate(invalid="ignore"):
+            k = np.floor(values)
+            ok = np.isfinite(k) & (k >= 0) & (k < width)
+        col = np.broadcast_to(np.arange(ncol), values.shape)
+        flat = (bins[:, None] * ncol + col) * width + np.where(ok, k, 0).astype(np.int64)
+        out += np.bincount(flat[ok], minlength=nb * ncol * width).reshape(nb, ncol * width)
+
+    # -- estimates ---------------------------------------------------------------------
+    def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
+        s = mean.reshape(self.n_bins, self.n_values)
+        n = s[:, 0]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m1, m2, m3, m4 = (s[:, sl] / n[:, None] for sl in self._c_pow)
+            mu2 = m2 - m1**2
+            mu3 = m3 - 3 * m1 * m2 + 2 * m1**3
+            mu4 = m4 - 4 * m1 * m3 + 6 * m1**2 * m2 - 3 * m1**4
+            out = {
+                "count": n,
+                "mean": self._shift + m1,
+                "variance": mu2,
+                "skewness": mu3 / mu2**1.5,
+                "kurtosis": mu4 / mu2**2,
+            }
+            if self.reference is not None:
+                norm = n[:, None, None] * self.dx
+                x = s[:, self._c_x].reshape(self.n_bins, 5, self.nx) / norm
+                pdf = s[:, self._c_m].reshape(self.n_bins, self.n_malik, 2 * self.nx) / norm
+                p0 = 0.5 * (pdf[:, :, self.nx - 1] + pdf[:, :, self.nx])
+                out.update({"X": x, "malik_pdf": pdf, "malik_P": pdf / p0[:, :, None]})
+        return out
+
+    def _conclude(self) -> None:
+        est, err = jackknife(self._acc, self._estimate)
+        self.results = {"edges": self.edges, "y": 0.5 * (self.edges[1:] + self.edges[:-1])}
+        for key in est:
+            self.results[key] = est[key]
+            self.results[f"{key}_err"] = err[key]
+        self.attrs = {
+            "dim": self.dim,
+            "components": ",".join(self.components),
+            "inertia_factor": self.inertia_factor,
+            "binning": "strip of the particle centre, number-weighted, pooled over the run",
+            "passes": 2 if self.reference is not None else 1,
+            "samples": self.n_frames,
+            "block_length": self._acc.block_length,
+            "n_blocks": self._acc.n_blocks,
+            "units": UNITS_NOTE,
+        }
+        if self.reference is None:
+            return
+        nx, dx = self.nx, self.dx
+        x_edges = dx * np.arange(nx + 1)
+        x_mid = 0.5 * (x_edges[1:] + x_edges[:-1])
+        self.results["X_edges"] = x_edges
+        self.results["X_centres"] = x_mid
+        self.results["X_reference"] = np.stack(
+            [np.diff(_chi_cdf(x_edges, k)) / dx for k in self.dof])
+        self.results["X_reference_centre"] = np.stack(
+            [folded_maxwellian(x_mid, k) for k in self.dof])
+        c_edges = dx * np.arange(-nx, nx + 1)
+        c_mid = 0.5 * (c_edges[1:] + c_edges[:-1])
+        binned = np.diff(0.5 * (1 + erf(c_edges / np.sqrt(2)))) / dx
+        self.results["malik_edges"] = c_edges
+        self.results["malik_centres"] = c_mid
+        self.results["gaussian"] = np.exp(-0.5 * c_mid**2)
+        self.results["gaussian_binned"] = binned / (0.5 * (binned[nx - 1] + binned[nx]))
+        self.attrs.update({
+            "X_names": ",".join(X_NAMES),
+            "X_degrees_of_freedom": ",".join(str(k) for k in self.dof),
+            "X_a": ",".join(f"{k / 2:g}" for k in self.dof),
+            "malik_components": ",".join(self.components[: self.n_malik]),
+            "malik_P0": "mean of the two histogram bins adjacent to 0",
+        })
+
+
+def velocity_distributions(
+    frames: Callable[[], Iterable[Frame]] | Iterable[Frame], **options: Any
+) -> VelocityDistribution:
+    """Both passes: moments, then histograms against the first pass's bin means/variances.
+
+    ``frames`` is a callable returning a fresh iterable of frames (e.g.
+    ``lambda: read_dump_fast(path, 2)``) or a re-iterable sequence (a list). ``options`` go
+    to :class:`VelocityDistribution`.
+    """
+    if not callable(frames) and iter(frames) is frames:
+        raise TypeError("velocity_distributions reads the frames twice: pass a list or a "
+                        "callable returning a fresh iterator, not an iterator")
+    source = frames if callable(frames) else (lambda: frames)
+    first = VelocityDistribution(**options).run(source())
+    options = {**options, "edges": first.edges, "reference": first.results}
+    return VelocityDistribution(**options).run(source())
