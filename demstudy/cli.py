@@ -57,28 +57,48 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    from .decks.contact import contact_setup
-    from .engines.lammps import profile_analysis
+    from .analysis.suite import run_statistics
     from .io.dump import has_fast_columns, read_dump, read_dump_fast
-    from .io.results import Results, write_results
-    from .scene import scene_to_toml
+    from .io.results import Results, frames_of, read_results, write_results
+    from .scene import parse_scene_text, scene_to_toml, validate_scene
 
-    scene = load_scene(args.scene, args.set)
-    dt = args.dt if args.dt is not None else contact_setup(scene).timestep
-    analysis = profile_analysis(scene)
-    fast = args.reader == "fast" or (args.reader == "auto" and has_fast_columns(args.dump))
-    reader = read_dump_fast if fast else read_dump
-    analysis.run(reader(args.dump, scene.dimension, dt=dt, start_time=args.start))
-    analysis.finish()
-    profiles, attrs = analysis.results, analysis.attrs
-    out = Path(args.out or Path(args.dump).with_suffix(".h5"))
-    write_results(out, Results(
-        {"engine": "lammps-dump",
-         "engine_version": "numpy fast reader" if fast else "MDAnalysis reader",
-         "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
-         "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(args.dump)},
-        profiles=profiles, profile_attrs=attrs))
-    print(f"results: {out} ({attrs['samples']} frames)")
+    what = [w.strip() for w in args.what.split(",") if w.strip()]
+    source = Path(args.source)
+    if source.suffix in (".h5", ".hdf5"):
+        results = read_results(source)
+        text = results.attrs["scene_toml"]
+        scene = load_scene(args.scene, args.set) if args.scene else validate_scene(
+            parse_scene_text(text, str(source)), str(source))
+        out = Path(args.out or source)
+
+        def frames():
+            return (f for f in frames_of(results, scene.dimension) if f.time >= args.start)
+    else:
+        if not args.scene:
+            raise ValueError("analyzing a dump needs --scene SCENE.toml (the scene it ran)")
+        from .decks.contact import contact_setup
+
+        scene = load_scene(args.scene, args.set)
+        dt = args.dt if args.dt is not None else contact_setup(scene).timestep
+        fast = args.reader == "fast" or (args.reader == "auto" and has_fast_columns(source))
+        reader = read_dump_fast if fast else read_dump
+        results = Results({"engine": "lammps-dump",
+                           "engine_version": "numpy fast reader" if fast else "MDAnalysis",
+                           "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
+                           "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(source)})
+        out = Path(args.out or source.with_suffix(".h5"))
+
+        def frames():
+            return reader(source, scene.dimension, dt=dt, start_time=args.start)
+
+    for name, (data, attrs) in run_statistics(scene, frames, what).items():
+        if name == "profiles":
+            results.profiles, results.profile_attrs = data, attrs
+        else:
+            results.groups[f"statistics/{name}"] = data
+            results.group_attrs[f"statistics/{name}"] = attrs
+    write_results(out, results)
+    print(f"results: {out} ({', '.join(what)})")
     return 0
 
 
@@ -132,12 +152,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_plot)
 
     p = sub.add_parser("analyze", parents=[overrides],
-                       help="profiles from a LAMMPS dump (read with MDAnalysis)")
-    p.add_argument("dump")
-    p.add_argument("--scene", required=True, help="the scene the dump was made from")
-    p.add_argument("--dt", type=float, help="time step (default: the scene's LAMMPS time step)")
+                       help="statistics from a results file's frames or from a LAMMPS dump")
+    p.add_argument("source", help="RUN.h5 (run with --keep-frames) or a LAMMPS dump")
+    p.add_argument("--scene", help="the scene (needed for dumps; default for RUN.h5: its own)")
+    p.add_argument("--what", default="profiles",
+                   help="comma-separated: profiles, vdf, gr (default: profiles)")
+    p.add_argument("--dt", type=float, help="dump time step (default: the scene's LAMMPS one)")
     p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")
-    p.add_argument("--out", help="results file (default: DUMP with suffix .h5)")
+    p.add_argument("--out", help="results file (default: RUN.h5 itself, or DUMP.h5)")
     p.add_argument("--reader", choices=["auto", "fast", "mdanalysis"], default="auto",
                    help="auto: the numpy fast path for demstudy's dumps, MDAnalysis otherwise")
     p.set_defaults(func=_cmd_analyze)

@@ -96,3 +96,26 @@ def test_bare_lees_edwards_deck_tilts_at_the_shear_rate(tmp_path):
     offset = np.mod(tilt - rate * ly * time + lx / 2, lx) - lx / 2  # flips: modulo L_x
     np.testing.assert_allclose(offset, 0.0, atol=1e-3)
     assert time.max() > 0.6
+
+
+def test_analyze_stored_frames_adds_statistics(tmp_path, capsys):
+    """`analyze RUN.h5 --what profiles,vdf,gr` recomputes the profiles from the stored frames
+    (identical to the ones made during the run) and adds the statistics to the same file."""
+    from demstudy.io.results import read_results
+
+    out = tmp_path / "chute.h5"
+    assert main(["run", str(CHUTE), "--out", str(out), "-q", "--keep-frames", *SHORT]) == 0
+    before = read_results(out)
+    assert main(["analyze", str(out), "--what", "profiles,vdf,gr"]) == 0
+    after = read_results(out)
+    for key in ("solid_fraction", "velocity", "temperature"):
+        np.testing.assert_allclose(after.profiles[key], before.profiles[key], rtol=1e-12,
+                                   atol=1e-15)
+    assert {"statistics/vdf", "statistics/gr"} <= set(after.groups)
+    gr = after.groups["statistics/gr"]
+    r, g = gr["r"], gr["g"][0]  # one y-bin: the whole box
+    assert np.all(g[r < 0.95] == 0)  # soft discs barely overlap
+    assert g[(r > 0.95) & (r < 1.1)].max() > 1.0  # the contact peak
+    assert after.attrs["scene_toml"] == before.attrs["scene_toml"]
+    assert "unknown statistic" in (
+        main(["analyze", str(out), "--what", "nonsense"]) and capsys.readouterr().err)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -18,6 +18,7 @@ import h5py
 import numpy as np
 
 from .. import UNITS_NOTE, __version__
+from .frames import Frame
 
 FORMAT_VERSION = 1
 
@@ -32,6 +33,7 @@ class Results:
     profile_attrs: dict[str, Any] = field(default_factory=dict)
     frames: dict[str, np.ndarray] | None = None
     groups: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    group_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 def _write_group(group: h5py.Group, data: Mapping[str, Any], attrs: Mapping[str, Any] = {}) -> None:
@@ -65,7 +67,7 @@ def write_results(path: str | os.PathLike, results: Results) -> Path:
             if results.frames:
                 _write_group(f.create_group("frames"), results.frames)
             for name, data in results.groups.items():
-                _write_group(f.require_group(name), data)
+                _write_group(f.require_group(name), data, results.group_attrs.get(name, {}))
         os.replace(tmp, path)
     finally:
         if tmp.exists():
@@ -84,7 +86,31 @@ def read_results(path: str | os.PathLike) -> Results:
                       frames=load("frames") or None)
         if "profiles" in f:
             res.profile_attrs = dict(f["profiles"].attrs)
-        for name in f:
-            if name not in ("timeseries", "profiles", "frames"):
-                res.groups[name] = load(name)
+
+        def collect(group: h5py.Group) -> None:
+            datasets = {k: v[()] for k, v in group.items() if isinstance(v, h5py.Dataset)}
+            if datasets:
+                key = group.name.lstrip("/")
+                res.groups[key] = datasets
+                res.group_attrs[key] = dict(group.attrs)
+            for item in group.values():
+                if isinstance(item, h5py.Group):
+                    collect(item)
+
+        for name, item in f.items():
+            if name not in ("timeseries", "profiles", "frames") and isinstance(item, h5py.Group):
+                collect(item)
     return res
+
+
+def frames_of(results: Results, dim: int) -> Iterator[Frame]:
+    """The frames stored in a results file (``--keep-frames``), as ``Frame`` objects."""
+    fr = results.frames
+    if not fr or "box_lo" not in fr:
+        raise ValueError("the results file holds no frames with their box: run with "
+                         "--keep-frames (or measure.keep_frames = true)")
+    for i, t in enumerate(fr["time"]):
+        yield Frame(time=float(t), box_lo=fr["box_lo"][i], box_hi=fr["box_hi"][i],
+                    position=fr["position"][i][:, :dim], velocity=fr["velocity"][i][:, :dim],
+                    angular_velocity=fr["angular_velocity"][i], radius=fr["radius"][i],
+                    tilt=float(fr["tilt"][i]) if "tilt" in fr else 0.0)

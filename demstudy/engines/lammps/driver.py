@@ -25,6 +25,7 @@ from tqdm import tqdm
 
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.steady import energy_trend, is_steady
+from ...analysis.suite import profile_analysis
 from ...decks import Deck
 from ...decks.output import WALL_FORCES, sample_steps, steps
 from ...decks.servo import ServoController, has_servo
@@ -38,25 +39,6 @@ from .session import LammpsSession, quoted
 
 CHECKPOINT_RESTART = "checkpoint.restart"
 CHECKPOINT_STATE = "checkpoint.pkl"
-
-
-def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None) -> ProfileAnalysis:
-    """Profiles along the scene's axis over the region particles can occupy (``walls``: the
-    current lower and upper wall positions when walls move)."""
-    m = scene.measure
-    axis = "xyz".index(m.axis)
-    period = scene.box.size[axis] if m.axis in scene.periodic else 0.0
-    if m.axis == "y" and walls is not None:
-        lo, hi = walls
-    elif m.axis == "y" and not scene.y_periodic:
-        lo = scene.wall_position("lower")
-        hi = scene.wall_position("upper") if scene.wall("upper") else scene.box.size[1]
-    else:
-        lo, hi = 0.0, scene.box.size[axis]
-    shift = scene.shear.rate * period if scene.shear is not None and m.axis == "y" else 0.0
-    return ProfileAnalysis(axis=m.axis, bin_width=m.bin_width, lo=lo, hi=hi,
-                           dim=scene.dimension, inertia_factor=scene.inertia_k, period=period,
-                           image_velocity_shift=shift)
 
 
 @dataclass
@@ -206,9 +188,11 @@ class Driver:
             state.profiles = profile_analysis(self.scene, (lower.y, upper.y))
         state.profiles.feed(frame)
         if self.keep_frames:
-            for key in ("position", "velocity", "angular_velocity", "radius"):
-                state.frames.setdefault(key, []).append(getattr(frame, key).copy())
+            for key in ("position", "velocity", "angular_velocity", "radius", "box_lo",
+                        "box_hi"):
+                state.frames.setdefault(key, []).append(np.array(getattr(frame, key)))
             state.frames.setdefault("time", []).append(t)
+            state.frames.setdefault("tilt", []).append(frame.tilt)
 
     def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
         restart = self.workdir / CHECKPOINT_RESTART
