@@ -43,4 +43,8 @@ def get_engine(name: str) -> Engine:
         from .lammps import LammpsEngine
 
         return LammpsEngine()
-    raise ValueError(f"engine = {name!r}: unknown engine (allowed: lammps)")
+    if name == "edmd":
+        from .edmd import EdmdEngine
+
+        return EdmdEngine()
+    raise ValueError(f"engine = {name!r}: unknown engine (allowed: lammps, edmd)")

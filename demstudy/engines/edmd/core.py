@@ -1,0 +1,81 @@
+"""Thin Python layer over the C++ event-driven core ``demstudy._native.EventDriven``.
+
+Dimensionless particle units: d = 1, m = 1 (mass ∝ d^dim), no gravity in milestone 1.
+
+``EventDriven(positions, velocities, angular_velocities, diameters, masses, box, dim, e=1,
+beta=-1, inertia_k=0.4, tc=0)``: positions/velocities (N, dim), angular velocities (N, 1) in
+2D and (N, 3) in 3D, box lengths (dim,), every axis periodic. ``advance_to(t)`` processes all
+events up to t, then synchronises every particle to t (``advance_to(t, max_events=k)`` stops
+after k events if t is not reached and returns False). ``get_state()`` returns every array
+needed to continue (positions, velocities, spins, cells, last-collision times, counters and
+the scheduled events); ``set_state(state)`` on a system built from the same particles
+continues bit-identically (events are processed in the total order (time, index)).
+Accessors: ``positions()`` (wrapped into [0, L)), ``velocities()``, ``angular_velocities()``,
+``kinetic_energy``, ``rotational_energy``, ``time``; counters ``collisions``,
+``cell_crossings``, ``events`` (= collisions + crossings), ``invalid_events`` (stale
+predictions discarded), ``elastic_tc_collisions``; ``virial`` = Σ r_ij·J_i over all collisions
+(r_ij = r_i − r_j, J_i the impulse on i) and ``virial_tensor`` Σ r_ij ⊗ J_i, so the collisional
+pressure over an interval Δt is ΔW / (dim V Δt); ``dissipated`` = energy lost in collisions
+(translational + rotational); ``min_gap()`` = smallest |r_ij| − σ_ij (negative: overlap).
+
+Collision rule (Lun; Malik 2008 eqs. 2.5–2.11 for unequal masses): with the unit normal n from
+i to j and the contact-point relative velocity g = v_i − v_j + (r_i ω_i + r_j ω_j) × n, the
+impulse on i is J = −m*(1 + e)(g·n) n − m*(1 + β) K/(1 + K) g_t, m* = m_i m_j/(m_i + m_j),
+I = K m r². So g_n' = −e g_n, g_t' = −β g_t, and for equal masses
+ΔE = −(m/4)[(1 − e²) g_n² + K/(1 + K)(1 − β²)|g_t|²]. β = −1 (smooth) never changes spins.
+
+Inelastic collapse: the TC model (Luding & McNamara 1998). A collision in which either
+partner had its previous collision less than ``tc`` earlier is elastic (e = 1, no tangential
+impulse). ``DEFAULT_TC`` = 1e-5 time units (the engine's default; 0 disables the model).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..._native import EventDriven, edmd_collide_pair
+from ...decks.base import UnsupportedByEngine
+from ...scene import Scene
+from ...scene.initial import InitialState
+
+DEFAULT_TC = 1e-5
+
+__all__ = ["DEFAULT_TC", "EventDriven", "collide_pair", "from_initial_state",
+           "scene_parameters"]
+
+
+def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
+    """One collision: returns (vi', vj', wi', wj', J) as 3-vectors (z = 0 / spin z in 2D)."""
+    as3 = [np.asarray(a, float).ravel().tolist() for a in (n, vi, vj, wi, wj)]
+    n3, vi3, vj3, wi3, wj3 = as3
+    return edmd_collide_pair(n3, float(ri), float(rj), float(mi), float(mj), float(inertia_k),
+                             float(e), float(beta), vi3, vj3, wi3, wj3)
+
+
+def scene_parameters(scene: Scene) -> dict:
+    """e, β and K of a scene (β = −1 for smooth contacts); refuses laws outside milestone 1."""
+    contact = scene.contact
+    if contact.law.model != "constant":
+        raise UnsupportedByEngine("edmd", "contact.law.model", contact.law.model,
+                                  "only a constant normal restitution is implemented")
+    rule = contact.tangential
+    if rule.model == "smooth":
+        beta = -1.0
+    elif rule.model in ("beta", "rough"):
+        beta = float(rule.beta)
+    else:
+        raise UnsupportedByEngine("edmd", "contact.tangential.model", rule.model,
+                                  "Coulomb friction (Walton) is not implemented yet; use "
+                                  "smooth, beta or rough")
+    return {"e": float(contact.restitution), "beta": beta, "inertia_k": float(scene.inertia_k)}
+
+
+def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -1.0,
+                       inertia_k: float = 0.4, tc: float = 0.0) -> EventDriven:
+    """An ``EventDriven`` system from ``demstudy.scene.initial.build_initial_state`` output."""
+    dim = state.position.shape[1]
+    c = np.ascontiguousarray
+    return EventDriven(c(state.position, float), c(state.velocity, float),
+                       c(state.angular_velocity, float), c(state.diameter, float),
+                       c(state.mass, float), [float(b) for b in box], dim, e=e, beta=beta,
+                       inertia_k=inertia_k, tc=tc)

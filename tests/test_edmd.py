@@ -1,0 +1,539 @@
+"""Event-driven hard-particle engine (``--engine edmd``), milestone 1.
+
+Dimensionless particle units: d = 1, m = 1 (mass ∝ d^dim), T0 = 1 sets the time scale.
+Reference formulas (stated here because the assertions depend on them):
+
+* pair collision, equal masses: ΔE = −(m/4)[(1 − e²) g_n² + K/(1 + K)(1 − β²)|g_t|²];
+* Carnahan–Starling Z = (1 + φ + φ² − φ³)/(1 − φ)³ (3D), Henderson Z = (1 + ν²/8)/(1 − ν)² (2D);
+* contact values g0 = (1 − φ/2)/(1 − φ)³ (CS), (1 − 7ν/16)/(1 − ν)² (Henderson);
+* Enskog collision frequency per particle ω = 4 n d² g0 √(πT/m) (3D), 2 n d g0 √(πT/m) (2D);
+* Haff: dT/dt = −(1 − e²) ω T / d_f (smooth particles, d_f = dim translational degrees of
+  freedom, one collision per pair loses (1 − e²) T on average), so T = T0/(1 + t/t0)² with
+  t0 = 2 d_f / ((1 − e²) ω0), ω0 the Enskog frequency at T0.
+
+Runtime about a minute on a 2-core machine (the elastic drift tests take most of it).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from demstudy.analysis.suite import profile_analysis
+from demstudy.decks.base import UnsupportedByEngine
+from demstudy.engines.base import EngineError, RunOptions, get_engine
+from demstudy.engines.edmd import (
+    EdmdEngine,
+    EventDriven,
+    check_supported,
+    collide_pair,
+    from_initial_state,
+)
+from demstudy.io.results import read_results
+from demstudy.scene import parse_scene_text, validate_scene
+from demstudy.scene.initial import build_initial_state
+
+
+def make_scene(dim: int, phi: float, n: int, seed: int = 1, e: float = 1.0,
+               extra: str = "", spread: float = 0.0, tangential: str = "smooth",
+               production: float = 1.0, sample: float = 1.0):
+    unit = math.pi / 6 if dim == 3 else math.pi / 4
+    length = (n * unit * (1 + spread**2 / 4) / phi) ** (1 / dim)
+    size = [round(length, 9)] * dim
+    tang = ('{ model = "smooth" }' if tangential == "smooth"
+            else f'{{ model = "beta", beta = {tangential} }}')
+    return validate_scene(parse_scene_text(f"""
+dimension = {dim}
+[box]
+size = {size}
+[particles]
+count = {n}
+diameter_spread = {spread}
+[contact]
+restitution = {e}
+tangential = {tang}
+[initial.velocity]
+temperature = 1.0
+[run]
+equilibration = 0.0
+production = {production}
+sample_interval = {sample}
+seed = {seed}
+{extra}
+"""))
+
+
+def system(scene, tc: float = 0.0, **kw) -> EventDriven:
+    params = check_supported(scene)
+    params.update(kw)
+    return from_initial_state(build_initial_state(scene), scene.box.size, tc=tc, **params)
+
+
+def fraction(scene) -> float:
+    return scene.solid_fraction
+
+
+def energy(s: EventDriven) -> float:
+    return s.kinetic_energy + s.rotational_energy
+
+
+# ---- collision rules ----------------------------------------------------------------------
+
+def random_pair(rng, dim):
+    n = rng.normal(size=3)
+    if dim == 2:
+        n[2] = 0.0
+    n /= np.linalg.norm(n)
+    vi, vj = rng.normal(size=3), rng.normal(size=3)
+    wi, wj = rng.normal(size=3), rng.normal(size=3)
+    if dim == 2:
+        vi[2] = vj[2] = 0.0
+        wi[:2] = wj[:2] = 0.0
+    # make the pair approach (centre velocities)
+    if (vi - vj) @ n < 0:
+        vi, vj = vj, vi
+    return n, vi, vj, wi, wj
+
+
+def pair_energy(m, ri, rj, K, vi, vj, wi, wj, mj=None):
+    mj = m if mj is None else mj
+    return 0.5 * (m * vi @ vi + mj * vj @ vj + K * m * ri**2 * wi @ wi
+                  + K * mj * rj**2 * wj @ wj)
+
+
+def contact_velocity(n, ri, rj, vi, vj, wi, wj):
+    return vi - vj + np.cross(ri * wi + rj * wj, n)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_energy_loss_per_collision_matches_the_analytic_formula(dim):
+    rng = np.random.default_rng(7 + dim)
+    for _ in range(500):
+        n, vi, vj, wi, wj = random_pair(rng, dim)
+        m = rng.uniform(0.2, 3.0)
+        ri, rj = rng.uniform(0.3, 0.7, size=2)  # ΔE does not depend on the radii
+        e, beta, K = rng.uniform(0.05, 1.0), rng.uniform(-1, 1), rng.uniform(0.05, 1.0)
+        g = contact_velocity(n, ri, rj, vi, vj, wi, wj)
+        gn = g @ n
+        gt = g - gn * n
+        before = pair_energy(m, ri, rj, K, vi, vj, wi, wj)
+        vi2, vj2, wi2, wj2, J = collide_pair(n, ri, rj, m, m, K, e, beta, vi, vj, wi, wj)
+        after = pair_energy(m, ri, rj, K, vi2, vj2, wi2, wj2)
+        expected = -(m / 4) * ((1 - e**2) * gn**2 + K / (1 + K) * (1 - beta**2) * gt @ gt)
+        assert after - before == pytest.approx(expected, rel=1e-11, abs=1e-13 * before)
+        g2 = contact_velocity(n, ri, rj, vi2, vj2, wi2, wj2)
+        np.testing.assert_allclose(g2 @ n, -e * gn, atol=1e-13 * (1 + abs(gn)))
+        np.testing.assert_allclose(g2 - (g2 @ n) * n, -beta * gt, atol=1e-12)
+        np.testing.assert_allclose(m * (vi2 + vj2), m * (vi + vj), atol=1e-12)
+        np.testing.assert_allclose(vi2, vi + J / m, atol=1e-13)
+        if dim == 2:
+            assert vi2[2] == vj2[2] == 0.0 and not wi2[:2].any() and not wj2[:2].any()
+
+
+def test_unequal_masses_follow_the_reduced_mass_form():
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        n, vi, vj, wi, wj = random_pair(rng, 3)
+        mi, mj = rng.uniform(0.2, 3.0, size=2)
+        ri, rj = rng.uniform(0.3, 0.7, size=2)
+        e, beta, K = rng.uniform(0.05, 1.0), rng.uniform(-1, 1), rng.uniform(0.05, 1.0)
+        g = contact_velocity(n, ri, rj, vi, vj, wi, wj)
+        gn = g @ n
+        gt = g - gn * n
+        before = pair_energy(mi, ri, rj, K, vi, vj, wi, wj, mj)
+        vi2, vj2, wi2, wj2, _ = collide_pair(n, ri, rj, mi, mj, K, e, beta, vi, vj, wi, wj)
+        after = pair_energy(mi, ri, rj, K, vi2, vj2, wi2, wj2, mj)
+        meff = mi * mj / (mi + mj)
+        expected = -(meff / 2) * ((1 - e**2) * gn**2 + K / (1 + K) * (1 - beta**2) * gt @ gt)
+        assert after - before == pytest.approx(expected, rel=1e-11, abs=1e-13 * before)
+        np.testing.assert_allclose(mi * vi2 + mj * vj2, mi * vi + mj * vj, atol=1e-12)
+        # angular momentum about the contact point is conserved
+        ci, cj = ri * n, -rj * n  # contact point relative to each centre
+        li = K * mi * ri**2 * wi - np.cross(ci, mi * vi)
+        lj = K * mj * rj**2 * wj - np.cross(cj, mj * vj)
+        li2 = K * mi * ri**2 * wi2 - np.cross(ci, mi * vi2)
+        lj2 = K * mj * rj**2 * wj2 - np.cross(cj, mj * vj2)
+        np.testing.assert_allclose(li2, li, atol=1e-12)
+        np.testing.assert_allclose(lj2, lj, atol=1e-12)
+
+
+def test_smooth_collisions_leave_spins_and_elastic_rough_ones_conserve_energy():
+    rng = np.random.default_rng(11)
+    for dim in (2, 3):
+        for _ in range(100):
+            n, vi, vj, wi, wj = random_pair(rng, dim)
+            _, _, wi2, wj2, _ = collide_pair(n, 0.5, 0.5, 1.0, 1.0, 0.4, 0.7, -1.0,
+                                             vi, vj, wi, wj)
+            assert np.array_equal(wi2, wi) and np.array_equal(wj2, wj)
+            before = pair_energy(1.0, 0.5, 0.5, 0.4, vi, vj, wi, wj)
+            out = collide_pair(n, 0.5, 0.5, 1.0, 1.0, 0.4, 1.0, 1.0, vi, vj, wi, wj)
+            after = pair_energy(1.0, 0.5, 0.5, 0.4, *out[:4])
+            assert after == pytest.approx(before, rel=1e-14)
+
+
+# ---- conservation and overlaps -------------------------------------------------------------
+
+@pytest.mark.parametrize("dim, n, seconds", [(3, 4000, 12.0), (2, 4000, 8.0)])
+def test_elastic_gas_conserves_energy_and_momentum(dim, n, seconds):
+    """Number density 0.5 (3D: φ = 0.26; 2D: ν = 0.39), N = 4000, run for a fixed wall time.
+    Measured on the development machine: 3.4e6 collisions in 12 s (3D) and 5.6e6 in 8 s (2D);
+    largest relative energy drift 1.6e-13 (3D) / 3.9e-13 (2D), momentum change 2e-13."""
+    phi = 0.5 * (math.pi / 6 if dim == 3 else math.pi / 4)
+    s = system(make_scene(dim, phi, n, seed=5))
+    e0 = energy(s)
+    p0 = s.velocities().sum(axis=0)
+    start, t = time.perf_counter(), 0.0
+    while time.perf_counter() - start < seconds:
+        t += 2.0
+        s.advance_to(t)
+        assert abs(energy(s) - e0) / e0 < 1e-10
+    assert s.collisions > 1e6
+    p = s.velocities().sum(axis=0)
+    assert np.abs(p - p0).max() < 1e-10 * math.sqrt(n)
+    assert s.min_gap() > -1e-9
+
+
+def test_elastic_rough_polydisperse_gas_conserves_energy():
+    scene = make_scene(3, 0.3, 1500, seed=2, spread=0.4, tangential="1.0")
+    s = system(scene)
+    state = build_initial_state(scene)
+    mass = state.mass
+    e0 = energy(s)
+    s.advance_to(8.0)
+    assert s.collisions > 5e4
+    assert abs(energy(s) - e0) / e0 < 1e-12
+    assert s.rotational_energy > 0.1 * e0  # spins took energy (β = 1 couples them)
+    np.testing.assert_allclose((mass[:, None] * s.velocities()).sum(axis=0),
+                               (mass[:, None] * state.velocity).sum(axis=0), atol=1e-10)
+    assert s.min_gap() > -1e-9
+
+
+def test_dissipated_energy_is_booked():
+    s = system(make_scene(2, 0.3, 1000, seed=4, e=0.8, tangential="0.3"), tc=1e-5)
+    e0 = energy(s)
+    s.advance_to(5.0)
+    assert s.dissipated > 0.3 * e0
+    assert energy(s) + s.dissipated == pytest.approx(e0, rel=1e-11)
+
+
+def pair_gaps(positions, diameters, box):
+    tree = cKDTree(positions, boxsize=box)
+    pairs = tree.query_pairs(1.5 * diameters.max(), output_type="ndarray")
+    d = positions[pairs[:, 0]] - positions[pairs[:, 1]]
+    d -= np.round(d / box) * box
+    return np.linalg.norm(d, axis=1) - (diameters[pairs[:, 0]] + diameters[pairs[:, 1]]) / 2
+
+
+@pytest.mark.parametrize("dim, phi, n, t_end", [(3, 0.55, 864, 8.0), (2, 0.80, 1000, 4.0)])
+def test_dense_packings_never_overlap(dim, phi, n, t_end):
+    """Dense random starts (demstudy's jittered close-packed lattice subset)."""
+    scene = make_scene(dim, phi, n, seed=3)
+    assert scene.solid_fraction == pytest.approx(phi, rel=1e-6)
+    state = build_initial_state(scene)
+    s = system(scene)
+    box = np.asarray(scene.box.size)
+    worst = 0.0
+    for k in range(1, 41):
+        s.advance_to(k * t_end / 40)
+        gaps = pair_gaps(s.positions(), state.diameter, box)
+        worst = min(worst, gaps.min(), s.min_gap())
+    assert worst > -1e-9
+    assert s.collisions > 8e4
+    assert abs(energy(s) / (state.mass[:, None] * state.velocity**2).sum() * 2 - 1) < 1e-10
+
+
+def test_inelastic_collapse_is_prevented_by_the_tc_model():
+    """Dense 2D cooling with e = 0.5: with t_c = 1e-5 the time reaches t = 200 within 3e6
+    events (measured: about 1e6); T falls by orders of magnitude meanwhile."""
+    scene = make_scene(2, 0.5, 500, seed=9, e=0.5)
+    s = system(scene, tc=1e-5)
+    e0 = energy(s)
+    assert s.advance_to(200.0, max_events=3_000_000)
+    assert s.time == 200.0
+    assert energy(s) < 1e-2 * e0
+    assert s.elastic_tc_collisions > 0
+    assert s.min_gap() > -1e-9
+
+
+# ---- equilibrium statistics ----------------------------------------------------------------
+
+def block_measure(s: EventDriven, n_blocks: int, block_time: float, dim: int):
+    """Per block: compressibility factor Z = PV/(NT) and collision frequency per particle."""
+    n = s.n
+    z, freq = [], []
+    w0, c0, t = s.virial, s.collisions, s.time
+    for _ in range(n_blocks):
+        t += block_time
+        s.advance_to(t)
+        kinetic = s.kinetic_energy
+        temperature = 2 * kinetic / (dim * (n - 1))  # zero total momentum: dim (N − 1) dofs
+        z.append((2 * kinetic / dim + (s.virial - w0) / (dim * block_time))
+                 / (n * temperature))
+        freq.append(2 * (s.collisions - c0) / (n * block_time))
+        w0, c0 = s.virial, s.collisions
+    z, freq = np.array(z), np.array(freq)
+    return (z.mean(), z.std(ddof=1) / math.sqrt(n_blocks), freq.mean(),
+            freq.std(ddof=1) / math.sqrt(n_blocks), temperature)
+
+
+def equilibrated(dim, phi, n, seed=1):
+    scene = make_scene(dim, phi, n, seed=seed)
+    s = system(scene)
+    s.advance_to(10.0)
+    return s, scene
+
+
+def collisions_per_time(s, dim, phi, n):
+    """Enskog estimate (CS/Henderson g0) of the collisions per unit time, T = 1."""
+    density = n / (s.n / fraction_density(dim, phi))
+    return n / 2 * enskog_frequency(dim, phi, density, 1.0)
+
+
+def fraction_density(dim, phi):
+    return phi / (math.pi / 6 if dim == 3 else math.pi / 4)
+
+
+def contact_value(dim, phi):
+    return (1 - phi / 2) / (1 - phi) ** 3 if dim == 3 else (1 - 7 * phi / 16) / (1 - phi) ** 2
+
+
+def enskog_frequency(dim, phi, density, temperature):
+    g0 = contact_value(dim, phi)
+    if dim == 3:
+        return 4 * density * g0 * math.sqrt(math.pi * temperature)
+    return 2 * density * g0 * math.sqrt(math.pi * temperature)
+
+
+def equation_of_state(dim, phi):
+    """Carnahan–Starling (3D), Henderson (2D)."""
+    if dim == 3:
+        return (1 + phi + phi**2 - phi**3) / (1 - phi) ** 3
+    return (1 + phi**2 / 8) / (1 - phi) ** 2
+
+
+def accurate_equation_of_state(dim, phi):
+    """Closer fits to simulation data: Kolafa–Labík–Malijevský (3D; CS is ~0.3 % low at
+    φ = 0.3–0.45) and Luding's corrected Henderson (2D; Henderson is 1–2 % high at ν ≥ 0.6)."""
+    if dim == 3:
+        return (1 + phi + phi**2 - 2 / 3 * (phi**3 + phi**4)) / (1 - phi) ** 3
+    return (1 + phi**2 / 8) / (1 - phi) ** 2 - phi**4 / (64 * (1 - phi) ** 4)
+
+
+@pytest.mark.parametrize("dim, phi", [(3, 0.1), (3, 0.25), (3, 0.4), (3, 0.45), (2, 0.2),
+                                      (2, 0.3), (2, 0.4), (2, 0.6)])
+def test_pressure_matches_the_equation_of_state(dim, phi):
+    """≈ 1e6 collisions per state point in 20 blocks; the block-averaged standard error of Z
+    is asserted < 0.15 % so a 0.5 % deviation is resolved. Henderson itself is off by more
+    than 0.5 % above ν ≈ 0.5 (measured with 4e6 collisions: −0.42 % at 0.5, −2.2 % at 0.65),
+    so ν = 0.6 (2e6 collisions: slower fluctuations near the fluid–hexatic transition) is
+    checked against the corrected form only."""
+    n = 2000
+    s, scene = equilibrated(dim, phi, n)
+    phi = scene.solid_fraction
+    per_time = n / 2 * enskog_frequency(dim, phi, fraction_density(dim, phi), 1.0)
+    block = (2e6 if phi > 0.55 else 1e6) / 20 / per_time
+    z, z_err, *_ = block_measure(s, 20, block, dim)
+    assert z_err / z < 1.5e-3
+    if dim == 3 or phi < 0.45:
+        assert z / equation_of_state(dim, phi) - 1 == pytest.approx(0.0, abs=5e-3)
+    assert z / accurate_equation_of_state(dim, phi) - 1 == pytest.approx(0.0, abs=3e-3)
+
+
+def test_collision_frequency_matches_enskog_at_phi_0_2():
+    n, dim = 4000, 3
+    s, scene = equilibrated(dim, 0.2, n, seed=2)
+    phi = scene.solid_fraction
+    per_time = n / 2 * enskog_frequency(dim, phi, fraction_density(dim, phi), 1.0)
+    _, _, freq, freq_err, temperature = block_measure(s, 20, 2e6 / 20 / per_time, dim)
+    expected = enskog_frequency(dim, phi, fraction_density(dim, phi), temperature)
+    assert freq_err / freq < 2e-3
+    assert freq / expected - 1 == pytest.approx(0.0, abs=1e-2)
+
+
+@pytest.mark.parametrize("dim", [3, 2])
+def test_haff_law_for_a_dilute_inelastic_smooth_gas(dim):
+    """φ (ν) = 0.05, e = 0.9, N = 2000, T0 = 1, averaged over 16 seeds, up to t = 2 t0 with
+    t0 = 2 d_f / ((1 − e²) ω0), ω0 the Enskog frequency (CS / Henderson g0): 3D t0 = 41.0,
+    2D t0 = 86.1. Measured T/T_Haff at t = (0.5, 1, 1.5, 2) t0: 3D 1.003, 1.005, 1.007, 1.008
+    (± 0.003), 2D 1.010, 1.018, 1.021, 1.021 (± 0.005): the homogeneous cooling state cools
+    slightly slower than Enskog–Haff (a2 < 0, velocity correlations; larger 2D systems drift
+    to +3 % at 2 t0), so the 3 % bound is checked up to 2 t0 with N = 2000."""
+    e, phi, n = 0.9, 0.05, 2000
+    scene = make_scene(dim, phi, n, seed=1, e=e)
+    phi = scene.solid_fraction
+    omega0 = enskog_frequency(dim, phi, fraction_density(dim, phi), 1.0)
+    t0 = 2 * dim / ((1 - e**2) * omega0)
+    assert t0 == pytest.approx({3: 41.0, 2: 86.1}[dim], abs=0.1)
+    times = t0 * np.array([0.25, 0.5, 1.0, 1.5, 2.0])
+    haff = 1 / (1 + times / t0) ** 2
+    ratios = []
+    for seed in range(1, 17):
+        s = system(make_scene(dim, phi, n, seed=seed, e=e), tc=1e-5)
+        t_init = 2 * s.kinetic_energy / (dim * (n - 1))
+        row = []
+        for t in times:
+            s.advance_to(t)
+            row.append(2 * s.kinetic_energy / (dim * (n - 1)) / t_init)
+        ratios.append(np.array(row) / haff)
+    ratios = np.array(ratios)
+    error = ratios.std(axis=0, ddof=1) / math.sqrt(len(ratios))
+    assert np.all(error < 0.01)  # resolves the 3 % bound
+    assert np.all(haff[-1] * ratios[:, -1] < 0.15)  # it really cooled: T(2 t0) ≈ T0/9
+    np.testing.assert_allclose(ratios.mean(axis=0), 1.0, atol=0.03)
+
+
+# ---- determinism, checkpoints --------------------------------------------------------------
+
+def test_state_round_trip_continues_bit_identically():
+    scene = make_scene(3, 0.3, 500, seed=6, e=0.9, tangential="0.2")
+    a = system(scene, tc=1e-5)
+    a.advance_to(3.0)
+    saved = a.get_state()
+    a.advance_to(6.0)
+    b = system(scene, tc=1e-5)
+    b.set_state(saved)
+    assert b.time == 3.0
+    b.advance_to(6.0)
+    for get in ("positions", "velocities", "angular_velocities"):
+        assert np.array_equal(getattr(a, get)(), getattr(b, get)())
+    assert (a.collisions, a.virial, a.dissipated) == (b.collisions, b.virial, b.dissipated)
+
+
+def test_rejects_bad_input():
+    scene = make_scene(3, 0.2, 100)
+    st = build_initial_state(scene)
+    with pytest.raises(ValueError, match="3 largest diameters"):
+        from_initial_state(st, [2.5, 2.5, 2.5])
+    with pytest.raises(ValueError, match="restitution"):
+        from_initial_state(st, scene.box.size, e=1.5)
+    s = from_initial_state(st, scene.box.size)
+    s.advance_to(1.0)
+    with pytest.raises(ValueError, match="must not decrease"):
+        s.advance_to(0.5)
+
+
+# ---- the engine ------------------------------------------------------------------------------
+
+ENGINE_SCENE = """
+dimension = 2
+[meta]
+name = "edmd-small"
+[box]
+size = [20.0, 20.0]
+[particles]
+solid_fraction = 0.3
+[contact]
+restitution = 0.95
+tangential = { model = "beta", beta = 0.4 }
+[initial.velocity]
+temperature = 1.0
+[run]
+equilibration = 2.0
+production = 4.0
+sample_interval = 0.5
+seed = 3
+[measure]
+bin_width = 2.0
+"""
+
+
+def engine_scene(overrides: dict | None = None):
+    data = parse_scene_text(ENGINE_SCENE)
+    for key, value in (overrides or {}).items():
+        target = data
+        *path, last = key.split(".")
+        for part in path:
+            target = target.setdefault(part, {})
+        target[last] = value
+    return validate_scene(data)
+
+
+def test_engine_writes_the_common_results_file(tmp_path):
+    assert isinstance(get_engine("edmd"), EdmdEngine)
+    scene = engine_scene()
+    path = EdmdEngine().run(scene, RunOptions(out=tmp_path / "r.h5", progress=False,
+                                              keep_frames=True))
+    res = read_results(path)
+    assert res.attrs["engine"] == "edmd" and res.attrs["seed"] == 3
+    assert res.attrs["equilibration_end"] == 2.0
+    assert "kinetic_energy_trend" in res.attrs and "steady" in res.attrs
+    ts = res.timeseries
+    np.testing.assert_allclose(ts["time"], np.arange(13) * 0.5)
+    for key in ("kinetic_energy", "rotational_energy", "momentum", "collisions", "pressure"):
+        assert key in ts
+    assert ts["momentum"].shape == (13, 2)
+    assert np.isnan(ts["pressure"][0]) and np.all(ts["pressure"][1:] > 0)
+    assert np.all(np.diff(ts["collisions"]) > 0)
+    assert res.profiles["solid_fraction"].mean() == pytest.approx(0.3, rel=0.02)
+    assert res.profile_attrs["samples"] == 8
+    assert res.frames["position"].shape[0] == 8
+    assert res.frames["angular_velocity"].shape[2] == 1
+    np.testing.assert_array_equal(res.frames["box_hi"][0], scene.box.size)
+    # the stored frames feed the common analyses (demstudy analyze)
+    from demstudy.io.results import frames_of
+    again = profile_analysis(scene).run(frames_of(res, 2)).finish()
+    np.testing.assert_allclose(again.results["solid_fraction"], res.profiles["solid_fraction"])
+    assert not (tmp_path / "r.edmd").exists()
+
+
+def test_engine_resume_is_bit_identical(tmp_path):
+    scene = engine_scene()
+    whole = EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5", progress=False))
+    out = tmp_path / "parts.h5"
+    with pytest.raises(EngineError, match="--resume"):
+        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
+    assert (tmp_path / "parts.edmd" / "checkpoint.pkl").exists()
+    EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True))
+    a, b = read_results(whole), read_results(out)
+    for key, value in a.timeseries.items():
+        assert np.array_equal(value, b.timeseries[key], equal_nan=True), key
+    for key, value in a.profiles.items():
+        assert np.array_equal(value, b.profiles[key], equal_nan=True), key
+
+
+@pytest.mark.parametrize("overrides, field", [
+    ({"walls": [{"side": "lower", "restitution": 0.9}]}, "walls"),
+    ({"shear": {"rate": 1.0}}, "shear"),
+    ({"contact.tangential": {"model": "coulomb", "mu": 0.5}}, "contact.tangential.model"),
+    ({"contact.law": {"model": "campbell-exp"}}, "contact.law.model"),
+    ({"run.unit": "collisions"}, "run.unit"),
+])
+def test_engine_refuses_features_outside_the_milestone(overrides, field, tmp_path):
+    scene = engine_scene(overrides)
+    with pytest.raises(UnsupportedByEngine) as info:
+        EdmdEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))
+    assert info.value.engine == "edmd" and info.value.field_name == field
+
+
+def test_engine_refuses_gravity(tmp_path):
+    scene = engine_scene({"walls": [{"side": "lower", "restitution": 0.9}],
+                          "gravity": {"angle": 30.0}})
+    with pytest.raises(UnsupportedByEngine):
+        check_supported(scene)
+    data = parse_scene_text(ENGINE_SCENE)
+    data["gravity"] = {"direction": [0.0, -1.0]}
+    try:
+        scene = validate_scene(data)
+    except Exception:  # gravity may require walls in the scene rules
+        return
+    with pytest.raises(UnsupportedByEngine) as info:
+        check_supported(scene)
+    assert info.value.field_name == "gravity"
+
+
+def test_cli_runs_the_edmd_engine(tmp_path, capsys):
+    from demstudy.cli import main
+
+    path = tmp_path / "scene.toml"
+    path.write_text(ENGINE_SCENE)
+    out = tmp_path / "cli.h5"
+    assert main(["run", str(path), "--engine", "edmd", "--out", str(out), "--quiet",
+                 "--set", "run.production=1.0"]) == 0
+    assert read_results(out).attrs["engine"] == "edmd"
+    assert main(["run", str(path), "--engine", "edmd", "--out", str(out), "--quiet",
+                 "--set", "shear={ rate = 1.0 }"]) != 0
+    assert "unsupported by edmd: shear" in capsys.readouterr().err
