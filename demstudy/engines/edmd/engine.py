@@ -16,10 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
 import pickle
-import signal
-import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,7 +26,6 @@ from tqdm import tqdm
 
 from ... import __version__
 from ...analysis.profiles import ProfileAnalysis
-from ...analysis.steady import energy_trend, is_steady
 from ...analysis.suite import profile_analysis
 from ...decks.base import UnsupportedByEngine
 from ...io.frames import Frame
@@ -37,6 +33,8 @@ from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
 from ...scene.initial import build_initial_state
 from ..base import EngineError, RunOptions
+from ..child import in_worker, launch_child
+from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
 from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters
 
 CHECKPOINT = "checkpoint.pkl"
@@ -88,13 +86,17 @@ class EdmdEngine:
     """``run(scene, options)``: event-driven hard discs/spheres (see the module docstring).
 
     ``options.extra["tc"]``: TC-model time (default ``DEFAULT_TC``; 0 switches it off).
-    ``options.isolate`` and ``options.np`` are ignored (one in-process serial run) and
-    ``options.dump`` is refused (no LAMMPS dump)."""
+    ``options.isolate`` runs it in a child process; ``options.np`` > 1 and ``options.dump``
+    are refused (a serial engine; no LAMMPS dump)."""
 
     name = "edmd"
 
     def run(self, scene: Scene, options: RunOptions) -> Path:
         params = check_supported(scene)
+        if options.np > 1:
+            raise UnsupportedByEngine("edmd", "--np", options.np, "the engine is serial")
+        if options.isolate and not in_worker():
+            return launch_child(self.name, scene, options)  # a crash in C++ stays there
         if options.dump is not None:
             raise UnsupportedByEngine("edmd", "--dump", str(options.dump),
                                       "the LAMMPS dump is not written by this engine; use "
@@ -117,7 +119,6 @@ class _Run:
         keep = options.keep_frames
         self.keep_frames = scene.measure.keep_frames if keep is None else keep
         self.volume = math.prod(scene.box.size)
-        self.stop_reason: str | None = None
 
     # -- state ----------------------------------------------------------------------------
     def _start(self) -> tuple[EventDriven, EdmdRunState]:
@@ -141,11 +142,9 @@ class _Run:
         self.workdir.mkdir(parents=True, exist_ok=True)
         snapshot = dataclasses.replace(
             state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
-        tmp = self.workdir / (CHECKPOINT + ".new")
-        with open(tmp, "wb") as fh:
-            pickle.dump({"scene": scene_to_toml(self.scene), "tc": self.tc,
-                         "core": core.get_state(), "run": snapshot}, fh)
-        os.replace(tmp, self.workdir / CHECKPOINT)
+        pickle_atomically(self.workdir / CHECKPOINT,
+                          {"scene": scene_to_toml(self.scene), "tc": self.tc,
+                           "core": core.get_state(), "run": snapshot})
 
     # -- sampling -------------------------------------------------------------------------
     def _sample(self, core: EventDriven, state: EdmdRunState, production: bool) -> None:
@@ -173,34 +172,24 @@ class _Run:
                       angular_velocity=core.angular_velocities(), radius=self.radius)
         state.profiles.feed(frame)
         if self.keep_frames:
-            for key in ("position", "velocity", "angular_velocity", "radius", "box_lo",
-                        "box_hi"):
-                state.frames.setdefault(key, []).append(np.array(getattr(frame, key)))
-            state.frames.setdefault("time", []).append(t)
-            state.frames.setdefault("tilt", []).append(frame.tilt)
+            keep_frame(state.frames, frame)
 
     # -- main loop ------------------------------------------------------------------------
-    def _request_stop(self, _signum=None, _frame=None) -> None:
-        self.stop_reason = "interrupted"
+    def _request_stop(self) -> None:
+        self.stop.request()
 
     def run(self) -> Path:
         core, state = self._start()
         started = time.perf_counter()
-        handler = None
-        if threading.current_thread() is threading.main_thread():
-            handler = signal.signal(signal.SIGINT, self._request_stop)
-        try:
+        self.stop = StopRequest(self.options.wall_limit)
+        with self.stop:
             if state.samples == 0 and not state.timeseries:
                 self._sample(core, state, production=False)
             self._loop(core, state, started)
-        finally:
-            if handler is not None:
-                signal.signal(signal.SIGINT, handler)
         state.wall_seconds += time.perf_counter() - started
         return self._write(core, state)
 
     def _loop(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
-        limit = self.options.wall_limit
         bar = tqdm(total=self.n_total * self.dt, initial=state.samples * self.dt, unit="τ",
                    disable=not self.options.progress,
                    bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} τ [{elapsed}<{remaining}]",
@@ -211,15 +200,13 @@ class _Run:
                 core.advance_to(state.samples * self.dt)
                 self._sample(core, state, production=state.samples > self.n_eq)
                 bar.update(self.dt)
-                if limit is not None and time.perf_counter() - started > limit:
-                    self.stop_reason = self.stop_reason or "wall-clock limit"
                 checkpoint = self.n_ckpt and state.samples % self.n_ckpt == 0
-                stop = self.stop_reason is not None
+                stop = self.stop.check()
                 if (stop or checkpoint) and state.samples < self.n_total:
                     self._checkpoint(core, state, started)
                 if stop and state.samples < self.n_total:
                     raise EngineError(
-                        f"stopped ({self.stop_reason}) at t = {core.time:.6g} after a "
+                        f"stopped ({self.stop.reason}) at t = {core.time:.6g} after a "
                         "checkpoint: run the same command again with --resume to continue")
 
     def _write(self, core: EventDriven, state: EdmdRunState) -> Path:
@@ -227,27 +214,13 @@ class _Run:
         scene = self.scene
         timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
         frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
-        production = timeseries["time"] > self.n_eq * self.dt + 0.5 * self.dt
-        trend = energy_trend(timeseries["time"][production],
-                             timeseries["kinetic_energy"][production])
         notes = [f"TC model (Luding & McNamara): a collision within t_c = {self.tc:g} of "
                  "either partner's previous collision is elastic (e = 1, no tangential "
                  f"impulse); {core.elastic_tc_collisions} such collisions"]
-        attrs = {
-            "engine": "edmd",
-            "engine_version": ENGINE_VERSION,
-            "scene_toml": scene_to_toml(scene),
-            "scene_name": scene.meta.name,
-            "seed": scene.run.seed,
-            "wall_seconds": state.wall_seconds,
-            "equilibration_end": self.n_eq * self.dt,
-            "kinetic_energy_trend": trend,
-            "steady": is_steady(trend),
-            "tc": self.tc,
-            "events": core.events,
-            "cell_crossings": core.cell_crossings,
-            "approximations": "\n".join(notes),
-        }
+        attrs = run_attrs(scene, "edmd", ENGINE_VERSION, state.wall_seconds,
+                          self.n_eq * self.dt, timeseries)
+        attrs.update(tc=self.tc, events=core.events, cell_crossings=core.cell_crossings,
+                     approximations="\n".join(notes))
         path = write_results(self.out, Results(attrs, timeseries, analysis.results,
                                                analysis.attrs, frames))
         (self.workdir / CHECKPOINT).unlink(missing_ok=True)

@@ -13,9 +13,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import pickle
-import signal
 import sys
-import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,7 +22,6 @@ import numpy as np
 from tqdm import tqdm
 
 from ...analysis.profiles import ProfileAnalysis
-from ...analysis.steady import energy_trend, is_steady
 from ...analysis.suite import profile_analysis
 from ...decks import Deck
 from ...decks.output import WALL_FORCES, sample_steps, steps
@@ -35,6 +32,7 @@ from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
 from ..base import EngineError, RunOptions
+from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
 from .session import LammpsSession, quoted
 
 CHECKPOINT_RESTART = "checkpoint.restart"
@@ -88,7 +86,6 @@ class Driver:
         self.keep_frames = scene.measure.keep_frames if keep is None else keep
         self.dump = Path(options.dump).resolve() if options.dump else None
         self.sources = wall_force_sources(scene)
-        self.stop_reason: str | None = None
 
     # -- set-up -------------------------------------------------------------------------
     def _issue_deck(self, session: LammpsSession, resume: bool) -> None:
@@ -188,11 +185,7 @@ class Driver:
             state.profiles = profile_analysis(self.scene, (lower.y, upper.y))
         state.profiles.feed(frame)
         if self.keep_frames:
-            for key in ("position", "velocity", "angular_velocity", "radius", "box_lo",
-                        "box_hi"):
-                state.frames.setdefault(key, []).append(np.array(getattr(frame, key)))
-            state.frames.setdefault("time", []).append(t)
-            state.frames.setdefault("tilt", []).append(frame.tilt)
+            keep_frame(state.frames, frame)
 
     def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
         restart = self.workdir / CHECKPOINT_RESTART
@@ -204,40 +197,26 @@ class Driver:
             state.dump_size = self.dump.stat().st_size
         snapshot = dataclasses.replace(
             state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
-        tmp = self.workdir / (CHECKPOINT_STATE + ".new")
-        with open(tmp, "wb") as fh:
-            pickle.dump({"scene": scene_to_toml(self.scene), "run": snapshot}, fh)
-        os.replace(tmp, self.workdir / CHECKPOINT_STATE)
+        pickle_atomically(self.workdir / CHECKPOINT_STATE,
+                          {"scene": scene_to_toml(self.scene), "run": snapshot})
 
     # -- main loop ----------------------------------------------------------------------
-    def _request_stop(self, _signum=None, _frame=None) -> None:
-        self.stop_reason = "interrupted"
+    def _request_stop(self) -> None:
+        self.stop.request()
 
     def run(self) -> Path:
         state = self._load_state()
         session = LammpsSession(self.workdir)
         started = time.perf_counter()
-        handler = None
-        if threading.current_thread() is threading.main_thread():
-            handler = signal.signal(signal.SIGINT, self._request_stop)
+        self.stop = StopRequest(self.options.wall_limit)
         try:
-            self._issue_deck(session, resume=self.options.resume)
-            if self.options.resume:
-                self._reanchor(session, state)  # variables are not in restart files
-                if self.dump is not None and session.rank == 0 and self.dump.exists():
-                    os.truncate(self.dump, state.dump_size)  # drop frames after the checkpoint
-            elif self.dump is not None and session.rank == 0:
-                self.dump.unlink(missing_ok=True)
-            session.command("run 0 post no")
-            if state.step == 0:
-                self._sample(session, state, production=False)  # the initial state
-            self._loop(session, state, started)
+            with self.stop:
+                self._start(session, state)
+                self._loop(session, state, started)
         except KeyboardInterrupt:  # no handler (not the main thread): keep the last checkpoint
             raise EngineError("interrupted: run again with --resume to continue from the last "
                               "checkpoint (if any)") from None
         finally:
-            if handler is not None:
-                signal.signal(signal.SIGINT, handler)
             version = session.lmp.version()
             session.close()
         if session.rank != 0:
@@ -245,9 +224,20 @@ class Driver:
         state.wall_seconds += time.perf_counter() - started
         return self._write(state, version)
 
+    def _start(self, session: LammpsSession, state: RunState) -> None:
+        self._issue_deck(session, resume=self.options.resume)
+        if self.options.resume:
+            self._reanchor(session, state)  # variables are not in restart files
+            if self.dump is not None and session.rank == 0 and self.dump.exists():
+                os.truncate(self.dump, state.dump_size)  # drop frames after the checkpoint
+        elif self.dump is not None and session.rank == 0:
+            self.dump.unlink(missing_ok=True)
+        session.command("run 0 post no")
+        if state.step == 0:
+            self._sample(session, state, production=False)  # the initial state
+
     def _loop(self, session: LammpsSession, state: RunState, started: float) -> None:
         servo = state.servo
-        limit = self.options.wall_limit
         # counted in steps (exact), shown in time units; sparse updates when not on a terminal
         bar = tqdm(total=self.n_total, initial=state.step, unit_scale=self.dt, unit="τ",
                    disable=not self.options.progress or session.rank != 0,
@@ -273,41 +263,25 @@ class Driver:
                     initialise = True  # new wall motion: re-anchor, LAMMPS sets up again
                 self._sample(session, state, production=state.step > self.n_eq)
                 bar.update(self.n_sample)
-                if limit is not None and time.perf_counter() - started > limit:
-                    self.stop_reason = self.stop_reason or "wall-clock limit"
-                stop = session.any_rank(self.stop_reason is not None)
+                stop = session.any_rank(self.stop.check())
                 checkpoint = self.n_ckpt and state.step % self.n_ckpt == 0
                 if (stop or checkpoint) and state.step < self.n_total:
                     self._checkpoint(session, state, started)
                     initialise = True  # write_restart re-initialised LAMMPS
                 if stop and state.step < self.n_total:
                     raise EngineError(
-                        f"stopped ({self.stop_reason or 'on another rank'}) at t = "
+                        f"stopped ({self.stop.reason or 'on another rank'}) at t = "
                         f"{state.step * self.dt:.6g} after a checkpoint: run the same command "
                         "again with --resume to continue")
 
     def _write(self, state: RunState, version: int) -> Path:
         analysis = state.profiles.finish()
-        scene = self.scene
         timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
         frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
-        production = timeseries["time"] > self.n_eq * self.dt + 0.5 * self.dt
-        trend = energy_trend(timeseries["time"][production],
-                             timeseries["kinetic_energy"][production])
-        attrs = {
-            "engine": "lammps",
-            "engine_version": f"LAMMPS {version}",
-            "scene_toml": scene_to_toml(scene),
-            "scene_name": scene.meta.name,
-            "seed": scene.run.seed,
-            "wall_seconds": state.wall_seconds,
-            "timestep": self.dt,
-            "equilibration_end": self.n_eq * self.dt,
-            "kinetic_energy_trend": trend,
-            "steady": is_steady(trend),
-            "deck": self.deck.render(scene.meta.name),
-            "approximations": "\n".join(self.deck.notes),
-        }
+        attrs = run_attrs(self.scene, "lammps", f"LAMMPS {version}", state.wall_seconds,
+                          self.n_eq * self.dt, timeseries)
+        attrs.update(timestep=self.dt, deck=self.deck.render(self.scene.meta.name),
+                     approximations="\n".join(self.deck.notes))
         path = write_results(self.out, Results(attrs, timeseries, analysis.results,
                                                analysis.attrs, frames))
         for name in (CHECKPOINT_RESTART, CHECKPOINT_STATE):

@@ -1,0 +1,97 @@
+"""Run any engine in a child process (on MPI ranks when asked), so that a crash in compiled
+code (a segfault, an MPI abort) ends the child and reaches the caller as an ``EngineError``.
+
+``python -m demstudy.engines.child JOB.json`` is the child's entry point: exit 0 when done,
+3 when it stopped after a checkpoint (Ctrl-C or the wall-clock limit), 1 on an engine error.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from .._lammps import mpirun_executable
+from ..scene import Scene, validate_scene
+from .base import EngineError, RunOptions
+
+WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
+STOPPED = 3
+
+
+def in_worker() -> bool:
+    return os.environ.get(WORKER_FLAG) == "1"
+
+
+def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
+    """Run ``engine`` on ``scene`` in a child process (``mpirun -np N`` when np > 1).
+
+    Ctrl-C reaches the child too, which stops at the end of its current segment after a
+    checkpoint; the caller then waits for it rather than killing it."""
+    payload = {
+        "engine": engine,
+        "scene": scene.model_dump(mode="json"),
+        "out": str(Path(options.out).resolve()),
+        "dump": str(Path(options.dump).resolve()) if options.dump else None,
+        "resume": options.resume,
+        "progress": options.progress,
+        "keep_frames": options.keep_frames,
+        "checkpoint_interval": options.checkpoint_interval,
+        "wall_limit": options.wall_limit,
+        "np": options.np,
+        "extra": options.extra,
+    }
+    out = Path(payload["out"])
+    out.parent.mkdir(parents=True, exist_ok=True)
+    job = out.with_name(f".{out.name}.job.json")
+    job.write_text(json.dumps(payload))
+    env = dict(os.environ, **{WORKER_FLAG: "1"})
+    cmd = [sys.executable, "-m", "demstudy.engines.child", str(job)]
+    if options.np > 1:
+        cmd = [mpirun_executable(), "-np", str(options.np), *cmd]
+    proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL)
+    try:
+        returncode = proc.wait()
+    except KeyboardInterrupt:
+        try:
+            returncode = proc.wait(timeout=300)
+        except (subprocess.TimeoutExpired, KeyboardInterrupt):
+            proc.kill()
+            returncode = -9
+    finally:
+        job.unlink(missing_ok=True)
+    if returncode == STOPPED:
+        raise EngineError("the run stopped after writing a checkpoint: run the same command "
+                          "again with --resume to continue")
+    if returncode != 0:
+        how = (f"was killed by signal {-returncode}" if returncode < 0
+               else f"failed (exit {returncode})")
+        raise EngineError(f"the {engine} run on {options.np} rank(s) {how}; see the messages "
+                          f"above (and the engine's log beside {out.name})")
+    return out
+
+
+def worker(job: str) -> int:
+    from .base import get_engine  # noqa: PLC0415 - the engines import this module
+
+    payload = json.loads(Path(job).read_text())
+    scene = validate_scene(payload["scene"], source=job)
+    options = RunOptions(out=Path(payload["out"]), np=payload["np"],
+                         dump=Path(payload["dump"]) if payload["dump"] else None,
+                         resume=payload["resume"], progress=payload["progress"],
+                         keep_frames=payload["keep_frames"],
+                         checkpoint_interval=payload["checkpoint_interval"],
+                         wall_limit=payload["wall_limit"], extra=payload["extra"])
+    try:
+        get_engine(payload["engine"]).run(scene, options)
+    except EngineError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return STOPPED if str(exc).startswith("stopped") else 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(worker(sys.argv[1]))
