@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"kinetic energy per disc in production: mean {ke.mean():.3f}, "
           f"min {ke.min():.3f}, max {ke.max():.3f} (m g d)")
     print(f"H = 2 × mass-mean height = {2 * mean_height:.2f} d; "
-          f"slip velocity u(y≈0.5) = {u[0]:.2f}, max u = {u.max():.2f} (√(g d))")
+          f"slip velocity u(y≈0.5) = {u[0]:.2f}, max u = {np.nanmax(u):.2f} (√(g d))")
     print(f"base: shear/normal force {abs(force[0] / force[1]):.3f} "
           f"(steady flow needs tan α = {np.tan(np.radians(alpha)):.3f}); normal force "
           f"{abs(force[1]):.2f} vs weight·cos α = {n * np.cos(np.radians(alpha)):.2f}")
