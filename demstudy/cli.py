@@ -60,15 +60,20 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     from .analysis.suite import run_statistics
     from .io.dump import has_fast_columns, read_dump, read_dump_fast
     from .io.results import Results, frames_of, read_results, write_results
-    from .scene import parse_scene_text, scene_to_toml, validate_scene
+    from .scene import apply_overrides, parse_scene_text, scene_to_toml, validate_scene
 
     what = [w.strip() for w in args.what.split(",") if w.strip()]
     source = Path(args.source)
     if source.suffix in (".h5", ".hdf5"):
         results = read_results(source)
-        text = results.attrs["scene_toml"]
-        scene = load_scene(args.scene, args.set) if args.scene else validate_scene(
-            parse_scene_text(text, str(source)), str(source))
+        if args.scene:
+            scene = load_scene(args.scene, args.set)
+        else:  # the run's own scene, with any --set applied
+            data = apply_overrides(parse_scene_text(results.attrs["scene_toml"], str(source)),
+                                   args.set, str(source))
+            scene = validate_scene(data, str(source))
+        if scene_to_toml(scene) != results.attrs["scene_toml"]:
+            results.attrs["analysis_scene_toml"] = scene_to_toml(scene)
         out = Path(args.out or source)
 
         def frames():
@@ -180,14 +185,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     from .decks.base import UnsupportedByEngine
-    from .engines.base import EngineError
+    from .engines.base import EngineError, RunRefused, RunStopped
 
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
     except (SceneError, UnsupportedByEngine, EngineError, ValueError, OSError) as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 2 if isinstance(exc, SceneError | UnsupportedByEngine) else 1
+        if isinstance(exc, RunStopped):
+            return 3  # checkpoint written: run again with --resume
+        return 2 if isinstance(exc, SceneError | UnsupportedByEngine | RunRefused) else 1
 
 
 if __name__ == "__main__":

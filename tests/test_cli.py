@@ -136,3 +136,22 @@ def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path):
     assert ke[-1] < ke[0]  # e = 0.9: it cools
     assert main(["run", str(CHUTE), "--engine", "edmd", "--out", str(tmp_path / "c.h5"),
                  "-q"]) == 2
+
+
+def test_stop_refusal_and_failure_have_distinct_exit_codes(tmp_path, capsys):
+    """Batch scripts can tell them apart: 3 = stopped after a checkpoint (resume it),
+    2 = refused before anything ran, 1 = failed; each says so in one line, once."""
+    scene = ROOT / "inputs" / "cooling" / "hcs-3d.toml"
+    out = tmp_path / "hcs.h5"
+    args = ["run", str(scene), "--engine", "edmd", "--out", str(out), "-q", "--keep-frames",
+            "--set", "run.production=2", "--set", "run.sample_interval=0.5"]
+    assert main([*args, "--wall-limit", "0"]) == 3
+    err = capsys.readouterr().err
+    assert err.count("--resume") == 1 and "Traceback" not in err
+    assert main([*args, "--resume"]) == 0
+    from demstudy.io.results import read_results
+
+    assert len(read_results(out).frames["time"]) == 4  # every production sample, once
+    assert main([*args, "--dump", str(tmp_path / "x.dump")]) == 2
+    err = capsys.readouterr().err
+    assert "unsupported by edmd" in err and "Traceback" not in err

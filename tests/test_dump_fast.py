@@ -96,3 +96,19 @@ def test_fast_reader_rejects_foreign_columns(tmp_path):
                     "0 1\n0 1\n0 1\nITEM: ATOMS id type x y z\n1 1 0.5 0.5 0.5\n")
     with pytest.raises(ValueError, match="read_dump"):
         list(read_dump_fast(path, 3))
+
+
+def test_both_readers_agree_on_a_negative_tilt(tmp_path):
+    """After a flip the Lees-Edwards tilt is negative: the header's first bound is then
+    xlo + xy, and MDAnalysis's shift must be undone with the true lower corner."""
+    path = tmp_path / "tilted.dump"
+    path.write_text(
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\n"
+        "ITEM: BOX BOUNDS xy xz yz pp pp pp\n-3.0 10.0 -3.0\n0.0 10.0 0.0\n0.0 10.0 0.0\n"
+        "ITEM: ATOMS id type radius x y z vx vy vz omegax omegay omegaz\n"
+        "1 1 0.5 1.0 2.0 3.0 0 0 0 0 0 0\n2 1 0.5 4.0 5.0 6.0 0 0 0 0 0 0\n")
+    (slow,), (fast,) = list(read_dump(path, 3)), list(read_dump_fast(path, 3))
+    np.testing.assert_allclose(fast.position[:, 0], [1.0, 4.0])
+    np.testing.assert_allclose(slow.position, fast.position, atol=1e-6)
+    assert slow.tilt == fast.tilt == -3.0
+    np.testing.assert_array_equal(slow.box_lo, [0.0, 0.0, 0.0])

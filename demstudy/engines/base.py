@@ -16,6 +16,14 @@ class EngineError(RuntimeError):
     """An engine failed; the message says what the engine reported and where."""
 
 
+class RunStopped(EngineError):
+    """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint."""
+
+
+class RunRefused(EngineError):
+    """The engine refused the scene or the options (reported by an engine's child process)."""
+
+
 @dataclass
 class RunOptions:
     out: Path

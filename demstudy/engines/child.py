@@ -16,10 +16,10 @@ from pathlib import Path
 
 from .._lammps import mpirun_executable
 from ..scene import Scene, validate_scene
-from .base import EngineError, RunOptions
+from .base import EngineError, RunOptions, RunRefused, RunStopped
 
 WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
-STOPPED = 3
+FAILED, REFUSED, STOPPED = 1, 2, 3  # the child's exit codes
 
 
 def in_worker() -> bool:
@@ -64,13 +64,16 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     finally:
         job.unlink(missing_ok=True)
     if returncode == STOPPED:
-        raise EngineError("the run stopped after writing a checkpoint: run the same command "
-                          "again with --resume to continue")
+        raise RunStopped("the run stopped after writing a checkpoint: run the same command "
+                         "again with --resume to continue")
+    if returncode == REFUSED:
+        raise RunRefused(f"the {engine} engine refused the run (see the message above)")
     if returncode != 0:
         how = (f"was killed by signal {-returncode}" if returncode < 0
                else f"failed (exit {returncode})")
+        log = f" and {out.with_suffix('.lammps') / 'log.lammps'}" if engine == "lammps" else ""
         raise EngineError(f"the {engine} run on {options.np} rank(s) {how}; see the messages "
-                          f"above (and the engine's log beside {out.name})")
+                          f"above{log}")
     return out
 
 
@@ -85,11 +88,18 @@ def worker(job: str) -> int:
                          keep_frames=payload["keep_frames"],
                          checkpoint_interval=payload["checkpoint_interval"],
                          wall_limit=payload["wall_limit"], extra=payload["extra"])
+    from ..decks.base import UnsupportedByEngine  # noqa: PLC0415
+
     try:
         get_engine(payload["engine"]).run(scene, options)
-    except EngineError as exc:
+    except RunStopped:
+        return STOPPED  # the parent says so, once
+    except (UnsupportedByEngine, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return STOPPED if str(exc).startswith("stopped") else 1
+        return REFUSED
+    except Exception as exc:  # one line, never a bare traceback
+        print(f"error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return FAILED
     return 0
 
 

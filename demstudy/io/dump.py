@@ -20,16 +20,11 @@ from .frames import Frame
 _BOUNDS = re.compile(rb"ITEM: BOX BOUNDS([^\n]*)\n([^\n]*)\n([^\n]*)\n([^\n]*)\n")
 
 
-def box_headers(path: str | Path) -> list[tuple[np.ndarray, np.ndarray, float]]:
-    """Per frame: the header's lower bounds as written (MDAnalysis subtracts these), the box
-    (3, 2) and the xy tilt (see ``_box_from_header``)."""
-    headers = []
-    for m in _BOUNDS.finditer(Path(path).read_bytes()):
-        lines = list(m.groups()[1:])
-        box, tilt = _box_from_header(m.group(1).split(), lines)
-        written_lo = np.array([float(line.split()[0]) for line in lines])
-        headers.append((written_lo, box, tilt))
-    return headers
+def box_headers(path: str | Path) -> list[tuple[np.ndarray, float]]:
+    """Per frame: the box (3, 2: lo, hi per axis; MDAnalysis subtracts its lower corner from
+    the coordinates) and the xy tilt (see ``_box_from_header``)."""
+    return [_box_from_header(m.group(1).split(), list(m.groups()[1:]))
+            for m in _BOUNDS.finditer(Path(path).read_bytes())]
 
 
 def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
@@ -56,8 +51,8 @@ def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             ts = universe.trajectory[index]
-        written_lo, box, tilt = headers[index]
-        pos = ts.positions.astype(float)[mobile] + written_lo
+        box, tilt = headers[index]
+        pos = ts.positions.astype(float)[mobile] + box[:, 0]
         omega = np.column_stack([ts.data[c] for c in extra[1:]]).astype(float)[mobile]
         yield Frame(
             time=time, box_lo=box[:dim, 0].copy(), box_hi=box[:dim, 1].copy(),

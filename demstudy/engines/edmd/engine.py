@@ -32,7 +32,7 @@ from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
 from ...scene.initial import build_initial_state
-from ..base import EngineError, RunOptions
+from ..base import EngineError, RunOptions, RunStopped
 from ..child import in_worker, launch_child
 from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
 from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters
@@ -77,6 +77,7 @@ class EdmdRunState:
     profiles: ProfileAnalysis | None = None
     wall_seconds: float = 0.0
     last_virial: float = 0.0
+    keep_frames: bool = False  # fixed when the run starts, kept on resume
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
@@ -95,12 +96,12 @@ class EdmdEngine:
         params = check_supported(scene)
         if options.np > 1:
             raise UnsupportedByEngine("edmd", "--np", options.np, "the engine is serial")
-        if options.isolate and not in_worker():
-            return launch_child(self.name, scene, options)  # a crash in C++ stays there
         if options.dump is not None:
             raise UnsupportedByEngine("edmd", "--dump", str(options.dump),
                                       "the LAMMPS dump is not written by this engine; use "
                                       "--keep-frames")
+        if options.isolate and not in_worker():
+            return launch_child(self.name, scene, options)  # a crash in C++ stays there
         tc = float(options.extra.get("tc", DEFAULT_TC))
         return _Run(scene, options, params, tc).run()
 
@@ -127,7 +128,8 @@ class _Run:
         self.mass = initial.mass
         core = from_initial_state(initial, self.scene.box.size, tc=self.tc, **self.params)
         if not self.options.resume:
-            return core, EdmdRunState(profiles=profile_analysis(self.scene))
+            return core, EdmdRunState(profiles=profile_analysis(self.scene),
+                                      keep_frames=self.keep_frames)
         path = self.workdir / CHECKPOINT
         if not path.exists():
             raise EngineError(f"--resume: no checkpoint in {self.workdir}")
@@ -136,6 +138,7 @@ class _Run:
         if saved["scene"] != scene_to_toml(self.scene) or saved["tc"] != self.tc:
             raise EngineError("--resume: the checkpoint belongs to a different scene")
         core.set_state(saved["core"])
+        self.keep_frames = saved["run"].keep_frames  # frames for the whole run or not at all
         return core, saved["run"]
 
     def _checkpoint(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
@@ -205,7 +208,7 @@ class _Run:
                 if (stop or checkpoint) and state.samples < self.n_total:
                     self._checkpoint(core, state, started)
                 if stop and state.samples < self.n_total:
-                    raise EngineError(
+                    raise RunStopped(
                         f"stopped ({self.stop.reason}) at t = {core.time:.6g} after a "
                         "checkpoint: run the same command again with --resume to continue")
 

@@ -31,7 +31,7 @@ from ...decks.walls import wall_force_sources
 from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
-from ..base import EngineError, RunOptions
+from ..base import EngineError, RunOptions, RunStopped
 from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
 from .session import LammpsSession, quoted
 
@@ -50,6 +50,7 @@ class RunState:
     wall_seconds: float = 0.0
     servo: ServoController | None = None
     dump_size: int = 0
+    keep_frames: bool = False  # fixed when the run starts, kept on resume
     # wall forces (on the particles) summed over segments since the last sample / servo update
     force_sums: dict[str, np.ndarray] = field(default_factory=dict)
     force_counts: dict[str, int] = field(default_factory=dict)
@@ -109,11 +110,14 @@ class Driver:
                 saved = pickle.load(fh)
             if saved["scene"] != scene_to_toml(self.scene):
                 raise EngineError("--resume: the checkpoint belongs to a different scene")
-            return saved["run"]
+            state = saved["run"]
+            self.keep_frames = state.keep_frames  # frames are stored for the whole run or not
+            return state
         if has_servo(self.scene):
             # bins are laid between the walls where they stand when production starts
-            return RunState(servo=ServoController(self.scene, self.dt))
-        return RunState(profiles=profile_analysis(self.scene))
+            return RunState(servo=ServoController(self.scene, self.dt),
+                            keep_frames=self.keep_frames)
+        return RunState(profiles=profile_analysis(self.scene), keep_frames=self.keep_frames)
 
     def _reanchor(self, session: LammpsSession, state: RunState) -> None:
         """Re-issue the time-anchored variables before LAMMPS initialises again.
@@ -269,7 +273,7 @@ class Driver:
                     self._checkpoint(session, state, started)
                     initialise = True  # write_restart re-initialised LAMMPS
                 if stop and state.step < self.n_total:
-                    raise EngineError(
+                    raise RunStopped(
                         f"stopped ({self.stop.reason or 'on another rank'}) at t = "
                         f"{state.step * self.dt:.6g} after a checkpoint: run the same command "
                         "again with --resume to continue")
