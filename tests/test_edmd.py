@@ -36,6 +36,7 @@ from demstudy.engines.edmd import (
 from demstudy.io.results import read_results
 from demstudy.scene import parse_scene_text, validate_scene
 from demstudy.scene.initial import build_initial_state
+from demstudy.theory import kinetic as theory
 
 
 def make_scene(dim: int, phi: float, n: int, seed: int = 1, e: float = 1.0,
@@ -294,25 +295,19 @@ def collisions_per_time(s, dim, phi, n):
 
 
 def fraction_density(dim, phi):
-    return phi / (math.pi / 6 if dim == 3 else math.pi / 4)
-
-
-def contact_value(dim, phi):
-    return (1 - phi / 2) / (1 - phi) ** 3 if dim == 3 else (1 - 7 * phi / 16) / (1 - phi) ** 2
+    return float(theory.number_density(phi, dim))
 
 
 def enskog_frequency(dim, phi, density, temperature):
-    g0 = contact_value(dim, phi)
-    if dim == 3:
-        return 4 * density * g0 * math.sqrt(math.pi * temperature)
-    return 2 * density * g0 * math.sqrt(math.pi * temperature)
+    """Enskog collisions per particle and time at number density ``density`` (the contact
+    value from φ: Carnahan–Starling / Henderson)."""
+    return float(theory.collision_frequency(phi, temperature, dim)) * density / fraction_density(
+        dim, phi)
 
 
 def equation_of_state(dim, phi):
-    """Carnahan–Starling (3D), Henderson (2D)."""
-    if dim == 3:
-        return (1 + phi + phi**2 - phi**3) / (1 - phi) ** 3
-    return (1 + phi**2 / 8) / (1 - phi) ** 2
+    """Carnahan–Starling (3D), Henderson (2D): Z = 1 + 2^(dim−1) φ g0."""
+    return float(theory.compressibility(phi, dim))
 
 
 def accurate_equation_of_state(dim, phi):

@@ -15,20 +15,12 @@ from demstudy.engines.base import RunOptions
 from demstudy.engines.lammps import LammpsEngine
 from demstudy.io.results import read_results
 from demstudy.scene import validate_scene
+from demstudy.theory import haff_t0
 
 
 def run(scene, tmp_path: Path, **options):
     return read_results(LammpsEngine().run(scene, RunOptions(out=tmp_path / "r.h5",
                                                             progress=False, **options)))
-
-
-def haff_time(phi: float, e: float, temperature: float) -> float:
-    """t0 of Haff's law T = T0/(1 + t/t0)² for smooth spheres (Enskog, Carnahan–Starling):
-    dT/dt = −(1 − e²) ω T / 3 with the collision frequency ω = 4 n d² g0 √(π T / m)."""
-    n = phi / (math.pi / 6)
-    g0 = (1 - phi / 2) / (1 - phi) ** 3
-    omega0 = 4 * n * g0 * math.sqrt(math.pi * temperature)
-    return 6.0 / ((1 - e * e) * omega0)
 
 
 def test_homogeneous_cooling_follows_haff(tmp_path):
@@ -47,7 +39,7 @@ def test_homogeneous_cooling_follows_haff(tmp_path):
     res = run(scene, tmp_path)
     t = res.timeseries["time"]
     temperature = res.timeseries["kinetic_energy"] / (1.5 * n)
-    t0 = haff_time(phi, e, temperature[0])
+    t0 = haff_t0(phi, temperature[0], 3, e)  # Enskog, Carnahan–Starling g0
     ratio = temperature / (temperature[0] / (1 + t / t0) ** 2)
     assert temperature[-1] < temperature[0] / 6  # it really cooled
     assert np.all(np.abs(ratio[t < 5] - 1) < 0.03), ratio[t < 5]

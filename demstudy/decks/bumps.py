@@ -27,7 +27,12 @@ class BumpRow:
 
     @property
     def group(self) -> str:
-        return f"bumps_{self.side}"
+        return bump_group(self.side)
+
+
+def bump_group(side: str) -> str:
+    """LAMMPS group (and ID prefix) of one wall's bumps."""
+    return f"bumps_{side}"
 
 
 def bumpy_walls(scene: Scene) -> list[Wall]:

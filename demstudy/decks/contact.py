@@ -46,12 +46,11 @@ class ContactSetup:
 
 
 def _rule(rule) -> dict:
-    if rule.model == "smooth":
-        return {}
-    if rule.model in ("beta", "rough"):
-        return {"beta": rule.beta}
+    """make_contact's arguments for a tangential rule (smooth, beta and rough all carry β)."""
     if rule.model == "coulomb":
         return {"mu": rule.mu, "beta0": rule.beta0}
+    if rule.model != "campbell-noslip":
+        return {"beta": rule.beta}
     raise UnsupportedByEngine(
         "lammps", "walls.tangential.model", rule.model,
         "Campbell's no-slip wall (centre takes the wall velocity, spin unchanged) has no "

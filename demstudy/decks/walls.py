@@ -10,7 +10,7 @@ from __future__ import annotations
 from ..scene import Scene
 from ..scene.schema import Wall
 from .base import Block, fmt
-from .bumps import bump_type
+from .bumps import bump_group, bump_type
 from .contact import ContactSetup
 
 
@@ -26,7 +26,7 @@ def wall_force_sources(scene: Scene) -> list[tuple[str, str, float]]:
     for wall in scene.walls:
         sources.append((wall.side, f"{wall_fix_id(wall.side)}_force", 1.0))
         if wall.kind == "bumpy":
-            sources.append((wall.side, f"bumps_{wall.side}_force", -1.0))
+            sources.append((wall.side, f"{bump_group(wall.side)}_force", -1.0))
     return sources
 
 
@@ -47,7 +47,7 @@ def wall_block(scene: Scene, wall: Wall, setup: ContactSetup) -> Block:
     if wall.kind == "bumpy":
         kind = bump_type(scene, wall.side)
         comment += f"; bumps: heavy particles of type {kind} moving with the wall"
-        group = f"bumps_{wall.side}"
+        group = bump_group(wall.side)
         cmds += [
             f"fix {group}_move {group} move linear {fmt(wall.velocity)} 0.0 0.0",
             # the particles' force on the bumps (pair forces only: bumps feel no gravity)

@@ -63,6 +63,10 @@ class Smooth(StrictModel):
 
     model: Literal["smooth"]
 
+    @property
+    def beta(self) -> float:
+        return -1.0
+
 
 class ConstantBeta(StrictModel):
     """Constant tangential restitution β of Lun / Malik (β = 0: Campbell's fully rough rule)."""

@@ -59,15 +59,12 @@ def scene_parameters(scene: Scene) -> dict:
         raise UnsupportedByEngine("edmd", "contact.law.model", contact.law.model,
                                   "only a constant normal restitution is implemented")
     rule = contact.tangential
-    if rule.model == "smooth":
-        beta = -1.0
-    elif rule.model in ("beta", "rough"):
-        beta = float(rule.beta)
-    else:
+    if rule.model == "coulomb":
         raise UnsupportedByEngine("edmd", "contact.tangential.model", rule.model,
                                   "Coulomb friction (Walton) is not implemented yet; use "
                                   "smooth, beta or rough")
-    return {"e": float(contact.restitution), "beta": beta, "inertia_k": float(scene.inertia_k)}
+    return {"e": float(contact.restitution), "beta": float(rule.beta),
+            "inertia_k": float(scene.inertia_k)}
 
 
 def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -1.0,

@@ -87,6 +87,7 @@ class Driver:
         self.keep_frames = scene.measure.keep_frames if keep is None else keep
         self.dump = Path(options.dump).resolve() if options.dump else None
         self.sources = wall_force_sources(scene)
+        self._mobile: np.ndarray | None = None
 
     # -- set-up -------------------------------------------------------------------------
     def _issue_deck(self, session: LammpsSession, resume: bool) -> None:
@@ -135,7 +136,9 @@ class Driver:
     # -- sampling -----------------------------------------------------------------------
     def _frame(self, session: LammpsSession, t: float) -> Frame:
         dim = self.scene.dimension
-        mobile = session.gather("type", 1, integer=True) == 1
+        if self._mobile is None:  # atom types never change: gather them once
+            self._mobile = session.gather("type", 1, integer=True) == 1
+        mobile = self._mobile
         x = session.gather("x", 3)[mobile, :dim]
         v = session.gather("v", 3)[mobile, :dim]
         omega = session.gather("omega", 3)[mobile]
