@@ -96,7 +96,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         def frames():
             return reader(source, scene.dimension, dt=dt, start_time=args.start)
 
-    for name, (data, attrs) in run_statistics(scene, frames, what).items():
+    for name, (data, attrs) in run_statistics(scene, frames, what, results).items():
         if name == "profiles":
             results.profiles, results.profile_attrs = data, attrs
         else:
@@ -161,7 +161,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("source", help="RUN.h5 (run with --keep-frames) or a LAMMPS dump")
     p.add_argument("--scene", help="the scene (needed for dumps; default for RUN.h5: its own)")
     p.add_argument("--what", default="profiles",
-                   help="comma-separated: profiles, vdf, gr (default: profiles)")
+                   help="comma-separated: profiles, vdf, gr, angles, stress, vcorr, lambda, "
+                        "waves, cgprofiles (default: profiles)")
     p.add_argument("--dt", type=float, help="dump time step (default: the scene's LAMMPS one)")
     p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")
     p.add_argument("--out", help="results file (default: RUN.h5 itself, or DUMP.h5)")

@@ -13,12 +13,18 @@ from typing import Any
 
 from ..io.frames import Frame
 from ..scene import Scene
+from .coarse_graining import CoarseGrainedProfiles
+from .collisions import CollisionAngles, collision_chunks
 from .pair_correlation import PairCorrelation
 from .profiles import ProfileAnalysis
+from .stress import stress_results
 from .vdf import velocity_distributions
+from .velocity_correlation import orientational_correlation, velocity_correlations
+from .waves import DensityWaves
 
 #: Statistics ``demstudy analyze --what`` can compute from frames.
-AVAILABLE = ("profiles", "vdf", "gr")
+AVAILABLE = ("profiles", "vdf", "gr", "angles", "stress", "vcorr", "lambda", "waves",
+             "cgprofiles")
 
 
 def profile_bounds(scene: Scene) -> tuple[float, float, float]:
@@ -49,9 +55,11 @@ def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None) -> 
 
 
 def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
-                   what: Iterable[str]) -> dict[str, tuple[dict, dict]]:
+                   what: Iterable[str], results: Any = None) -> dict[str, tuple[dict, dict]]:
     """``{name: (results, attrs)}`` for each requested statistic; ``frames`` returns a fresh
-    iterable each call (the velocity distributions read the frames twice)."""
+    iterable each call (the velocity distributions read the frames twice). ``results``: the
+    source results file's content (:class:`~demstudy.io.results.Results`), needed by
+    ``angles`` (its ``/collisions`` log) and ``stress`` (its profiles and wall forces)."""
     out: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
     lo, hi, period = profile_bounds(scene)
     for name in what:
@@ -70,8 +78,92 @@ def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
             r_max = min(5.0, 0.5 * min(periodic) - 0.05) if periodic else 5.0
             ana = PairCorrelation(dim=scene.dimension, r_max=r_max, dr=0.05,
                                   periodic_y=scene.y_periodic).run(frames()).finish()
+        elif name == "angles":
+            ana = collision_angle_analysis(scene, results)
+        elif name == "stress":
+            data, attrs = stress_from_results(scene, results)
+            out[name] = (data, attrs)
+            continue
+        elif name in ("vcorr", "lambda", "waves", "cgprofiles"):
+            ana = correlation_analysis(scene, frames, name)
         else:
             raise ValueError(f"--what {name!r}: unknown statistic (allowed: "
                              f"{', '.join(AVAILABLE)})")
         out[name] = (ana.results, ana.attrs)
     return out
+
+
+def _need_results(results: Any, name: str) -> Any:
+    if results is None:
+        raise ValueError(f"--what {name}: needs a results file (RUN.h5), not a dump")
+    return results
+
+
+def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> CollisionAngles:
+    """P(theta) per profile bin from the ``/collisions`` log of a results file (production
+    only), with the Savage–Jeffrey overlay when the file's profiles use the same bins."""
+    res = _need_results(results, "angles")
+    log = res.groups.get("collisions")
+    if not log:
+        raise ValueError("--what angles: the results file has no /collisions log "
+                         "(event-driven runs write it)")
+    lo, hi, _period = profile_bounds(scene)
+    edges = res.profiles.get("edges")
+    if edges is None:
+        n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
+        edges = [lo + (hi - lo) * i / n_bins for i in range(n_bins + 1)]
+    start = float(res.attrs.get("equilibration_end", 0.0))
+    ana = CollisionAngles(edges, dim=scene.dimension)
+    ana.run(collision_chunks(log, n_chunks, start))
+    if res.profiles and scene.measure.axis == "y":
+        ana.overlay(res.profiles)
+    return ana
+
+
+def stress_from_results(scene: Scene, results: Any) -> tuple[dict, dict]:
+    """The ``/stress`` datasets from a results file: kinetic (its profiles), wall stresses
+    and momentum balance (its time series), plus the contact / collisional tensors the
+    engine stored in ``/stress`` (carried over)."""
+    res = _need_results(results, "stress")
+    if not res.profiles:
+        raise ValueError("--what stress: the results file has no /profiles")
+    stored = res.groups.get("stress", {})
+    parts = {k: (stored[k], stored[f"{k}_err"]) for k in ("contact", "collisional")
+             if k in stored and f"{k}_err" in stored}
+    return stress_results(scene, res.profiles, res.timeseries,
+                          float(res.attrs.get("equilibration_end", 0.0)),
+                          contact=parts.get("contact"), collisional=parts.get("collisional"))
+
+
+def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], name: str) -> Any:
+    """vcorr / lambda (two passes: run-mean bin velocities first) and waves in bins of
+    ``measure.bin_width`` along y; cgprofiles along ``measure.axis`` with w = bin_width / 2
+    at points spaced bin_width / 2."""
+    lo, hi, period = profile_bounds(scene)
+    dim, shift = scene.dimension, image_shift(scene, period)
+    n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
+    if name == "cgprofiles":  # along measure.axis, like the profiles
+        return CoarseGrainedProfiles(width=0.5 * scene.measure.bin_width,
+                                     axis=scene.measure.axis, lo=lo, hi=hi, dim=dim,
+                                     period=period, image_velocity_shift=shift,
+                                     n_points=2 * n_bins).run(frames()).finish()
+    if scene.measure.axis != "y":  # the other statistics bin along y
+        lo, hi = 0.0, scene.box.size[1]
+        n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
+    y_period = scene.box.size[1] if scene.y_periodic else 0.0
+    edges = [lo + (hi - lo) * i / n_bins for i in range(n_bins + 1)]
+    y_bins = {"dim": dim, "edges": edges, "period": y_period,
+              "image_velocity_shift": scene.shear.rate * y_period if scene.shear else 0.0}
+    if name == "vcorr":
+        periodic = [scene.box.size[i] for i, a in enumerate("xyz"[:dim]) if a in scene.periodic]
+        r_max = min(5.0, 0.5 * min(periodic) - 0.05) if periodic else 5.0
+        return velocity_correlations(frames, r_max=r_max, dr=0.1, **y_bins)
+    if name == "lambda":
+        return orientational_correlation(frames, **y_bins)
+    if name == "waves":
+        ranges: list[tuple[float, float] | None] = [None] * dim
+        if not scene.y_periodic:  # where the centres can be: walls -/+ d/2
+            ranges[1] = (lo + 0.5, hi - 0.5)
+        return DensityWaves(dim=dim, ranges=ranges, periodic_y=scene.y_periodic
+                            ).run(frames()).finish()
+    raise ValueError(f"unknown statistic {name!r}")

@@ -10,6 +10,10 @@ from .contact import ContactSetup
 from .walls import wall_force_sources
 
 WALL_FORCES = "wall_forces"
+#: local computes read by the driver for the contact stress (measure.statistics "stress"):
+#: normal force on i (fx fy fz), tangential force on i (p1-p3), x_i - x_j (p10-p12)
+STRESS_PAIRS, STRESS_IDS = "stress_pairs", "stress_ids"
+STRESS_COLUMNS = 9
 
 
 def sample_steps(scene: Scene, dt: float) -> int:
@@ -31,6 +35,12 @@ def sampling_block(scene: Scene, setup: ContactSetup) -> Block:
         forces = " ".join(f"c_{compute}[*]" for _side, compute, _sign in sources)
         cmds.append(f"fix {WALL_FORCES} all ave/time 1 {n} {n} {forces}")
         columns += [f"f_{WALL_FORCES}[{i}]" for i in range(1, 3 * len(sources) + 1)]
+    if "stress" in scene.measure.statistics:
+        # contact forces and atom IDs of every touching pair, evaluated only when the
+        # driver reads them (same neighbour loop and cutoff: the rows correspond)
+        cmds.append(f"compute {STRESS_PAIRS} all pair/local fx fy fz p1 p2 p3 p10 p11 p12 "
+                    "cutoff radius")
+        cmds.append(f"compute {STRESS_IDS} all property/local patom1 patom2 cutoff radius")
     if scene.shear is not None:
         columns.append("xy")  # the Lees–Edwards tilt
     cmds.append("thermo_style custom " + " ".join(columns))

@@ -84,9 +84,10 @@ class ServoController:
     LAMMPS initialisation (``run … pre yes``), which also re-reads the box for fix deform.
     """
 
-    def __init__(self, scene: Scene, dt: float):
+    def __init__(self, scene: Scene, dt: float | None):
         self.scene = scene
-        self.n_steps = servo_interval_steps(scene, dt)
+        # time-stepped engines update every n_steps; event-driven ones count collisions
+        self.n_steps = servo_interval_steps(scene, dt) if dt is not None else 0
         self.walls = {
             w.side: WallMotion(w.side, scene.wall_position(w.side), 0.0, 0.0, w.velocity)
             for w in scene.walls

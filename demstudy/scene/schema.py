@@ -326,7 +326,8 @@ class Soft(StrictModel):
 
 
 #: Statistics the engines compute today (issue 4 extends the list).
-Statistic = Literal["profiles"]
+Statistic = Literal["profiles", "angles", "stress", "vcorr", "lambda", "waves",
+                    "cgprofiles"]
 
 
 class Measure(StrictModel):

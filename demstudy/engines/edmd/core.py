@@ -31,6 +31,8 @@ impulse). ``DEFAULT_TC`` = 1e-5 time units (the engine's default; 0 disables the
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..._native import EventDriven, edmd_collide_pair
@@ -41,7 +43,7 @@ from ...scene.initial import InitialState
 DEFAULT_TC = 1e-5
 
 __all__ = ["DEFAULT_TC", "EventDriven", "collide_pair", "from_initial_state",
-           "scene_parameters"]
+           "scene_parameters", "y_range"]
 
 
 def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
@@ -52,27 +54,76 @@ def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
                              float(e), float(beta), vi3, vj3, wi3, wj3)
 
 
-def scene_parameters(scene: Scene) -> dict:
-    """e, β and K of a scene (β = −1 for smooth contacts); refuses laws outside milestone 1."""
-    contact = scene.contact
-    if contact.law.model != "constant":
-        raise UnsupportedByEngine("edmd", "contact.law.model", contact.law.model,
-                                  "only a constant normal restitution is implemented")
-    rule = contact.tangential
+def _rule(restitution: float, rule, law=None, gravity: float | None = None,
+          who: str = "contact") -> dict:
+    """Collision-rule options of the core from a scene's restitution, tangential rule and law."""
+    out: dict = {"e": float(restitution)}
     if rule.model == "coulomb":
-        raise UnsupportedByEngine("edmd", "contact.tangential.model", rule.model,
-                                  "Coulomb friction (Walton) is not implemented yet; use "
-                                  "smooth, beta or rough")
-    return {"e": float(contact.restitution), "beta": float(rule.beta),
-            "inertia_k": float(scene.inertia_k)}
+        out.update(tangential="coulomb", mu=float(rule.mu), beta0=float(rule.beta0))
+    elif rule.model == "campbell-noslip":
+        out.update(tangential="noslip")
+    else:
+        out.update(tangential="beta", beta=float(rule.beta))
+    if law is not None and law.model == "campbell-exp":
+        if gravity is None:
+            raise UnsupportedByEngine("edmd", f"{who}.law.model", law.model,
+                                      "Campbell's e(v) = ½[1 + exp(−3v/√(gR))] needs gravity "
+                                      "(its speed scale is √(gR))")
+        # e(v) = ½[1 + exp(−v/speed)], speed = √(g R)/3 with R = ½
+        out.update(law="campbell-exp", speed=math.sqrt(gravity * 0.5) / 3.0)
+    elif law is not None and law.model == "gutt-piecewise":
+        out.update(law="gutt-piecewise", e1=float(law.e1), e2=float(law.e2),
+                   crossover_speed=float(law.crossover_speed))
+    return out
+
+
+def scene_parameters(scene: Scene) -> dict:
+    """e, β and K of a scene's pair collisions plus every other core option the scene needs
+    (gravity, Lees–Edwards, walls, cell range along a bounded y)."""
+    contact = scene.contact
+    g = scene.gravity.magnitude if scene.gravity is not None else None
+    pair = _rule(contact.restitution, contact.tangential, contact.law, g)
+    params: dict = {"e": pair.pop("e"), "beta": float(pair.get("beta", -1.0)),
+                    "inertia_k": float(scene.inertia_k)}
+    if pair != {"tangential": "beta", "beta": params["beta"]}:
+        params["pair"] = pair
+    if scene.gravity_vector is not None:
+        params["gravity"] = [float(c) for c in scene.gravity_vector]
+    if scene.shear is not None:
+        params["shear_rate"] = float(scene.shear.rate)
+    if not scene.y_periodic:
+        walls = []
+        for wall in scene.walls:
+            if wall.kind == "bumpy":
+                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].kind", wall.kind,
+                                          "bumpy walls are not implemented in the event-driven "
+                                          "engine; use flat walls with a rough rule")
+            rule = _rule(wall.restitution, wall.tangential, who=f"walls[{wall.side}]")
+            walls.append({"side": wall.side, "position": scene.wall_position(wall.side),
+                          "velocity": float(wall.velocity), **rule})
+        params.update(periodic_y=False, walls=walls)
+    return params
+
+
+def y_range(scene: Scene, positions: np.ndarray) -> tuple[float, float]:
+    """Extent of the cell grid along a bounded y: from the lower wall (or the lowest particle)
+    to the upper wall (or the top of the box or the highest particle); the first and last
+    rows are open-ended, so walls that move out and particles that fly off stay covered."""
+    y = positions[:, 1]
+    lo = scene.wall_position("lower") if scene.wall("lower") else float(y.min()) - 1.0
+    hi = scene.wall_position("upper") if scene.wall("upper") else \
+        max(scene.box.size[1], float(y.max()) + 1.0)
+    return lo, hi
 
 
 def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -1.0,
-                       inertia_k: float = 0.4, tc: float = 0.0) -> EventDriven:
-    """An ``EventDriven`` system from ``demstudy.scene.initial.build_initial_state`` output."""
+                       inertia_k: float = 0.4, tc: float = 0.0, **options) -> EventDriven:
+    """An ``EventDriven`` system from ``demstudy.scene.initial.build_initial_state`` output;
+    ``options`` as ``EventDriven`` (gravity, shear_rate, periodic_y, y_range, walls, pair,
+    stress_bins, log_every, log_capacity)."""
     dim = state.position.shape[1]
     c = np.ascontiguousarray
     return EventDriven(c(state.position, float), c(state.velocity, float),
                        c(state.angular_velocity, float), c(state.diameter, float),
                        c(state.mass, float), [float(b) for b in box], dim, e=e, beta=beta,
-                       inertia_k=inertia_k, tc=tc)
+                       inertia_k=inertia_k, tc=tc, **options)

@@ -26,8 +26,10 @@ from tqdm import tqdm
 
 from ... import __version__
 from ...analysis.profiles import ProfileAnalysis
-from ...analysis.suite import profile_analysis
+from ...analysis.stress import collisional_stress, stress_results
+from ...analysis.suite import profile_analysis, profile_bounds
 from ...decks.base import UnsupportedByEngine
+from ...decks.servo import ServoController, has_servo
 from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
@@ -35,36 +37,27 @@ from ...scene.initial import build_initial_state
 from ..base import EngineError, RunOptions, RunStopped
 from ..child import in_worker, launch_child
 from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
-from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters
+from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters, y_range
 
 CHECKPOINT = "checkpoint.pkl"
-ENGINE_VERSION = f"demstudy-edmd {__version__} (milestone 1: periodic box, e, beta, K, TC)"
+ENGINE_VERSION = (f"demstudy-edmd {__version__} (gravity, flat walls, servo, Lees-Edwards, "
+                  "Walton, e(v), TC)")
+#: collision-log records kept per run (sampled every ``log_every`` collisions)
+LOG_CAPACITY = 200_000
 
 
 def check_supported(scene: Scene) -> dict:
-    """Refuse every scene feature outside milestone 1; return e, β, K."""
-    if scene.walls:
-        raise UnsupportedByEngine("edmd", "walls", [w.side for w in scene.walls],
-                                  "walls are not implemented yet (fully periodic boxes only)")
-    if scene.gravity is not None:
-        raise UnsupportedByEngine("edmd", "gravity", scene.gravity.magnitude,
-                                  "gravity (parabolic flights) is not implemented yet")
-    if scene.shear is not None:
-        raise UnsupportedByEngine("edmd", "shear", scene.shear.rate,
-                                  "Lees–Edwards shear is not implemented yet")
-    if scene.run.unit != "time":
-        raise UnsupportedByEngine("edmd", "run.unit", scene.run.unit,
-                                  "run lengths in collisions are not implemented; use 'time'")
-    missing = [a for a in "xyz"[:scene.dimension] if a not in scene.periodic]
-    if missing:
-        raise UnsupportedByEngine("edmd", "box.periodic", list(scene.periodic),
-                                  "every axis must be periodic")
+    """Refuse what the event-driven engine cannot do (bumpy walls, small periodic boxes);
+    return the core's options for the scene."""
+    params = scene_parameters(scene)
     d_max = 1.0 + scene.particles.diameter_spread / 2
-    if min(scene.box.size) < 3 * d_max:
+    short = [a for i, a in enumerate("xyz"[:scene.dimension])
+             if a in scene.periodic and scene.box.size[i] < 3 * d_max]
+    if short:
         raise UnsupportedByEngine("edmd", "box.size", list(scene.box.size),
-                                  f"every box length must be at least 3 largest diameters "
-                                  f"({3 * d_max:g}) for the cell lists")
-    return scene_parameters(scene)
+                                  f"every periodic box length must be at least 3 largest "
+                                  f"diameters ({3 * d_max:g}) for the cell lists")
+    return params
 
 
 @dataclass
@@ -77,7 +70,18 @@ class EdmdRunState:
     profiles: ProfileAnalysis | None = None
     wall_seconds: float = 0.0
     last_virial: float = 0.0
+    last_time: float = 0.0
+    last_impulse: dict[str, np.ndarray] = field(default_factory=dict)
     keep_frames: bool = False  # fixed when the run starts, kept on resume
+    servo: ServoController | None = None
+    next_servo: int = 0  # collision count of the next servo update
+    servo_impulse: dict[str, np.ndarray] = field(default_factory=dict)
+    servo_time: float = 0.0
+    last_stress: np.ndarray | None = None
+    stress_chunks: list = field(default_factory=list)  # per production interval
+    stress_durations: list = field(default_factory=list)
+    log: dict[str, list] = field(default_factory=dict)
+    logged: int = 0
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
@@ -86,9 +90,10 @@ class EdmdRunState:
 class EdmdEngine:
     """``run(scene, options)``: event-driven hard discs/spheres (see the module docstring).
 
-    ``options.extra["tc"]``: TC-model time (default ``DEFAULT_TC``; 0 switches it off).
-    ``options.isolate`` runs it in a child process; ``options.np`` > 1 and ``options.dump``
-    are refused (a serial engine; no LAMMPS dump)."""
+    ``options.extra``: ``tc`` (TC-model time, default ``DEFAULT_TC``; 0 switches it off),
+    ``log_every`` (log every k-th collision; default 1 when the scene measures "angles",
+    otherwise no log). ``options.isolate`` runs it in a child process; ``options.np`` > 1
+    and ``options.dump`` are refused (a serial engine; no LAMMPS dump)."""
 
     name = "edmd"
 
@@ -112,7 +117,8 @@ class _Run:
         self.out = Path(options.out).resolve()
         self.workdir = self.out.with_suffix(".edmd")
         run = scene.run
-        self.dt = run.sample_interval
+        self.dt = run.sample_interval  # time, or collisions per particle
+        self.by_collisions = run.unit == "collisions"
         self.n_eq = round(run.equilibration / self.dt)
         self.n_total = self.n_eq + max(1, round(run.production / self.dt))
         ckpt = options.checkpoint_interval or run.checkpoint_interval
@@ -120,16 +126,41 @@ class _Run:
         keep = options.keep_frames
         self.keep_frames = scene.measure.keep_frames if keep is None else keep
         self.volume = math.prod(scene.box.size)
+        statistics = scene.measure.statistics
+        default_log = 1 if "angles" in statistics else 0
+        self.log_every = int(options.extra.get("log_every", default_log))
+        self.stress = scene.measure.axis == "y"
 
     # -- state ----------------------------------------------------------------------------
+    def _core_options(self, initial) -> dict:
+        options = dict(self.params)
+        if not self.scene.y_periodic:
+            options["y_range"] = y_range(self.scene, initial.position)
+        if self.stress:
+            lo, hi, _period = profile_bounds(self.scene)
+            n_bins = max(1, round((hi - lo) / self.scene.measure.bin_width))
+            self.stress_edges = lo + (hi - lo) / n_bins * np.arange(n_bins + 1)
+            options["stress_bins"] = (lo, (hi - lo) / n_bins, n_bins)
+        if self.log_every > 0:
+            options.update(log_every=self.log_every, log_capacity=LOG_CAPACITY)
+        return options
+
     def _start(self) -> tuple[EventDriven, EdmdRunState]:
         initial = build_initial_state(self.scene)
         self.radius = initial.diameter / 2
         self.mass = initial.mass
-        core = from_initial_state(initial, self.scene.box.size, tc=self.tc, **self.params)
+        self.n = len(self.mass)
+        core = from_initial_state(initial, self.scene.box.size, tc=self.tc,
+                                  **self._core_options(initial))
         if not self.options.resume:
-            return core, EdmdRunState(profiles=profile_analysis(self.scene),
-                                      keep_frames=self.keep_frames)
+            servo = ServoController(self.scene, None) if has_servo(self.scene) else None
+            state = EdmdRunState(keep_frames=self.keep_frames, servo=servo)
+            if servo is None:
+                state.profiles = profile_analysis(self.scene)
+            else:
+                state.next_servo = self._servo_interval()
+                state.servo_impulse = self._impulses(core)
+            return core, state
         path = self.workdir / CHECKPOINT
         if not path.exists():
             raise EngineError(f"--resume: no checkpoint in {self.workdir}")
@@ -149,7 +180,56 @@ class _Run:
                           {"scene": scene_to_toml(self.scene), "tc": self.tc,
                            "core": core.get_state(), "run": snapshot})
 
+    def _impulses(self, core: EventDriven) -> dict[str, np.ndarray]:
+        return {w.side: core.wall_impulse(0 if w.side == "lower" else 1)
+                for w in self.scene.walls}
+
+    # -- servo ----------------------------------------------------------------------------
+    def _servo_interval(self) -> int:
+        servo = next(w.servo for w in self.scene.walls if w.servo is not None)
+        return max(1, round(servo.interval_collisions * self.n))
+
+    def _servo_update(self, core: EventDriven, state: EdmdRunState) -> None:
+        """Campbell's servo step after every interval_collisions × N pair collisions: the
+        walls' mean forces over the interval set their new normal velocities (the rule of
+        ``ServoController``); the periodic width is rescaled (positions affinely) to keep
+        width/gap, and the upper wall's speed follows the gap when the shear rate is held."""
+        servo, t = state.servo, core.time
+        impulses = self._impulses(core)
+        span = max(t - state.servo_time, 1e-300)
+        force = {side: float(impulses[side][1] - state.servo_impulse[side][1]) / span
+                 for side in impulses}
+        servo.update(t, force, float(core.box[0]))
+        for side, wall in servo.walls.items():
+            k = 0 if side == "lower" else 1
+            wall.y = core.wall_position(k)  # the core's position is the truth
+            core.set_wall(k, wall.y, wall.vy, wall.vx)
+        if servo.scale_width:
+            core.scale_width(servo.shape * servo.gap / float(core.box[0]))
+        state.servo_impulse, state.servo_time = impulses, t
+        state.next_servo += self._servo_interval()
+
     # -- sampling -------------------------------------------------------------------------
+    def _advance_interval(self, core: EventDriven, state: EdmdRunState) -> None:
+        """Advance to the next sample: a time, or a collision count with run.unit =
+        'collisions'; servo updates happen on the way."""
+        if self.by_collisions:
+            t_end, target = 1e300, round(state.samples * self.dt * self.n)
+            guard = 1000 * max(1, target - core.collisions) + 10_000_000
+        else:
+            t_end, target, guard = state.samples * self.dt, 0, 0
+        while True:
+            stops = [c for c in (target, state.next_servo if state.servo else 0) if c > 0]
+            if core.advance_to(t_end, max_events=guard, stop_collisions=min(stops, default=0)):
+                return
+            if state.servo is not None and core.collisions >= state.next_servo:
+                self._servo_update(core, state)
+                continue
+            if target and core.collisions >= target:
+                return
+            raise EngineError(f"no pair collisions within {guard} events after t = "
+                              f"{core.time:.6g}: a run counted in collisions cannot go on")
+
     def _sample(self, core: EventDriven, state: EdmdRunState, production: bool) -> None:
         dim, t = self.scene.dimension, core.time
         velocity = core.velocities()
@@ -159,20 +239,58 @@ class _Run:
         state.record("kinetic_energy", kinetic)
         state.record("rotational_energy", core.rotational_energy)
         state.record("collisions", core.collisions)
+        state.record("wall_collisions", core.wall_collisions)
         state.record("dissipated_energy", core.dissipated)
-        virial = core.virial
-        if state.samples == 0:
-            pressure = float("nan")
-        else:
-            pressure = (2 * kinetic / dim + (virial - state.last_virial) / (dim * self.dt)) \
-                / self.volume
-        state.last_virial = virial
-        state.record("pressure", pressure)
+        if self.scene.gravity is not None:
+            state.record("gravity_work", core.gravity_work)
+        span = t - state.last_time
+        impulses = self._impulses(core)
+        for side, impulse in impulses.items():
+            # force of the particles on the wall, averaged over the interval that just ended
+            previous = state.last_impulse.get(side, impulse)
+            force = -(impulse - previous)[:dim] / span if span > 0 else np.full(dim, np.nan)
+            state.record(f"wall_force_{side}", force)
+            state.record(f"wall_work_{side}", core.wall_work(0 if side == "lower" else 1))
+        state.last_impulse = impulses
+        if self.scene.shear is not None:
+            state.record("tilt", core.shear_offset)
+        if state.servo is not None:
+            for side, wall in state.servo.walls.items():  # the core's positions are the truth
+                wall.y = core.wall_position(0 if side == "lower" else 1)
+            state.servo.t_last = t
+            for key, value in state.servo.state().items():
+                state.record(key, value)
+            state.record("width", float(core.box[0]))
+        if self.scene.y_periodic:
+            virial = core.virial
+            pressure = float("nan") if state.samples == 0 or span <= 0 else \
+                (2 * kinetic / dim + (virial - state.last_virial) / (dim * span)) / self.volume
+            state.last_virial = virial
+            state.record("pressure", pressure)
+        if self.stress:
+            sums = core.stress_sums[:, :dim, :dim].transpose(0, 2, 1)  # P_ab = Σ J_a r_b
+            if production and state.last_stress is not None:
+                state.stress_chunks.append(sums - state.last_stress)
+                state.stress_durations.append(span)
+            state.last_stress = sums
+        log = core.take_log() if self.log_every > 0 else {}
+        if production and log and state.logged < LOG_CAPACITY:
+            keep = min(len(log["time"]), LOG_CAPACITY - state.logged)
+            for key, value in log.items():
+                state.log.setdefault(key, []).append(value[:keep])
+            state.logged += keep
+        state.last_time = t
         if not production:
             return
-        frame = Frame(time=t, box_lo=np.zeros(dim), box_hi=np.asarray(self.scene.box.size, float),
-                      position=core.positions(), velocity=velocity,
-                      angular_velocity=core.angular_velocities(), radius=self.radius)
+        lo, hi = np.zeros(dim), np.asarray(core.box, float)
+        if not self.scene.y_periodic:
+            lo[1] = core.wall_position(0) if self.scene.wall("lower") else 0.0
+            hi[1] = core.wall_position(1) if self.scene.wall("upper") else hi[1]
+        frame = Frame(time=t, box_lo=lo, box_hi=hi, position=core.positions(),
+                      velocity=velocity, angular_velocity=core.angular_velocities(),
+                      radius=self.radius, tilt=core.shear_offset)
+        if state.profiles is None:  # servo: bins between the walls where production starts
+            state.profiles = profile_analysis(self.scene, (float(lo[1]), float(hi[1])))
         state.profiles.feed(frame)
         if self.keep_frames:
             keep_frame(state.frames, frame)
@@ -193,14 +311,16 @@ class _Run:
         return self._write(core, state)
 
     def _loop(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
-        bar = tqdm(total=self.n_total * self.dt, initial=state.samples * self.dt, unit="τ",
+        unit = "coll/N" if self.by_collisions else "τ"
+        bar = tqdm(total=self.n_total * self.dt, initial=state.samples * self.dt, unit=unit,
                    disable=not self.options.progress,
-                   bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} τ [{elapsed}<{remaining}]",
+                   bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} " + unit +
+                   " [{elapsed}<{remaining}]",
                    desc=f"edmd {self.scene.meta.name}")
         with bar:
             while state.samples < self.n_total:
                 state.samples += 1
-                core.advance_to(state.samples * self.dt)
+                self._advance_interval(core, state)
                 self._sample(core, state, production=state.samples > self.n_eq)
                 bar.update(self.dt)
                 checkpoint = self.n_ckpt and state.samples % self.n_ckpt == 0
@@ -217,16 +337,52 @@ class _Run:
         scene = self.scene
         timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
         frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
-        notes = [f"TC model (Luding & McNamara): a collision within t_c = {self.tc:g} of "
-                 "either partner's previous collision is elastic (e = 1, no tangential "
+        notes = [f"TC model (Luding & McNamara): a pair collision within t_c = {self.tc:g} "
+                 "of either partner's previous collision is elastic (e = 1, no tangential "
                  f"impulse); {core.elastic_tc_collisions} such collisions"]
+        if scene.gravity is not None and scene.walls:
+            notes.append("particles pressed onto a wall by gravity leave it at least at "
+                         "½ t_c |g_n| (a hop of period t_c: resting contact); "
+                         f"{core.resting_bounces} such bounces")
+        if state.servo is not None and state.servo.scale_width:
+            notes.append("servo width scaling: x positions are rescaled affinely at each "
+                         "servo update")
+        equilibration_end = float(timeseries["time"][self.n_eq])
         attrs = run_attrs(scene, "edmd", ENGINE_VERSION, state.wall_seconds,
-                          self.n_eq * self.dt, timeseries)
+                          equilibration_end, timeseries)
         attrs.update(tc=self.tc, events=core.events, cell_crossings=core.cell_crossings,
-                     approximations="\n".join(notes))
+                     wall_collisions=core.wall_collisions, approximations="\n".join(notes),
+                     run_unit=scene.run.unit)
+        groups, group_attrs = {}, {}
+        collisional = None
+        if self.stress and state.stress_chunks:
+            section = self._cross_section(timeseries)
+            collisional = collisional_stress(np.asarray(state.stress_chunks),
+                                             np.asarray(state.stress_durations),
+                                             self.stress_edges, section)
+        if self.stress:
+            stress, stress_attrs = stress_results(scene, analysis.results, timeseries,
+                                                  start=equilibration_end,
+                                                  collisional=collisional)
+            groups["stress"], group_attrs["stress"] = stress, stress_attrs
+        if state.log:
+            groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}
+            group_attrs["collisions"] = {
+                "log_every": self.log_every, "capacity": LOG_CAPACITY,
+                "units": "d = 1, m = 1 (g = 1 with gravity); kind 0 pair, 1 lower wall, "
+                         "2 upper wall; normal from i to j (or to the wall); branch r_j - r_i "
+                         "(contact point - r_i for walls); impulse on i; velocity v_i - v_j "
+                         "and spin_velocity (contact-point relative velocity) before"}
         path = write_results(self.out, Results(attrs, timeseries, analysis.results,
-                                               analysis.attrs, frames))
+                                               analysis.attrs, frames, groups, group_attrs))
         (self.workdir / CHECKPOINT).unlink(missing_ok=True)
         if self.workdir.exists() and not any(self.workdir.iterdir()):
             self.workdir.rmdir()
         return path
+
+    def _cross_section(self, timeseries: dict[str, np.ndarray]) -> float:
+        """Bin cross-section: the (mean production) periodic width × depth."""
+        size = list(self.scene.box.size)
+        if "width" in timeseries:
+            size[0] = float(np.mean(timeseries["width"][self.n_eq:]))
+        return float(np.prod([size[i] for i in range(self.scene.dimension) if i != 1]))

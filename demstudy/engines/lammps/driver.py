@@ -22,12 +22,20 @@ import numpy as np
 from tqdm import tqdm
 
 from ...analysis.profiles import ProfileAnalysis
-from ...analysis.suite import profile_analysis
+from ...analysis.stress import ContactStress, branch_sums, stress_results
+from ...analysis.suite import profile_analysis, profile_bounds
 from ...decks import Deck
-from ...decks.output import WALL_FORCES, sample_steps, steps
+from ...decks.output import (
+    STRESS_COLUMNS,
+    STRESS_IDS,
+    STRESS_PAIRS,
+    WALL_FORCES,
+    sample_steps,
+    steps,
+)
 from ...decks.servo import ServoController, has_servo
 from ...decks.system import DATA_FILE
-from ...decks.walls import wall_force_sources
+from ...decks.walls import wall_fix_id, wall_force_sources
 from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
@@ -47,6 +55,7 @@ class RunState:
     timeseries: dict[str, list] = field(default_factory=dict)
     frames: dict[str, list] = field(default_factory=dict)
     profiles: ProfileAnalysis | None = None
+    stress: ContactStress | None = None  # contact stress (measure.statistics "stress")
     wall_seconds: float = 0.0
     servo: ServoController | None = None
     dump_size: int = 0
@@ -87,7 +96,9 @@ class Driver:
         self.keep_frames = scene.measure.keep_frames if keep is None else keep
         self.dump = Path(options.dump).resolve() if options.dump else None
         self.sources = wall_force_sources(scene)
+        self.measure_stress = "stress" in scene.measure.statistics
         self._mobile: np.ndarray | None = None
+        self._all: tuple[np.ndarray, np.ndarray] | None = None  # (x, radius) of every atom
 
     # -- set-up -------------------------------------------------------------------------
     def _issue_deck(self, session: LammpsSession, resume: bool) -> None:
@@ -139,10 +150,12 @@ class Driver:
         if self._mobile is None:  # atom types never change: gather them once
             self._mobile = session.gather("type", 1, integer=True) == 1
         mobile = self._mobile
-        x = session.gather("x", 3)[mobile, :dim]
+        x_all, r_all = session.gather("x", 3), session.gather("radius", 1)
+        self._all = (x_all, r_all)
+        x = x_all[mobile, :dim]
         v = session.gather("v", 3)[mobile, :dim]
         omega = session.gather("omega", 3)[mobile]
-        radius = session.gather("radius", 1)[mobile]
+        radius = r_all[mobile]
         boxlo, boxhi, xy, *_ = session.lmp.extract_box()
         return Frame(time=t, box_lo=np.array(boxlo[:dim]), box_hi=np.array(boxhi[:dim]),
                      position=x, velocity=v,
@@ -185,6 +198,8 @@ class Driver:
             for key, value in state.servo.state().items():
                 state.record(key, value)
             state.record("width", float(frame.lengths[0]))
+        if production and self.measure_stress:  # collective (sum over ranks)
+            self._sample_stress(session, state, frame)
         if not production or session.rank != 0:
             return
         if state.profiles is None:
@@ -193,6 +208,59 @@ class Driver:
         state.profiles.feed(frame)
         if self.keep_frames:
             keep_frame(state.frames, frame)
+
+    def _sample_stress(self, session: LammpsSession, state: RunState, frame: Frame) -> None:
+        """Contact stress of this sample: every rank bins the contacts it holds (pairs from
+        ``compute pair/local``, wall contacts from the wall fixes' per-atom arrays), the
+        per-bin sums are added over the ranks, rank 0 accumulates them."""
+        if state.stress is None:  # bins of the profiles, laid when production starts
+            lo, hi, _ = profile_bounds(self.scene)
+            if state.servo is not None:
+                lo, hi = state.servo.walls["lower"].y, state.servo.walls["upper"].y
+            n_bins = max(1, round((hi - lo) / self.scene.measure.bin_width))
+            period = self.scene.box.size[1] if self.scene.y_periodic else 0.0
+            state.stress = ContactStress(lo + (hi - lo) / n_bins * np.arange(n_bins + 1),
+                                         self.scene.dimension, period)
+        sums = session.sum_ranks(self._contact_sums(session, state.stress))
+        if session.rank == 0:
+            section = float(np.prod(np.delete(frame.lengths, 1)))
+            state.stress.add_sums(sums, section)
+
+    def _contact_sums(self, session: LammpsSession, stress: ContactStress) -> np.ndarray:
+        """Per-bin sums of f_i (x) (r_i - r_j) over this rank's contacts (branch to a bump's
+        or a wall's contact point for wall contacts)."""
+        dim = self.scene.dimension
+        x_all, r_all = self._all
+        mobile = self._mobile
+        rows = session.local_array(STRESS_PAIRS, STRESS_COLUMNS)
+        ids = session.local_array(STRESS_IDS, 2).astype(np.int64) - 1
+        if ids.shape[0] != rows.shape[0]:
+            raise EngineError(f"{STRESS_PAIRS} and {STRESS_IDS} disagree on the contacts")
+        force = rows[:, 0:3] + rows[:, 3:6]  # on i: normal + tangential
+        sep = rows[:, 6:9]  # x_i - x_j (minimum image)
+        i, j = ids[:, 0], ids[:, 1]
+        dist = np.linalg.norm(sep, axis=1)
+        both = mobile[i] & mobile[j]
+        ends = [(x_all[i[both], 1], force[both], sep[both])]
+        for a, b, sign in ((i, j, 1.0), (j, i, -1.0)):  # mobile a, bump b
+            sel = mobile[a] & ~mobile[b] & (dist > 0)
+            reach = r_all[a[sel]] - 0.5 * (r_all[a[sel]] + r_all[b[sel]] - dist[sel])
+            unit = sign * sep[sel] / dist[sel, None]
+            ends.append((x_all[a[sel], 1], sign * force[sel], unit * reach[:, None]))
+        local_x = None
+        for wall in self.scene.walls:
+            contacts = session.fix_atom_array(wall_fix_id(wall.side))
+            if contacts.size == 0:
+                continue
+            if local_x is None:
+                local_x = session.local_positions()
+            on = contacts[:, 0] != 0
+            ends.append((local_x[on, 1], contacts[on, 1:4], local_x[on] - contacts[on, 4:7]))
+        y = np.concatenate([e[0] for e in ends])
+        f = np.concatenate([e[1] for e in ends])[:, :dim]
+        br = np.concatenate([e[2] for e in ends])[:, :dim]
+        return branch_sums(y, y - br[:, 1], f[:, :, None] * br[:, None, :], stress.edges,
+                           stress.period)
 
     def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
         restart = self.workdir / CHECKPOINT_RESTART
@@ -289,8 +357,14 @@ class Driver:
                           self.n_eq * self.dt, timeseries)
         attrs.update(timestep=self.dt, deck=self.deck.render(self.scene.meta.name),
                      approximations="\n".join(self.deck.notes))
-        path = write_results(self.out, Results(attrs, timeseries, analysis.results,
-                                               analysis.attrs, frames))
+        results = Results(attrs, timeseries, analysis.results, analysis.attrs, frames)
+        if self.measure_stress:
+            contact = state.stress.finish() if state.stress is not None else None
+            data, group_attrs = stress_results(self.scene, analysis.results, timeseries,
+                                               self.n_eq * self.dt, contact=contact)
+            group_attrs["contact_samples"] = state.stress.samples if state.stress else 0
+            results.groups["stress"], results.group_attrs["stress"] = data, group_attrs
+        path = write_results(self.out, results)
         for name in (CHECKPOINT_RESTART, CHECKPOINT_STATE):
             (self.workdir / name).unlink(missing_ok=True)
         return path

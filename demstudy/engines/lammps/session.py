@@ -16,6 +16,7 @@ from ..base import EngineError
 
 # MPICH ABI handles (the runtime is the `mpich` wheel's): MPI_COMM_WORLD, MPI_INT, MPI_MAX
 _MPI_COMM_WORLD, _MPI_INT, _MPI_MAX = 0x44000000, 0x4C000405, 0x58000001
+_MPI_DOUBLE, _MPI_SUM = 0x4C00080B, 0x58000003
 
 
 def quoted(path: Path | str) -> str:
@@ -70,6 +71,39 @@ class LammpsSession:
         if status != 0:
             raise EngineError(f"MPI_Allreduce failed with code {status}")
         return bool(recv.value)
+
+    def local_array(self, compute_id: str, columns: int) -> np.ndarray:
+        """This rank's rows of a local compute's array (e.g. ``compute pair/local``)."""
+        data = self.lmp.numpy.extract_compute(compute_id, self._lam.LMP_STYLE_LOCAL,
+                                              self._lam.LMP_TYPE_ARRAY)
+        if data is None:
+            return np.zeros((0, columns))
+        return np.array(data, dtype=np.float64).reshape(-1, columns)
+
+    def fix_atom_array(self, fix_id: str) -> np.ndarray:
+        """This rank's rows (owned atoms) of a fix's per-atom array."""
+        data = self.lmp.numpy.extract_fix(fix_id, self._lam.LMP_STYLE_ATOM,
+                                          self._lam.LMP_TYPE_ARRAY)
+        return np.zeros((0, 0)) if data is None else np.array(data, dtype=np.float64)
+
+    def local_positions(self) -> np.ndarray:
+        """Positions of this rank's owned atoms (the rows of per-atom fix arrays)."""
+        nlocal = int(self.lmp.extract_setting("nlocal"))
+        return np.array(self.lmp.numpy.extract_atom("x"), dtype=np.float64)[:nlocal]
+
+    def sum_ranks(self, values: np.ndarray) -> np.ndarray:
+        """Element-wise sum of a float array over the ranks (MPI_Allreduce, MPI_SUM)."""
+        send = np.ascontiguousarray(values, dtype=np.float64)
+        if self.nprocs == 1:
+            return send.copy()
+        recv = np.empty_like(send)
+        lib = ctypes.CDLL(str(preload_mpi()), mode=ctypes.RTLD_GLOBAL)
+        status = lib.MPI_Allreduce(send.ctypes.data_as(ctypes.c_void_p),
+                                   recv.ctypes.data_as(ctypes.c_void_p), send.size,
+                                   _MPI_DOUBLE, _MPI_SUM, _MPI_COMM_WORLD)
+        if status != 0:
+            raise EngineError(f"MPI_Allreduce failed with code {status}")
+        return recv
 
     def close(self) -> None:
         self.lmp.close()

@@ -49,9 +49,39 @@ std::size_t rows(const InArr& a, std::size_t cols, const char* name) {
     return static_cast<std::size_t>(a.shape(0));
 }
 
+Rule parse_rule(nb::handle h, const char* who) {
+    // {"e": .., "law": "constant"|"campbell-exp"|"gutt-piecewise", "speed", "e1", "e2",
+    //  "crossover_speed", "tangential": "beta"|"coulomb"|"noslip", "beta", "mu", "beta0"}
+    Rule r;
+    nb::dict d = nb::cast<nb::dict>(h);
+    auto num = [&](const char* key, double dflt) {
+        return d.contains(key) ? nb::cast<double>(d[key]) : dflt;
+    };
+    r.e = num("e", 1.0);
+    const std::string law = d.contains("law") ? nb::cast<std::string>(d["law"]) : "constant";
+    if (law == "constant") r.law = Rule::kConstant;
+    else if (law == "campbell-exp") r.law = Rule::kCampbellExp;
+    else if (law == "gutt-piecewise") r.law = Rule::kGutt;
+    else throw nb::value_error((std::string(who) + ": unknown law " + law).c_str());
+    r.speed = num("speed", 1.0);
+    r.e1 = num("e1", 1.0);
+    r.e2 = num("e2", 1.0);
+    r.crossover = num("crossover_speed", 1.0);
+    const std::string tang =
+        d.contains("tangential") ? nb::cast<std::string>(d["tangential"]) : "beta";
+    if (tang == "beta") r.tangential = Rule::kBeta;
+    else if (tang == "coulomb") r.tangential = Rule::kCoulomb;
+    else if (tang == "noslip") r.tangential = Rule::kNoSlip;
+    else throw nb::value_error((std::string(who) + ": unknown tangential rule " + tang).c_str());
+    r.beta = num("beta", -1.0);
+    r.mu = num("mu", 0.0);
+    r.beta0 = num("beta0", 0.0);
+    return r;
+}
+
 EventDriven* make(InArr pos, InArr vel, InArr omega, InArr diameter, InArr mass,
                   std::vector<double> box, int dim, double e, double beta, double inertia_k,
-                  double tc) {
+                  double tc, nb::kwargs options) {
     require(dim == 2 || dim == 3, "dim must be 2 or 3");
     require(box.size() == static_cast<std::size_t>(dim), "box needs dim lengths");
     const std::size_t n = rows(pos, dim, "positions (N, dim)");
@@ -67,10 +97,58 @@ EventDriven* make(InArr pos, InArr vel, InArr omega, InArr diameter, InArr mass,
         require(box[a] > 0.0, "box lengths must be positive");
         p.box[a] = box[a];
     }
-    p.restitution = e;
-    p.beta = beta;
+    p.pair.e = e;
+    p.pair.beta = beta;
     p.inertia_k = inertia_k;
     p.tc = tc;
+    for (auto item : options) {
+        const std::string key = nb::cast<std::string>(item.first);
+        nb::handle v = item.second;
+        if (key == "pair") {
+            nb::dict d = nb::cast<nb::dict>(v);
+            if (!d.contains("e")) d["e"] = e;
+            if (!d.contains("beta")) d["beta"] = beta;
+            p.pair = parse_rule(d, "pair");
+        } else if (key == "gravity") {
+            auto g = nb::cast<std::vector<double>>(v);
+            require(g.size() == static_cast<std::size_t>(dim), "gravity needs dim components");
+            for (int a = 0; a < dim; ++a) p.gravity[a] = g[a];
+        } else if (key == "shear_rate") {
+            p.shear_rate = nb::cast<double>(v);
+        } else if (key == "periodic_y") {
+            p.periodic_y = nb::cast<bool>(v);
+        } else if (key == "y_range") {
+            auto r = nb::cast<std::vector<double>>(v);
+            require(r.size() == 2, "y_range needs (lo, hi)");
+            p.y_lo = r[0];
+            p.y_hi = r[1];
+        } else if (key == "walls") {
+            for (nb::handle wh : nb::cast<nb::list>(v)) {
+                nb::dict d = nb::cast<nb::dict>(wh);
+                const std::string side = nb::cast<std::string>(d["side"]);
+                require(side == "lower" || side == "upper", "wall side: lower or upper");
+                Wall& w = p.wall[side == "lower" ? 0 : 1];
+                w.present = true;
+                w.y0 = nb::cast<double>(d["position"]);
+                w.vn = d.contains("normal_velocity") ? nb::cast<double>(d["normal_velocity"]) : 0.0;
+                w.u[0] = d.contains("velocity") ? nb::cast<double>(d["velocity"]) : 0.0;
+                w.u[2] = d.contains("velocity_z") ? nb::cast<double>(d["velocity_z"]) : 0.0;
+                w.rule = parse_rule(d, "wall");
+            }
+        } else if (key == "stress_bins") {
+            auto b = nb::cast<std::vector<double>>(v);
+            require(b.size() == 3, "stress_bins needs (lo, width, count)");
+            p.stress_lo = b[0];
+            p.stress_width = b[1];
+            p.stress_bins = static_cast<std::int64_t>(b[2]);
+        } else if (key == "log_every") {
+            p.log_every = nb::cast<std::int64_t>(v);
+        } else if (key == "log_capacity") {
+            p.log_capacity = nb::cast<std::int64_t>(v);
+        } else {
+            throw nb::value_error(("unknown option " + key).c_str());
+        }
+    }
     try {
         return new EventDriven(p, static_cast<std::int64_t>(n), pos.data(), vel.data(),
                                omega.data(), diameter.data(), mass.data());
@@ -89,19 +167,15 @@ nb::dict state_dict(const EventDriven& s) {
     d["last"] = from_vector(st.last, {n});
     d["count"] = from_vector(st.count, {n});
     d["cell"] = from_vector(st.cell, {n, 3});
-    d["ev_time"] = from_vector(st.ev_time, {n});
-    d["ev_partner"] = from_vector(st.ev_partner, {n});
-    d["ev_count"] = from_vector(st.ev_count, {n});
+    d["ev_time"] = from_vector(st.ev_time, {n + 1});
+    d["ev_partner"] = from_vector(st.ev_partner, {n + 1});
+    d["ev_count"] = from_vector(st.ev_count, {n + 1});
     d["co_time"] = from_vector(st.co_time, {n});
     d["co_partner"] = from_vector(st.co_partner, {n});
     d["co_count"] = from_vector(st.co_count, {n});
-    d["virial"] = from_vector(std::vector<double>(st.virial, st.virial + 9), {3, 3});
-    d["time"] = st.time;
-    d["dissipated"] = st.dissipated;
-    d["collisions"] = st.collisions;
-    d["crossings"] = st.crossings;
-    d["invalid"] = st.invalid;
-    d["tc_elastic"] = st.tc_elastic;
+    d["stress"] = from_vector(st.stress, {st.stress.size()});
+    d["scalars"] = from_vector(st.scalars, {st.scalars.size()});
+    d["counters"] = from_vector(st.counters, {st.counters.size()});
     return d;
 }
 
@@ -122,21 +196,16 @@ void set_state(EventDriven& s, nb::dict d) {
     st.count = vec<std::int64_t>(d["count"], n, "count");
     st.cell = vec<std::int32_t>(d["cell"], 3 * n, "cell");
     if (d.contains("ev_time")) {  // without them the events are predicted afresh
-        st.ev_time = vec<double>(d["ev_time"], n, "ev_time");
-        st.ev_partner = vec<std::int32_t>(d["ev_partner"], n, "ev_partner");
-        st.ev_count = vec<std::int64_t>(d["ev_count"], n, "ev_count");
+        st.ev_time = vec<double>(d["ev_time"], n + 1, "ev_time");
+        st.ev_partner = vec<std::int32_t>(d["ev_partner"], n + 1, "ev_partner");
+        st.ev_count = vec<std::int64_t>(d["ev_count"], n + 1, "ev_count");
         st.co_time = vec<double>(d["co_time"], n, "co_time");
         st.co_partner = vec<std::int32_t>(d["co_partner"], n, "co_partner");
         st.co_count = vec<std::int64_t>(d["co_count"], n, "co_count");
     }
-    auto vir = vec<double>(d["virial"], 9, "virial");
-    std::copy(vir.begin(), vir.end(), st.virial);
-    st.time = nb::cast<double>(d["time"]);
-    st.dissipated = nb::cast<double>(d["dissipated"]);
-    st.collisions = nb::cast<std::int64_t>(d["collisions"]);
-    st.crossings = nb::cast<std::int64_t>(d["crossings"]);
-    st.invalid = nb::cast<std::int64_t>(d["invalid"]);
-    st.tc_elastic = nb::cast<std::int64_t>(d["tc_elastic"]);
+    st.stress = vec<double>(d["stress"], s.stress_sums().size(), "stress");
+    st.scalars = vec<double>(d["scalars"], 33, "scalars");
+    st.counters = vec<std::int64_t>(d["counters"], 7, "counters");
     try {
         s.set_state(st);
     } catch (const std::invalid_argument& err) {
@@ -144,14 +213,14 @@ void set_state(EventDriven& s, nb::dict d) {
     }
 }
 
-nb::tuple collide(std::vector<double> n, double ri, double rj, double mi, double mj,
+nb::tuple collide_py(std::vector<double> n, double ri, double rj, double mi, double mj,
                   double inertia_k, double e, double beta, std::vector<double> vi,
                   std::vector<double> vj, std::vector<double> wi, std::vector<double> wj) {
     require(n.size() == 3 && vi.size() == 3 && vj.size() == 3 && wi.size() == 3 &&
                 wj.size() == 3,
             "collide_pair: vectors need 3 components (z = 0 in 2D)");
     double J[3];
-    collide_pair(n.data(), ri, rj, mi, mj, inertia_k, e, beta, vi.data(), vj.data(), wi.data(),
+    collide(n.data(), ri, rj, 1.0 / mi, 1.0 / mj, inertia_k, e, beta, vi.data(), vj.data(), wi.data(),
                  wj.data(), J);
     auto a = from_vector(vi, {3}), b = from_vector(vj, {3}), c = from_vector(wi, {3}),
          d = from_vector(wj, {3}), j = from_vector(std::vector<double>(J, J + 3), {3});
@@ -161,7 +230,7 @@ nb::tuple collide(std::vector<double> n, double ri, double rj, double mi, double
 }  // namespace
 
 void bind(nb::module_& m) {
-    m.def("edmd_collide_pair", &collide, "n"_a, "ri"_a, "rj"_a, "mi"_a, "mj"_a, "inertia_k"_a,
+    m.def("edmd_collide_pair", &collide_py, "n"_a, "ri"_a, "rj"_a, "mi"_a, "mj"_a, "inertia_k"_a,
           "e"_a, "beta"_a, "vi"_a, "vj"_a, "wi"_a, "wj"_a,
           "One hard-particle collision (n: unit normal from i to j, 3 components; spins as "
           "3-vectors, z only in 2D). Returns (vi', vj', wi', wj', J), J the impulse on i.");
@@ -171,30 +240,31 @@ void bind(nb::module_& m) {
         .def("__init__",
              [](EventDriven* self, InArr pos, InArr vel, InArr omega, InArr diameter,
                 InArr mass, std::vector<double> box, int dim, double e, double beta,
-                double inertia_k, double tc) {
+                double inertia_k, double tc, nb::kwargs options) {
                  EventDriven* made = make(pos, vel, omega, diameter, mass, box, dim, e, beta,
-                                          inertia_k, tc);
+                                          inertia_k, tc, options);
                  new (self) EventDriven(std::move(*made));
                  delete made;
              },
              "positions"_a, "velocities"_a, "angular_velocities"_a, "diameters"_a, "masses"_a,
              "box"_a, "dim"_a, "e"_a = 1.0, "beta"_a = -1.0, "inertia_k"_a = 0.4,
-             "tc"_a = 0.0)
+             "tc"_a = 0.0, "options"_a)
         .def("advance_to",
-             [](EventDriven& s, double t, std::int64_t max_events) {
+             [](EventDriven& s, double t, std::int64_t max_events, std::int64_t stop_collisions) {
                  bool reached;
                  try {
                      nb::gil_scoped_release release;
-                     reached = s.advance_to(t, max_events);
+                     reached = s.advance_to(t, max_events, stop_collisions);
                  } catch (const std::invalid_argument& err) {
                      throw nb::value_error(err.what());
                  }
                  return reached;
              },
-             "t"_a, "max_events"_a = 0,
+             "t"_a, "max_events"_a = 0, "stop_collisions"_a = 0,
              "Process events up to t, then synchronise every particle to t (returns True). "
-             "With max_events > 0, stop after that many events if t is not reached, "
-             "synchronise to the last event time and return False.")
+             "Stop early (synchronised to the last event time, returns False) after "
+             "max_events events (> 0) or when the pair-collision count reaches "
+             "stop_collisions (> 0).")
         .def_prop_ro("time", &EventDriven::time)
         .def_prop_ro("n", &EventDriven::size)
         .def_prop_ro("dim", &EventDriven::dim)
@@ -230,9 +300,100 @@ void bind(nb::module_& m) {
         .def_prop_ro("virial_tensor",
                      [](const EventDriven& s) {
                          const double* v = s.virial_tensor();
-                         return from_vector(std::vector<double>(v, v + 9), {3, 3});
+                         return nb::cast(from_vector(std::vector<double>(v, v + 9), {3, 3}), nb::rv_policy::move);
                      })
         .def_prop_ro("dissipated", &EventDriven::dissipated)
+        .def_prop_ro("gravity_work", &EventDriven::gravity_work)
+        .def_prop_ro("wall_collisions", &EventDriven::wall_collisions)
+        .def_prop_ro("resting_bounces", &EventDriven::resting_bounces)
+        .def_prop_ro("shear_offset", &EventDriven::shear_offset)
+        .def_prop_ro("box",
+                     [](const EventDriven& s) {
+                         const double* b = s.params().box;
+                         return nb::cast(from_vector(std::vector<double>(b, b + s.dim()),
+                                            {static_cast<std::size_t>(s.dim())}), nb::rv_policy::move);
+                     })
+        .def("wall_impulse",
+             [](const EventDriven& s, int side) {
+                 require(side == 0 || side == 1, "side: 0 (lower) or 1 (upper)");
+                 const double* j = s.wall_impulse(side);
+                 return from_vector(std::vector<double>(j, j + 3), {3});
+             },
+             "side"_a, "Cumulative impulse the wall gave the particles (3 components).")
+        .def("wall_work",
+             [](const EventDriven& s, int side) {
+                 require(side == 0 || side == 1, "side: 0 (lower) or 1 (upper)");
+                 return s.wall_work(side);
+             },
+             "side"_a, "Cumulative work done by the wall on the particles.")
+        .def("wall_position",
+             [](const EventDriven& s, int side) {
+                 require(side == 0 || side == 1, "side: 0 (lower) or 1 (upper)");
+                 return s.params().wall[side].position(s.time());
+             },
+             "side"_a)
+        .def("set_wall",
+             [](EventDriven& s, int side, double y, double vn, double ux, double uz) {
+                 try {
+                     s.set_wall(side, y, vn, ux, uz);
+                 } catch (const std::invalid_argument& err) {
+                     throw nb::value_error(err.what());
+                 }
+             },
+             "side"_a, "position"_a, "normal_velocity"_a, "velocity"_a, "velocity_z"_a = 0.0,
+             "Move a wall now: position, normal velocity, surface velocity (x, z).")
+        .def("scale_width",
+             [](EventDriven& s, double f) {
+                 try {
+                     s.scale_width(f);
+                 } catch (const std::invalid_argument& err) {
+                     throw nb::value_error(err.what());
+                 }
+             },
+             "factor"_a, "Scale x positions and the x period by factor.")
+        .def_prop_ro("stress_sums",
+                     [](const EventDriven& s) {
+                         const auto& v = s.stress_sums();
+                         return nb::cast(from_vector(v, {v.size() / 9, 3, 3}), nb::rv_policy::move);
+                     })
+        .def("take_log",
+             [](EventDriven& s) {
+                 const auto log = s.take_log();
+                 const std::size_t m = log.size();
+                 const std::size_t dim = static_cast<std::size_t>(s.dim());
+                 nb::dict d;
+                 auto col = [&](auto get, std::size_t width) {
+                     auto out = owned<double>(width == 1 ? std::vector<std::size_t>{m}
+                                                         : std::vector<std::size_t>{m, width});
+                     double* o = out.data();
+                     for (std::size_t k = 0; k < m; ++k) get(log[k], o + k * width);
+                     return out;
+                 };
+                 d["time"] = col([](const LogRecord& r, double* o) { o[0] = r.time; }, 1);
+                 d["kind"] = col([](const LogRecord& r, double* o) { o[0] = r.kind; }, 1);
+                 d["i"] = col([](const LogRecord& r, double* o) { o[0] = r.i; }, 1);
+                 d["j"] = col([](const LogRecord& r, double* o) { o[0] = r.j; }, 1);
+                 d["position"] = col([dim](const LogRecord& r, double* o) {
+                     for (std::size_t a = 0; a < dim; ++a) o[a] = r.point[a]; }, dim);
+                 d["normal"] = col([dim](const LogRecord& r, double* o) {
+                     for (std::size_t a = 0; a < dim; ++a) o[a] = r.normal[a]; }, dim);
+                 d["branch"] = col([dim](const LogRecord& r, double* o) {
+                     for (std::size_t a = 0; a < dim; ++a) o[a] = r.branch[a]; }, dim);
+                 d["impulse"] = col([dim](const LogRecord& r, double* o) {
+                     for (std::size_t a = 0; a < dim; ++a) o[a] = r.impulse[a]; }, dim);
+                 d["velocity"] = col([dim](const LogRecord& r, double* o) {
+                     for (std::size_t a = 0; a < dim; ++a) o[a] = r.velocity[a]; }, dim);
+                 d["spin_velocity"] = col([dim](const LogRecord& r, double* o) {
+                     for (std::size_t a = 0; a < dim; ++a) o[a] = r.slip[a]; }, dim);
+                 return d;
+             },
+             "Drain the collision log: dict of arrays (time, kind 0 pair / 1 lower wall / 2 "
+             "upper wall, i, j (input indices, -1 for walls), position = contact point, "
+             "normal (i -> j or wall), branch (r_j - r_i; contact point - r_i for walls), "
+             "impulse on i, velocity = v_i - v_j (walls: v_i - u_wall) and spin_velocity = "
+             "the contact-point relative velocity, both before the collision).")
+        .def("min_wall_gap", &EventDriven::min_wall_gap,
+             "Smallest particle-surface-to-wall distance (inf without walls; < 0: inside).")
         .def_prop_ro("cells",
                      [](const EventDriven& s) {
                          const int* c = s.cells_per_axis();

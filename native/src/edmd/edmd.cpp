@@ -1,5 +1,5 @@
 // Event-driven hard discs / spheres: see native/include/edmd/edmd.hpp.
-// Dimensionless particle units: d = 1, m = 1.
+// Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 #include "edmd/edmd.hpp"
 
 #include <algorithm>
@@ -18,18 +18,59 @@ inline void cross3(const double* a, const double* b, double* out) {
     out[1] = a[2] * b[0] - a[0] * b[2];
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Earliest t >= 0 at which y(t) = y0 + vy t + ay t²/2 reaches 0 while increasing (y0 <= 0:
+// before the target). Roots in the cancellation-free forms. At or past the target (y0 >= 0,
+// round-off or a penetration): now if moving on, else when the motion turns back onwards.
+double first_hit(double y0, double vy, double ay) {
+    if (y0 >= 0.0) {
+        if (vy > 0.0) return 0.0;
+        if (ay <= 0.0) return kInfinity;
+        const double disc = vy * vy - 2.0 * ay * y0;
+        return disc > 0.0 ? (-vy + std::sqrt(disc)) / ay : -vy / ay;
+    }
+    if (ay == 0.0) return vy > 0.0 ? -y0 / vy : kInfinity;
+    const double disc = vy * vy - 2.0 * ay * y0;
+    if (ay > 0.0) {
+        const double s = std::sqrt(disc);
+        return vy <= 0.0 ? (-vy + s) / ay : -2.0 * y0 / (vy + s);
+    }
+    if (vy <= 0.0 || disc < 0.0) return kInfinity;
+    return -2.0 * y0 / (vy + std::sqrt(disc));
+}
 }  // namespace
 
-void collide_pair(const double n[3], double ri, double rj, double mi, double mj,
-                  double inertia_k, double e, double beta, double vi[3], double vj[3],
-                  double wi[3], double wj[3], double J[3]) {
+double Rule::restitution(double gn) const {
+    switch (law) {
+        case kCampbellExp:
+            return 0.5 * (1.0 + std::exp(-gn / speed));
+        case kGutt:
+            // c_r = e1 c for c <= c_b, e1 c_b + e2 (c - c_b) above
+            return gn <= crossover || gn <= 0.0 ? e1 : (e1 * crossover + e2 * (gn - crossover)) / gn;
+        default:
+            return e;
+    }
+}
+
+double Rule::beta_for(double e_n, double k, double gn, double gt) const {
+    if (tangential != kCoulomb) return beta;
+    // Walton: sticking (β₀) unless the tangential impulse would exceed μ times the normal one
+    if (k <= 0.0 || gt <= 0.0) return beta0;
+    const double sliding = -1.0 + mu * (1.0 + e_n) * (1.0 + 1.0 / k) * gn / gt;
+    return std::min(beta0, sliding);
+}
+
+void collide(const double n[3], double ri, double rj, double im_i, double im_j,
+             double inertia_k, double e, double beta, double vi[3], double vj[3], double wi[3],
+             double wj[3], double J[3]) {
     // relative velocity of the contact points, g = vi - vj + (ri wi + rj wj) x n
     double s[3], sxn[3], g[3];
-    for (int a = 0; a < 3; ++a) s[a] = ri * wi[a] + rj * wj[a];
+    for (int a = 0; a < 3; ++a) s[a] = ri * wi[a] + (im_j > 0.0 ? rj * wj[a] : 0.0);
     cross3(s, n, sxn);
     for (int a = 0; a < 3; ++a) g[a] = vi[a] - vj[a] + sxn[a];
     const double gn = dot3(g, n);
-    const double meff = mi * mj / (mi + mj);
+    const double meff = 1.0 / (im_i + im_j);
     const bool rotating = inertia_k > 0.0 && beta > -1.0;
     const double ct = rotating ? meff * (1.0 + beta) * inertia_k / (1.0 + inertia_k) : 0.0;
     for (int a = 0; a < 3; ++a) {
@@ -37,16 +78,17 @@ void collide_pair(const double n[3], double ri, double rj, double mi, double mj,
         J[a] = -meff * (1.0 + e) * gn * n[a] - ct * gt;
     }
     for (int a = 0; a < 3; ++a) {
-        vi[a] += J[a] / mi;
-        vj[a] -= J[a] / mj;
+        vi[a] += J[a] * im_i;
+        vj[a] -= J[a] * im_j;
     }
     if (rotating) {
         double nxj[3];
         cross3(n, J, nxj);
-        const double fi = 1.0 / (inertia_k * mi * ri), fj = 1.0 / (inertia_k * mj * rj);
-        for (int a = 0; a < 3; ++a) {
-            wi[a] += fi * nxj[a];
-            wj[a] += fj * nxj[a];
+        const double fi = im_i / (inertia_k * ri);
+        for (int a = 0; a < 3; ++a) wi[a] += fi * nxj[a];
+        if (im_j > 0.0) {
+            const double fj = im_j / (inertia_k * rj);
+            for (int a = 0; a < 3; ++a) wj[a] += fj * nxj[a];
         }
     }
 }
@@ -55,13 +97,44 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
                          const double* omega, const double* diameter, const double* mass)
     : p_(p), n_(n) {
     if (p.dim != 2 && p.dim != 3) throw std::invalid_argument("dim must be 2 or 3");
-    if (!(p.restitution > 0.0 && p.restitution <= 1.0))
-        throw std::invalid_argument("restitution must be in (0, 1]");
-    if (!(p.beta >= -1.0 && p.beta <= 1.0)) throw std::invalid_argument("beta must be in [-1, 1]");
+    auto check_rule = [](const Rule& r, const std::string& who) {
+        const bool ok_e = r.law == Rule::kConstant ? (r.e > 0.0 && r.e <= 1.0)
+                          : r.law == Rule::kCampbellExp ? r.speed > 0.0
+                          : r.law == Rule::kGutt ? (r.e1 >= 0.0 && r.e1 <= 1.0 && r.e2 >= 0.0 &&
+                                                     r.e2 <= 1.0 && r.crossover > 0.0)
+                                                  : false;
+        if (!ok_e) throw std::invalid_argument(who + " restitution must be in (0, 1]");
+        if (!(r.beta >= -1.0 && r.beta <= 1.0) || !(r.beta0 >= -1.0 && r.beta0 <= 1.0))
+            throw std::invalid_argument(who + " beta must be in [-1, 1]");
+        if (!(r.mu >= 0.0)) throw std::invalid_argument(who + " mu must be >= 0");
+    };
+    check_rule(p.pair, "pair");
+    if (p.pair.tangential == Rule::kNoSlip)
+        throw std::invalid_argument("the no-slip rule is for walls only");
     if (!(p.inertia_k >= 0.0)) throw std::invalid_argument("inertia_k must be >= 0");
     if (!(p.tc >= 0.0)) throw std::invalid_argument("tc must be >= 0");
     if (n < 1 || n > (std::int64_t{1} << 30)) throw std::invalid_argument("need 1 <= N < 2^30");
-    if (p.dim == 2) p_.box[2] = 1.0;
+    for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(p.gravity[a])) throw std::invalid_argument("gravity must be finite");
+    if (p.dim == 2) {
+        p_.box[2] = 1.0;
+        p_.gravity[2] = 0.0;
+    }
+    gravity_ = p_.gravity[0] != 0.0 || p_.gravity[1] != 0.0 || p_.gravity[2] != 0.0;
+    if (p.shear_rate != 0.0 && (!p.periodic_y || !std::isfinite(p.shear_rate)))
+        throw std::invalid_argument("Lees-Edwards shear needs a periodic y");
+    if (p.periodic_y) {
+        p_.wall[0].present = p_.wall[1].present = false;
+    } else {
+        for (int s = 0; s < 2; ++s)
+            if (p.wall[s].present) check_rule(p.wall[s].rule, s == 0 ? "lower wall" : "upper wall");
+        if (!(p.y_hi > p.y_lo)) throw std::invalid_argument("y_hi must exceed y_lo");
+    }
+    if (p.stress_bins < 0 || (p.stress_bins > 0 && !(p.stress_width > 0.0)))
+        throw std::invalid_argument("stress bins need a positive width");
+    if (p.log_every < 0 || p.log_capacity < 0)
+        throw std::invalid_argument("log_every and log_capacity must be >= 0");
+    stress_.assign(static_cast<std::size_t>(9 * p.stress_bins), 0.0);
     const std::size_t N = static_cast<std::size_t>(n);
     P_.assign(N, Particle{});
     w_.assign(3 * N, 0.0);
@@ -69,7 +142,7 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     m_.resize(N);
     count_.assign(N, 0);
     cell_.assign(3 * N, 0);
-    double dmax = 0.0;
+    dmax_ = 0.0;
     const int nrot = p.dim == 2 ? 1 : 3;
     for (std::size_t i = 0; i < N; ++i) {
         for (int a = 0; a < p.dim; ++a) {
@@ -77,8 +150,10 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
             double x = pos[i * p.dim + a];
             if (!std::isfinite(x) || !std::isfinite(vel[i * p.dim + a]))
                 throw std::invalid_argument("non-finite position or velocity");
-            x = x - L * std::floor(x / L);
-            if (x >= L) x -= L;
+            if (a != 1 || p_.periodic_y) {
+                x = x - L * std::floor(x / L);
+                if (x >= L) x -= L;
+            }
             P_[i].x[a] = x;
             P_[i].v[a] = vel[i * p.dim + a];
         }
@@ -90,35 +165,11 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
             throw std::invalid_argument("diameters and masses must be positive");
         P_[i].r = 0.5 * diameter[i];
         m_[i] = mass[i];
-        dmax = std::max(dmax, diameter[i]);
+        dmax_ = std::max(dmax_, diameter[i]);
     }
-    // cells: width >= the largest diameter, at least 3 per axis, at most ~8 per particle
-    double width = dmax;
-    for (int iter = 0; iter < 200; ++iter) {
-        std::int64_t total = 1;
-        for (int a = 0; a < p.dim; ++a) {
-            ncell_[a] = static_cast<int>(std::floor(p_.box[a] / width));
-            total *= ncell_[a];
-        }
-        if (total <= std::max<std::int64_t>(8 * n, 64)) break;
-        width *= 1.1;
-    }
-    for (int a = 0; a < p.dim; ++a) {
-        if (ncell_[a] < 3)
-            throw std::invalid_argument(
-                "every box length must be at least 3 largest diameters (axis " +
-                std::to_string(a) + ": " + std::to_string(p_.box[a]) + ")");
-        cw_[a] = p_.box[a] / ncell_[a];
-    }
-    if (p.dim == 2) {
-        ncell_[2] = 1;
-        cw_[2] = p_.box[2];
-    }
+    setup_grid();
     for (std::size_t i = 0; i < N; ++i)
-        for (int a = 0; a < p.dim; ++a) {
-            int c = static_cast<int>(std::floor(P_[i].x[a] / cw_[a]));
-            cell_[3 * i + a] = std::clamp(c, 0, ncell_[a] - 1);
-        }
+        for (int a = 0; a < p.dim; ++a) cell_[3 * i + a] = cell_of(P_[i].x[a], a);
     // internal order: by cell (neighbours close in memory); order_[internal] = input index
     order_.resize(N);
     for (std::size_t i = 0; i < N; ++i) order_[i] = static_cast<std::int32_t>(i);
@@ -147,13 +198,51 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     co_t_.assign(N, kInf);
     co_partner_.assign(N, -1);
     co_count_.assign(N, 0);
-    ev_t_.assign(N, kInf);
-    ev_partner_.assign(N, kNone);
-    ev_count_.assign(N, 0);
-    heap_.resize(N);
-    pos_in_heap_.resize(N);
+    ev_t_.assign(N + 1, kInf);
+    ev_partner_.assign(N + 1, kNone);
+    ev_count_.assign(N + 1, 0);
+    heap_.resize(N + 1);
+    pos_in_heap_.resize(N + 1);
     predict_all();
+    schedule_system();
     heap_build();
+}
+
+// Cells: width >= the largest diameter, >= 3 per periodic axis, at most ~8 per particle. A
+// non-periodic y is covered from y_lo to y_hi; its first and last rows are open-ended.
+void EventDriven::setup_grid() {
+    double width = dmax_;
+    const std::int64_t n = n_;
+    for (int iter = 0; iter < 400; ++iter) {
+        std::int64_t total = 1;
+        for (int a = 0; a < p_.dim; ++a) {
+            const double L = (a == 1 && !p_.periodic_y) ? p_.y_hi - p_.y_lo : p_.box[a];
+            ncell_[a] = std::max(1, static_cast<int>(std::floor(L / width)));
+            total *= ncell_[a];
+        }
+        if (total <= std::max<std::int64_t>(8 * n, 64)) break;
+        width *= 1.1;
+    }
+    for (int a = 0; a < p_.dim; ++a) {
+        const bool periodic = a != 1 || p_.periodic_y;
+        if (periodic && ncell_[a] < 3)
+            throw std::invalid_argument(
+                "every periodic box length must be at least 3 largest diameters (axis " +
+                std::to_string(a) + ": " + std::to_string(p_.box[a]) + ")");
+        const double L = periodic ? p_.box[a] : p_.y_hi - p_.y_lo;
+        cw_[a] = L / ncell_[a];
+        org_[a] = periodic ? 0.0 : p_.y_lo;
+    }
+    if (p_.dim == 2) {
+        ncell_[2] = 1;
+        cw_[2] = p_.box[2];
+        org_[2] = 0.0;
+    }
+}
+
+int EventDriven::cell_of(double x, int axis) const {
+    const int c = static_cast<int>(std::floor((x - org_[axis]) / cw_[axis]));
+    return std::clamp(c, 0, ncell_[axis] - 1);
 }
 
 void EventDriven::build_cells() {
@@ -181,85 +270,164 @@ void EventDriven::remove_cell(std::int32_t i) {
     if (next_[i] >= 0) prev_[next_[i]] = prev_[i];
 }
 
-void EventDriven::advance(std::int32_t i, double t) {
-    const double dt = t - P_[i].t;
-    if (dt != 0.0) {
-        for (int a = 0; a < 3; ++a) P_[i].x[a] += P_[i].v[a] * dt;
-        P_[i].t = t;
+void EventDriven::state_at(std::int32_t i, double tt, double x[3], double v[3]) const {
+    const double dt = tt - P_[i].t;
+    const double* g = p_.gravity;
+    for (int a = 0; a < 3; ++a) {
+        x[a] = P_[i].x[a] + (P_[i].v[a] + 0.5 * g[a] * dt) * dt;
+        v[a] = P_[i].v[a] + g[a] * dt;
     }
 }
 
-// Separation j - i at time tt, with j's periodic image chosen from the cell offset
-// (unambiguous with >= 3 cells per axis).
-void EventDriven::image(std::int32_t i, std::int32_t j, double tt, double dr[3]) const {
-    for (int a = 0; a < 3; ++a) {
-        const int dc = cell_[3 * j + a] - cell_[3 * i + a];
-        double shift = 0.0;
-        if (dc > 1) shift = -p_.box[a];
-        else if (dc < -1) shift = p_.box[a];
-        dr[a] = (P_[j].x[a] + P_[j].v[a] * (tt - P_[j].t)) + shift -
-                (P_[i].x[a] + P_[i].v[a] * (tt - P_[i].t));
+void EventDriven::advance(std::int32_t i, double t) {
+    const double dt = t - P_[i].t;
+    if (dt == 0.0) return;
+    if (gravity_) {
+        const double* g = p_.gravity;
+        double dx[3];
+        for (int a = 0; a < 3; ++a) {
+            dx[a] = (P_[i].v[a] + 0.5 * g[a] * dt) * dt;
+            P_[i].x[a] += dx[a];
+            P_[i].v[a] += g[a] * dt;
+        }
+        gravity_work_ += m_[i] * dot3(g, dx);
+    } else {
+        for (int a = 0; a < 3; ++a) P_[i].x[a] += P_[i].v[a] * dt;
+    }
+    P_[i].t = t;
+}
+
+double EventDriven::le_delta(double t) const {
+    return le_cell_ * cw_[0] + p_.shear_rate * p_.box[1] * (t - le_t_);
+}
+
+double EventDriven::shear_offset() const {
+    if (p_.shear_rate == 0.0) return 0.0;
+    const double L = p_.box[0];
+    double d = le_delta(time_);
+    d -= L * std::floor(d / L);
+    return d >= L ? d - L : d;
+}
+
+// Separation dr = r_j - r_i at time_ (j's nearest image: cell offsets along y, minimum image
+// along x and z) and the velocity shift vs of that image (Lees–Edwards: ± rate Ly along x).
+void EventDriven::separation(std::int32_t i, std::int32_t j, double dr[3], double vs[3]) const {
+    double xi[3], vi[3], xj[3], vj[3];
+    state_at(i, time_, xi, vi);
+    state_at(j, time_, xj, vj);
+    vs[0] = vs[1] = vs[2] = 0.0;
+    for (int a = 0; a < 3; ++a) dr[a] = xj[a] - xi[a];
+    if (p_.periodic_y) {
+        const int dc = cell_[3 * j + 1] - cell_[3 * i + 1];
+        const int side = dc < -1 ? 1 : dc > 1 ? -1 : 0;  // j's image above (+1) or below (-1)
+        if (side != 0) {
+            dr[1] += side * p_.box[1];
+            dr[0] += side * le_delta(time_);
+            vs[0] = side * p_.shear_rate * p_.box[1];
+        }
+    }
+    for (int a = 0; a < p_.dim; ++a) {
+        if (a == 1) continue;
+        dr[a] -= p_.box[a] * std::nearbyint(dr[a] / p_.box[a]);
     }
     if (p_.dim == 2) dr[2] = 0.0;
 }
 
-// Scan the neighbouring cells of i (only the layer at offset `dir` along `only_axis` when
-// only_axis >= 0) and lower i's collision candidate (co_*) where a partner hits earlier.
-void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
-    const double* xi = P_[i].x;
-    const double* vi = P_[i].v;
+// Visit the particles j of the neighbouring cells of i (only the layer at offset `dir` along
+// `only_axis` when only_axis >= 0) with the shift of j's image: visit(j, shift, vshift).
+// Across a Lees–Edwards boundary the image row slides: 6 x-cells cover every partner that can
+// come within reach until the next re-scan (the offset moves by one cell width between them).
+template <typename F>
+void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& visit) const {
     const std::int32_t* ci = &cell_[3 * i];
     const int zr = p_.dim == 3 ? 1 : 0;
+    for (int dz = -zr; dz <= zr; ++dz) {
+        if (only_axis == 2 && dz != dir) continue;
+        for (int dy = -1; dy <= 1; ++dy) {
+            if (only_axis == 1 && dy != dir) continue;
+            std::int32_t c[3] = {0, ci[1] + dy, ci[2] + dz};
+            double shift[3] = {0.0, 0.0, 0.0}, vshift[3] = {0.0, 0.0, 0.0};
+            int side = 0;
+            if (c[1] < 0 || c[1] >= ncell_[1]) {
+                if (!p_.periodic_y) continue;
+                side = c[1] < 0 ? -1 : 1;
+                c[1] -= side * ncell_[1];
+                shift[1] = side * p_.box[1];
+            }
+            if (dz != 0) {
+                if (c[2] < 0) {
+                    c[2] += ncell_[2];
+                    shift[2] = -p_.box[2];
+                } else if (c[2] >= ncell_[2]) {
+                    c[2] -= ncell_[2];
+                    shift[2] = p_.box[2];
+                }
+            }
+            int x0 = ci[0] - 1, x1 = ci[0] + 1;
+            if (side != 0 && p_.shear_rate != 0.0) {
+                shift[0] = side * le_delta(time_);
+                vshift[0] = side * p_.shear_rate * p_.box[1];
+                if (side > 0) {
+                    x0 = ci[0] - 3 - le_cell_;
+                    x1 = ci[0] + 2 - le_cell_;
+                } else {
+                    x0 = ci[0] - 2 + le_cell_;
+                    x1 = ci[0] + 3 + le_cell_;
+                }
+            }
+            for (int cu = x0; cu <= x1; ++cu) {
+                if (only_axis == 0 && cu - ci[0] != dir) continue;
+                const int nx = ncell_[0];
+                c[0] = ((cu % nx) + nx) % nx;
+                const double s0 = shift[0] + static_cast<double>((cu - c[0]) / nx) * p_.box[0];
+                const double sh[3] = {s0, shift[1], shift[2]};
+                for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j]) {
+                    if (j == i) continue;
+                    visit(j, sh, vshift);
+                }
+            }
+        }
+    }
+}
+
+// Scan the neighbours of i and lower i's collision candidate (co_*) where a partner hits
+// earlier. Pair collision times do not depend on gravity (both partners fall alike).
+void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
+    const double* xi = P_[i].x;  // i is synchronised to time_
+    const double* vi = P_[i].v;
+    const double ri = P_[i].r;
     double best = co_t_[i] - time_;  // relative to now (inf when there is no candidate)
     std::int32_t partner = co_partner_[i];
     std::int64_t partner_count = co_count_[i];
-    for (int dz = -zr; dz <= zr; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-                const int d[3] = {dx, dy, dz};
-                if (only_axis >= 0 && d[only_axis] != dir) continue;
-                int c[3] = {ci[0] + dx, ci[1] + dy, ci[2] + dz};
-                double shift[3] = {0.0, 0.0, 0.0};
-                for (int a = 0; a < 3; ++a) {
-                    if (d[a] == 0) continue;
-                    if (c[a] < 0) {
-                        c[a] += ncell_[a];
-                        shift[a] = -p_.box[a];
-                    } else if (c[a] >= ncell_[a]) {
-                        c[a] -= ncell_[a];
-                        shift[a] = p_.box[a];
-                    }
-                }
-                for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j]) {
-                    if (j == i) continue;
-                    const double* xj = P_[j].x;
-                    const double* vj = P_[j].v;
-                    const double dtj = time_ - P_[j].t;
-                    double dr[3], dv[3];
-                    for (int a = 0; a < 3; ++a) {
-                        dr[a] = xj[a] + vj[a] * dtj + shift[a] - xi[a];
-                        dv[a] = vj[a] - vi[a];
-                    }
-                    const double b = dot3(dr, dv);
-                    if (b >= 0.0) continue;
-                    const double sigma = P_[i].r + P_[j].r;
-                    const double cc = dot3(dr, dr) - sigma * sigma;
-                    double t;
-                    if (cc <= 0.0) {
-                        t = 0.0;  // touching or overlapping and approaching: collide now
-                    } else {
-                        const double aa = dot3(dv, dv);
-                        const double disc = b * b - aa * cc;
-                        if (disc <= 0.0) continue;
-                        t = cc / (-b + std::sqrt(disc));
-                    }
-                    if (t < best || (t == best && partner >= 0 && j < partner)) {
-                        best = t;
-                        partner = j;
-                        partner_count = count_[j];
-                    }
-                }
-            }
+    const double* g = p_.gravity;
+    for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
+        const Particle& pj = P_[j];
+        const double dtj = time_ - pj.t;
+        double dr[3], dv[3];
+        for (int a = 0; a < 3; ++a) {
+            const double vj = pj.v[a] + g[a] * dtj;
+            dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj + sh[a] - xi[a];
+            dv[a] = vj + vs[a] - vi[a];
+        }
+        const double b = dot3(dr, dv);
+        if (b >= 0.0) return;
+        const double sigma = ri + pj.r;
+        const double cc = dot3(dr, dr) - sigma * sigma;
+        double t;
+        if (cc <= 0.0) {
+            t = 0.0;  // touching or overlapping and approaching: collide now
+        } else {
+            const double aa = dot3(dv, dv);
+            const double disc = b * b - aa * cc;
+            if (disc <= 0.0) return;
+            t = cc / (-b + std::sqrt(disc));
+        }
+        if (t < best || (t == best && partner >= 0 && j < partner)) {
+            best = t;
+            partner = j;
+            partner_count = count_[j];
+        }
+    });
     if (partner >= 0) {
         co_t_[i] = time_ + best;
         co_partner_[i] = partner;
@@ -267,7 +435,15 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
     }
 }
 
-// i's event: the earlier of its next cell crossing and its collision candidate.
+double EventDriven::wall_time(std::int32_t i, int side) const {
+    const Wall& w = p_.wall[side];
+    const double y = P_[i].x[1], vy = P_[i].v[1], r = P_[i].r;
+    const double yw = w.position(time_);
+    if (side == 0) return first_hit(-(y - r - yw), -(vy - w.vn), -p_.gravity[1]);
+    return first_hit(-(yw - y - r), vy - w.vn, p_.gravity[1]);
+}
+
+// i's event: the earliest of its cell crossings, wall collisions and collision candidate.
 void EventDriven::schedule(std::int32_t i) {
     const double* xi = P_[i].x;
     const double* vi = P_[i].v;
@@ -275,28 +451,39 @@ void EventDriven::schedule(std::int32_t i) {
     double best = kInf;
     std::int32_t kind = kNone;
     for (int a = 0; a < p_.dim; ++a) {
-        double t;
-        if (vi[a] > 0.0) {
-            const double hi = ci[a] + 1 == ncell_[a] ? p_.box[a] : (ci[a] + 1) * cw_[a];
-            t = (hi - xi[a]) / vi[a];
-        } else if (vi[a] < 0.0) {
-            t = (ci[a] * cw_[a] - xi[a]) / vi[a];
-        } else {
-            continue;
+        const bool open = a == 1 && !p_.periodic_y;
+        const double lo = org_[a] + ci[a] * cw_[a];
+        const double hi = ci[a] + 1 == ncell_[a] && !open ? p_.box[a] : lo + cw_[a];
+        if (!(open && ci[a] + 1 == ncell_[a])) {
+            const double t = first_hit(xi[a] - hi, vi[a], p_.gravity[a]);
+            if (t < best) {
+                best = t;
+                kind = -(a + 1);
+            }
         }
-        if (t < 0.0) t = 0.0;
-        if (t < best) {
-            best = t;
-            kind = -(a + 1);
+        if (!(open && ci[a] == 0)) {
+            const double t = first_hit(lo - xi[a], -vi[a], -p_.gravity[a]);
+            if (t < best) {
+                best = t;
+                kind = -(a + 4);
+            }
         }
     }
-    const double cross = time_ + best;
-    if (co_partner_[i] >= 0 && co_t_[i] <= cross) {
+    for (int s = 0; s < 2; ++s) {
+        if (!p_.wall[s].present) continue;
+        const double t = wall_time(i, s);
+        if (t < best) {
+            best = t;
+            kind = s == 0 ? kLowerWall : kUpperWall;
+        }
+    }
+    const double other = time_ + best;
+    if (co_partner_[i] >= 0 && co_t_[i] <= other) {
         ev_t_[i] = co_t_[i];
         ev_partner_[i] = co_partner_[i];
         ev_count_[i] = co_count_[i];
     } else {
-        ev_t_[i] = cross;
+        ev_t_[i] = other;
         ev_partner_[i] = kind;
         ev_count_[i] = 0;
     }
@@ -314,10 +501,11 @@ void EventDriven::predict(std::int32_t i) {
 // After a crossing along `axis` in direction `dir`: the collision candidate found so far is
 // still the earliest among the partners scanned before (whose trajectories are unchanged, or
 // they re-predicted themselves and scanned i), so only the newly adjacent cell layer is
-// scanned. A stale candidate (partner collided since) forces a full prediction.
+// scanned. A stale candidate (partner collided since) forces a full prediction, as does a
+// row next to a Lees–Edwards boundary (its image cells slide).
 void EventDriven::predict_crossed(std::int32_t i, int axis, int dir) {
     const std::int32_t p = co_partner_[i];
-    if (p >= 0 && count_[p] != co_count_[i]) {
+    if ((p >= 0 && count_[p] != co_count_[i]) || le_row(i)) {
         predict(i);
         return;
     }
@@ -327,6 +515,26 @@ void EventDriven::predict_crossed(std::int32_t i, int axis, int dir) {
 
 void EventDriven::predict_all() {
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) predict(i);
+}
+
+// Re-predict the particles of the two rows next to the Lees–Edwards boundary.
+void EventDriven::predict_rows() {
+    const int rows[2] = {0, ncell_[1] - 1};
+    for (int k = 0; k < (ncell_[1] > 1 ? 2 : 1); ++k)
+        for (int cz = 0; cz < ncell_[2]; ++cz)
+            for (int cx = 0; cx < ncell_[0]; ++cx) {
+                const std::int32_t c[3] = {cx, rows[k], cz};
+                for (std::int32_t i = head_[cell_index(c)]; i >= 0; i = next_[i]) {
+                    predict(i);
+                    heap_update(i);
+                }
+            }
+}
+
+void EventDriven::schedule_system() {
+    ev_partner_[n_] = kReshuffle;
+    ev_count_[n_] = 0;
+    ev_t_[n_] = p_.shear_rate != 0.0 ? le_t_ + cw_[0] / (p_.shear_rate * p_.box[1]) : kInf;
 }
 
 void EventDriven::heap_up(std::int64_t k) {
@@ -344,7 +552,7 @@ void EventDriven::heap_up(std::int64_t k) {
 
 void EventDriven::heap_down(std::int64_t k) {
     const Node node = heap_[k];
-    const std::int64_t n = n_;
+    const std::int64_t n = n_ + 1;
     while (true) {
         std::int64_t child = 2 * k + 1;
         if (child >= n) break;
@@ -369,42 +577,124 @@ void EventDriven::heap_update(std::int32_t i) {
 }
 
 void EventDriven::heap_build() {
-    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+    for (std::int32_t i = 0; i <= static_cast<std::int32_t>(n_); ++i) {
         heap_[i] = Node{ev_t_[i], i};
         pos_in_heap_[i] = i;
     }
-    for (std::int64_t k = n_ / 2 - 1; k >= 0; --k) heap_down(k);
+    for (std::int64_t k = (n_ + 1) / 2 - 1; k >= 0; --k) heap_down(k);
+}
+
+// Collisional stress per bin along y: r_ij ⊗ J_i shared among the bins the branch r_i → r_j
+// crosses, in proportion to the length inside each (a branch in one plane y = const goes to
+// its bin). Periodic y: bins wrap; otherwise parts outside the bins are dropped.
+void EventDriven::add_stress(double yi, double yj, const double dr[3], const double J[3]) {
+    const std::int64_t nb = p_.stress_bins;
+    if (nb == 0) return;
+    double t[9];
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) t[3 * a + b] = -dr[a] * J[b];
+    const double w = p_.stress_width, lo = p_.stress_lo;
+    const double ya = std::min(yi, yj), yb = std::max(yi, yj);
+    auto add = [&](std::int64_t bin, double frac) {
+        if (p_.periodic_y) bin = ((bin % nb) + nb) % nb;
+        if (bin < 0 || bin >= nb || frac <= 0.0) return;
+        double* s = &stress_[9 * bin];
+        for (int k = 0; k < 9; ++k) s[k] += frac * t[k];
+    };
+    const auto b0 = static_cast<std::int64_t>(std::floor((ya - lo) / w));
+    const auto b1 = static_cast<std::int64_t>(std::floor((yb - lo) / w));
+    if (b0 == b1 || yb == ya) {
+        add(b0, 1.0);
+        return;
+    }
+    const double len = yb - ya;
+    for (std::int64_t b = b0; b <= b1; ++b) {
+        const double s0 = std::max(ya, lo + b * w), s1 = std::min(yb, lo + (b + 1) * w);
+        add(b, (s1 - s0) / len);
+    }
+}
+
+void EventDriven::log_collision(int kind, std::int32_t i, std::int32_t j, const double point[3],
+                                const double n[3], const double branch[3], const double J[3],
+                                const double v[3], const double g[3]) {
+    ++log_seen_;
+    if (p_.log_every <= 0 || log_seen_ % p_.log_every != 0 ||
+        static_cast<std::int64_t>(log_.size()) >= p_.log_capacity)
+        return;
+    LogRecord r{};
+    r.time = time_;
+    r.kind = kind;
+    r.i = order_[i];
+    r.j = j >= 0 ? order_[j] : -1;
+    for (int a = 0; a < 3; ++a) {
+        r.point[a] = point[a];
+        r.normal[a] = n[a];
+        r.branch[a] = branch[a];
+        r.impulse[a] = J[a];
+        r.velocity[a] = v[a];
+        r.slip[a] = g[a];
+    }
+    log_.push_back(r);
+}
+
+std::vector<LogRecord> EventDriven::take_log() {
+    std::vector<LogRecord> out;
+    out.swap(log_);
+    return out;
 }
 
 void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
     advance(i, time_);
     advance(j, time_);
-    double dr[3];
-    image(i, j, time_, dr);
+    double dr[3], vs[3];
+    separation(i, j, dr, vs);
     const double dist = std::sqrt(dot3(dr, dr));
     double n[3] = {dr[0] / dist, dr[1] / dist, dr[2] / dist};
-    double e = p_.restitution, beta = p_.beta;
-    if (p_.tc > 0.0 && (time_ - last_[i] < p_.tc || time_ - last_[j] < p_.tc)) {
-        e = 1.0;
-        beta = -1.0;
-        ++tc_elastic_;
-    }
-    last_[i] = last_[j] = time_;
     double* vi = P_[i].v;
     double* vj = P_[j].v;
     double* wi = &w_[3 * i];
     double* wj = &w_[3 * j];
-    const double K = p_.inertia_k;
+    const double ri = P_[i].r, rj = P_[j].r, K = p_.inertia_k;
+    double vji[3];  // j's image velocity
+    for (int a = 0; a < 3; ++a) vji[a] = vj[a] + vs[a];
+    // pre-collision contact-point velocity g = vi - vj + (ri wi + rj wj) x n
+    double s[3], sxn[3], g[3], vrel[3];
+    for (int a = 0; a < 3; ++a) s[a] = ri * wi[a] + rj * wj[a];
+    cross3(s, n, sxn);
+    for (int a = 0; a < 3; ++a) {
+        vrel[a] = vi[a] - vji[a];
+        g[a] = vrel[a] + sxn[a];
+    }
+    const double gn = dot3(g, n);
+    double gt2 = 0.0;
+    for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
+    double e, beta;
+    if (p_.tc > 0.0 && (time_ - last_[i] < p_.tc || time_ - last_[j] < p_.tc)) {
+        e = 1.0;
+        beta = -1.0;
+        ++tc_elastic_;
+    } else {
+        e = p_.pair.restitution(std::max(gn, 0.0));
+        beta = p_.pair.beta_for(e, K, std::max(gn, 0.0), std::sqrt(gt2));
+    }
+    last_[i] = last_[j] = time_;
     auto energy = [&]() {
-        return 0.5 * m_[i] * (dot3(vi, vi) + K * P_[i].r * P_[i].r * dot3(wi, wi)) +
-               0.5 * m_[j] * (dot3(vj, vj) + K * P_[j].r * P_[j].r * dot3(wj, wj));
+        return 0.5 * m_[i] * (dot3(vi, vi) + K * ri * ri * dot3(wi, wi)) +
+               0.5 * m_[j] * (dot3(vji, vji) + K * rj * rj * dot3(wj, wj));
     };
-    const double before = (e < 1.0 || beta > -1.0) ? energy() : 0.0;
+    const double before = energy();
     double J[3];
-    collide_pair(n, P_[i].r, P_[j].r, m_[i], m_[j], K, e, beta, vi, vj, wi, wj, J);
-    if (e < 1.0 || (beta > -1.0 && beta < 1.0)) dissipated_ += before - energy();
+    collide(n, ri, rj, 1.0 / m_[i], 1.0 / m_[j], K, e, beta, vi, vji, wi, wj, J);
+    dissipated_ += before - energy();
+    for (int a = 0; a < 3; ++a) vj[a] = vji[a] - vs[a];
     for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) virial_[3 * a + b] += -dr[a] * J[b];
+    add_stress(P_[i].x[1], P_[i].x[1] + dr[1], dr, J);
+    if (p_.log_every > 0) {
+        double point[3];
+        for (int a = 0; a < 3; ++a) point[a] = P_[i].x[a] + n[a] * ri;
+        log_collision(0, i, j, point, n, dr, J, vrel, g);
+    }
     ++count_[i];
     ++count_[j];
     ++collisions_;
@@ -414,35 +704,134 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
     heap_update(j);
 }
 
-void EventDriven::process_crossing(std::int32_t i, int axis) {
+// A wall is a body of infinite mass moving with (u_x, v_n, u_z). A particle pressed onto it by
+// gravity leaves with at least ½ t_r |g_n| (t_r = tc, or 1e-8 when the TC model is off), so
+// it hops with a period of at least t_r instead of colliding infinitely often.
+void EventDriven::process_wall(std::int32_t i, int side) {
     advance(i, time_);
-    remove_cell(i);
-    std::int32_t& c = cell_[3 * i + axis];
-    const int v_dir = P_[i].v[axis] > 0.0 ? 1 : -1;
-    if (v_dir > 0) {
-        if (++c == ncell_[axis]) {
-            c = 0;
-            P_[i].x[axis] -= p_.box[axis];
+    Wall& w = p_.wall[side];
+    const double n[3] = {0.0, side == 0 ? -1.0 : 1.0, 0.0};  // particle -> wall
+    double uw[3] = {w.u[0], w.vn, p_.dim == 3 ? w.u[2] : 0.0};
+    double* v = P_[i].v;
+    double* om = &w_[3 * i];
+    const double r = P_[i].r, m = m_[i], K = p_.inertia_k;
+    double vrel[3], rw[3], rwxn[3], g[3];
+    for (int a = 0; a < 3; ++a) {
+        vrel[a] = v[a] - uw[a];
+        rw[a] = r * om[a];
+    }
+    cross3(rw, n, rwxn);
+    for (int a = 0; a < 3; ++a) g[a] = vrel[a] + rwxn[a];
+    const double gn = dot3(g, n);
+    double gt2 = 0.0;
+    for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
+    const Rule& rule = w.rule;
+    const double e = rule.restitution(std::max(gn, 0.0));
+    auto energy = [&]() {  // in the wall's frame
+        double u[3];
+        for (int a = 0; a < 3; ++a) u[a] = v[a] - uw[a];
+        return 0.5 * m * (dot3(u, u) + K * r * r * dot3(om, om));
+    };
+    const double before = energy();
+    double J[3] = {0.0, 0.0, 0.0};
+    if (rule.tangential == Rule::kNoSlip) {
+        // Campbell's no-slip wall: the centre takes the wall's tangential velocity, the spin
+        // is unchanged, the normal velocity is reversed with e_w
+        const double vn = dot3(vrel, n);
+        for (int a = 0; a < 3; ++a) {
+            const double new_v = a == 1 ? uw[1] - e * vn * n[1] : uw[a];
+            J[a] = m * (new_v - v[a]);
+            v[a] = new_v;
         }
     } else {
-        if (--c < 0) {
-            c = ncell_[axis] - 1;
-            P_[i].x[axis] += p_.box[axis];
+        const double beta = rule.beta_for(e, K, std::max(gn, 0.0), std::sqrt(gt2));
+        double dummy[3] = {0.0, 0.0, 0.0};
+        collide(n, r, 0.0, 1.0 / m, 0.0, K, e, beta, v, uw, om, dummy, J);
+    }
+    // minimum rebound under gravity
+    const double gnorm = dot3(p_.gravity, n);
+    if (gnorm > 0.0) {
+        const double rest = p_.tc > 0.0 ? p_.tc : 1e-8;
+        const double vmin = 0.5 * rest * gnorm;
+        double out[3];
+        for (int a = 0; a < 3; ++a) out[a] = v[a] - uw[a];
+        const double vout = -dot3(out, n);  // > 0: leaving the wall
+        if (vout < vmin) {
+            const double dv = vout - vmin;  // add (vmin - vout) away from the wall
+            for (int a = 0; a < 3; ++a) {
+                v[a] += dv * n[a];
+                J[a] += m * dv * n[a];
+            }
+            ++resting_;
         }
     }
-    insert_cell(i);
-    ++crossings_;
-    predict_crossed(i, axis, v_dir);
+    dissipated_ += before - energy();
+    wall_work_[side] += dot3(J, uw);
+    for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
+    if (p_.log_every > 0) {
+        double point[3], branch[3];
+        for (int a = 0; a < 3; ++a) {
+            branch[a] = r * n[a];
+            point[a] = P_[i].x[a] + branch[a];
+        }
+        log_collision(side + 1, i, -1, point, n, branch, J, vrel, g);
+    }
+    last_[i] = time_;
+    ++count_[i];
+    ++wall_collisions_;
+    predict(i);
     heap_update(i);
 }
 
-bool EventDriven::advance_to(double t, std::int64_t max_events) {
+void EventDriven::process_crossing(std::int32_t i, int code) {
+    advance(i, time_);
+    const int axis = code >= -3 ? -code - 1 : -code - 4;
+    const int dir = code >= -3 ? 1 : -1;
+    remove_cell(i);
+    std::int32_t& c = cell_[3 * i + axis];
+    bool wrapped = false;
+    c += dir;
+    if (c == ncell_[axis] || c < 0) {  // periodic axes only (open rows have no crossing out)
+        c = c < 0 ? ncell_[axis] - 1 : 0;
+        P_[i].x[axis] -= dir * p_.box[axis];
+        wrapped = true;
+    }
+    if (wrapped && axis == 1 && p_.shear_rate != 0.0) {
+        // through a Lees–Edwards boundary: take the image's x position and velocity
+        const double L = p_.box[0];
+        double x = P_[i].x[0] - dir * le_delta(time_);
+        x -= L * std::floor(x / L);
+        if (x >= L) x -= L;
+        P_[i].x[0] = x;
+        P_[i].v[0] -= dir * p_.shear_rate * p_.box[1];
+        cell_[3 * i] = cell_of(x, 0);
+    }
+    insert_cell(i);
+    ++crossings_;
+    if (wrapped && axis == 1 && p_.shear_rate != 0.0)
+        predict(i);
+    else
+        predict_crossed(i, axis, dir);
+    heap_update(i);
+}
+
+// The Lees–Edwards offset has moved by one cell width: re-scan the rows next to the boundary.
+void EventDriven::process_reshuffle() {
+    le_cell_ = (le_cell_ + 1) % ncell_[0];
+    le_t_ = time_;
+    schedule_system();
+    heap_update(static_cast<std::int32_t>(n_));
+    predict_rows();
+}
+
+bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t stop_collisions) {
     if (!(t >= time_)) throw std::invalid_argument("advance_to: time must not decrease");
     if (!std::isfinite(t)) throw std::invalid_argument("advance_to: time must be finite");
-    const std::int64_t start = collisions_ + crossings_;
+    const std::int64_t start = events();
     bool reached = true;
     while (true) {
-        if (max_events > 0 && collisions_ + crossings_ - start >= max_events) {
+        if ((max_events > 0 && events() - start >= max_events) ||
+            (stop_collisions > 0 && collisions_ >= stop_collisions)) {
             reached = false;
             break;
         }
@@ -450,6 +839,10 @@ bool EventDriven::advance_to(double t, std::int64_t max_events) {
         const double et = heap_[0].t;
         if (!(et <= t)) break;
         time_ = et;
+        if (i == static_cast<std::int32_t>(n_)) {
+            process_reshuffle();
+            continue;
+        }
         const std::int32_t p = ev_partner_[i];
         if (p >= 0) {
             if (count_[p] != ev_count_[i]) {
@@ -459,8 +852,12 @@ bool EventDriven::advance_to(double t, std::int64_t max_events) {
             } else {
                 process_collision(i, p);
             }
+        } else if (p == kLowerWall || p == kUpperWall) {
+            process_wall(i, p == kLowerWall ? 0 : 1);
+        } else if (p >= -6) {
+            process_crossing(i, p);
         } else {
-            process_crossing(i, -p - 1);
+            throw std::logic_error("edmd: corrupt event queue");
         }
     }
     if (reached) time_ = t;
@@ -468,22 +865,70 @@ bool EventDriven::advance_to(double t, std::int64_t max_events) {
     return reached;
 }
 
+void EventDriven::set_wall(int side, double y, double vn, double ux, double uz) {
+    if (side < 0 || side > 1 || !p_.wall[side].present)
+        throw std::invalid_argument("set_wall: no such wall");
+    if (!std::isfinite(y) || !std::isfinite(vn) || !std::isfinite(ux) || !std::isfinite(uz))
+        throw std::invalid_argument("set_wall: values must be finite");
+    Wall& w = p_.wall[side];
+    w.y0 = y;
+    w.t0 = time_;
+    w.vn = vn;
+    w.u[0] = ux;
+    w.u[2] = p_.dim == 3 ? uz : 0.0;
+    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+        advance(i, time_);
+        schedule(i);
+    }
+    heap_build();
+}
+
+void EventDriven::scale_width(double factor) {
+    if (!(factor > 0.0) || !std::isfinite(factor))
+        throw std::invalid_argument("scale_width: factor must be positive");
+    if (p_.shear_rate != 0.0) throw std::invalid_argument("scale_width: not with Lees-Edwards");
+    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+        advance(i, time_);
+        P_[i].x[0] *= factor;
+    }
+    p_.box[0] *= factor;
+    setup_grid();
+    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+        double& x = P_[i].x[0];
+        x -= p_.box[0] * std::floor(x / p_.box[0]);
+        if (x >= p_.box[0]) x -= p_.box[0];
+        cell_[3 * i] = cell_of(x, 0);
+    }
+    build_cells();
+    predict_all();
+    heap_build();
+}
+
 void EventDriven::positions(double* out) const {
     for (std::int64_t i = 0; i < n_; ++i) {
         const std::int64_t o = order_[i];
+        double x[3], v[3];
+        state_at(static_cast<std::int32_t>(i), time_, x, v);
         for (int a = 0; a < p_.dim; ++a) {
             const double L = p_.box[a];
-            double x = P_[i].x[a] + P_[i].v[a] * (time_ - P_[i].t);
-            x -= L * std::floor(x / L);
-            if (x >= L) x -= L;
-            out[o * p_.dim + a] = x;
+            double xa = x[a];
+            if (a == 1 && p_.shear_rate != 0.0) {
+                xa = std::clamp(xa, 0.0, std::nextafter(L, 0.0));  // wrapping needs the offset
+            } else if (a != 1 || p_.periodic_y) {
+                xa -= L * std::floor(xa / L);
+                if (xa >= L) xa -= L;
+            }
+            out[o * p_.dim + a] = xa;
         }
     }
 }
 
 void EventDriven::velocities(double* out) const {
-    for (std::int64_t i = 0; i < n_; ++i)
-        for (int a = 0; a < p_.dim; ++a) out[order_[i] * p_.dim + a] = P_[i].v[a];
+    for (std::int64_t i = 0; i < n_; ++i) {
+        double x[3], v[3];
+        state_at(static_cast<std::int32_t>(i), time_, x, v);
+        for (int a = 0; a < p_.dim; ++a) out[order_[i] * p_.dim + a] = v[a];
+    }
 }
 
 void EventDriven::angular_velocities(double* out) const {
@@ -498,7 +943,11 @@ void EventDriven::angular_velocities(double* out) const {
 
 double EventDriven::kinetic_energy() const {
     double e = 0.0;
-    for (std::int64_t i = 0; i < n_; ++i) e += 0.5 * m_[i] * dot3(P_[i].v, P_[i].v);
+    for (std::int64_t i = 0; i < n_; ++i) {
+        double x[3], v[3];
+        state_at(static_cast<std::int32_t>(i), time_, x, v);
+        e += 0.5 * m_[i] * dot3(v, v);
+    }
     return e;
 }
 
@@ -512,12 +961,15 @@ double EventDriven::rotational_energy() const {
 EventDriven::State EventDriven::get_state() const {
     State s;
     s.pos.resize(3 * n_);
-    for (std::int64_t i = 0; i < n_; ++i)
-        for (int a = 0; a < 3; ++a)
-            s.pos[3 * i + a] = P_[i].x[a] + P_[i].v[a] * (time_ - P_[i].t);
     s.vel.resize(3 * n_);
-    for (std::int64_t i = 0; i < n_; ++i)
-        for (int a = 0; a < 3; ++a) s.vel[3 * i + a] = P_[i].v[a];
+    for (std::int64_t i = 0; i < n_; ++i) {
+        double x[3], v[3];
+        state_at(static_cast<std::int32_t>(i), time_, x, v);
+        for (int a = 0; a < 3; ++a) {
+            s.pos[3 * i + a] = x[a];
+            s.vel[3 * i + a] = v[a];
+        }
+    }
     s.omega = w_;
     s.last = last_;
     s.count = count_;
@@ -528,37 +980,53 @@ EventDriven::State EventDriven::get_state() const {
     s.co_time = co_t_;
     s.co_partner = co_partner_;
     s.co_count = co_count_;
-    s.time = time_;
-    s.dissipated = dissipated_;
-    std::copy(virial_, virial_ + 9, s.virial);
-    s.collisions = collisions_;
-    s.crossings = crossings_;
-    s.invalid = invalid_;
-    s.tc_elastic = tc_elastic_;
+    s.stress = stress_;
+    s.scalars = {time_, dissipated_, gravity_work_, p_.box[0], le_t_,
+                 static_cast<double>(le_cell_)};
+    for (int k = 0; k < 2; ++k) {
+        const Wall& w = p_.wall[k];
+        s.scalars.insert(s.scalars.end(), {w.y0, w.t0, w.vn, w.u[0], w.u[2]});
+    }
+    for (int k = 0; k < 2; ++k)
+        s.scalars.insert(s.scalars.end(), wall_impulse_[k], wall_impulse_[k] + 3);
+    s.scalars.insert(s.scalars.end(), {wall_work_[0], wall_work_[1]});
+    s.scalars.insert(s.scalars.end(), virial_, virial_ + 9);
+    s.counters = {collisions_, crossings_, invalid_, tc_elastic_, resting_, wall_collisions_,
+                  log_seen_};
     return s;
 }
 
 void EventDriven::set_state(const State& s) {
     const std::size_t N = static_cast<std::size_t>(n_);
     if (s.pos.size() != 3 * N || s.vel.size() != 3 * N || s.omega.size() != 3 * N ||
-        s.last.size() != N || s.count.size() != N || s.cell.size() != 3 * N)
+        s.last.size() != N || s.count.size() != N || s.cell.size() != 3 * N ||
+        s.scalars.size() != 33 || s.counters.size() != 7 || s.stress.size() != stress_.size())
         throw std::invalid_argument("set_state: array sizes do not match this system");
     const bool events = !s.ev_time.empty();
-    if (events && (s.ev_time.size() != N || s.ev_partner.size() != N || s.ev_count.size() != N ||
-                   s.co_time.size() != N || s.co_partner.size() != N || s.co_count.size() != N))
+    if (events && (s.ev_time.size() != N + 1 || s.ev_partner.size() != N + 1 ||
+                   s.ev_count.size() != N + 1 || s.co_time.size() != N ||
+                   s.co_partner.size() != N || s.co_count.size() != N))
         throw std::invalid_argument("set_state: event arrays do not match this system");
-    if (events)
+    const double t = s.scalars[0];
+    if (events) {
         for (std::size_t i = 0; i < N; ++i)
             if (s.co_partner[i] < -1 || s.co_partner[i] >= n_ || std::isnan(s.co_time[i]))
                 throw std::invalid_argument("set_state: invalid collision candidate");
-    if (events)
-        for (std::size_t i = 0; i < N; ++i) {
+        for (std::size_t i = 0; i <= N; ++i) {
             const std::int32_t p = s.ev_partner[i];
-            if (!(p == kNone || (p < 0 && p >= -p_.dim) ||
-                  (p >= 0 && p < n_ && p != static_cast<std::int32_t>(i))) ||
-                std::isnan(s.ev_time[i]) || s.ev_time[i] < s.time)
+            const bool ok = i == N ? p == kReshuffle
+                                   : (p == kNone || (p < 0 && p >= kUpperWall) ||
+                                      (p >= 0 && p < n_ && p != static_cast<std::int32_t>(i)));
+            if (!ok || std::isnan(s.ev_time[i]) || s.ev_time[i] < t)
                 throw std::invalid_argument("set_state: invalid scheduled event");
         }
+    }
+    const double box_x = s.scalars[3];
+    if (!(box_x > 0.0)) throw std::invalid_argument("set_state: invalid box");
+    if (box_x != p_.box[0]) {
+        p_.box[0] = box_x;
+        setup_grid();
+    }
     for (std::size_t k = 0; k < 3 * N; ++k) {
         const int a = static_cast<int>(k % 3);
         if (s.cell[k] < 0 || s.cell[k] >= ncell_[a])
@@ -568,19 +1036,40 @@ void EventDriven::set_state(const State& s) {
         for (int a = 0; a < 3; ++a) {
             P_[i].x[a] = s.pos[3 * i + a];
             P_[i].v[a] = s.vel[3 * i + a];
-            P_[i].t = s.time;
+            P_[i].t = t;
         }
     w_ = s.omega;
     last_ = s.last;
     count_ = s.count;
     cell_ = s.cell;
-    time_ = s.time;
-    dissipated_ = s.dissipated;
-    std::copy(s.virial, s.virial + 9, virial_);
-    collisions_ = s.collisions;
-    crossings_ = s.crossings;
-    invalid_ = s.invalid;
-    tc_elastic_ = s.tc_elastic;
+    stress_ = s.stress;
+    time_ = t;
+    dissipated_ = s.scalars[1];
+    gravity_work_ = s.scalars[2];
+    le_t_ = s.scalars[4];
+    le_cell_ = static_cast<std::int32_t>(s.scalars[5]);
+    std::size_t k = 6;
+    for (int side = 0; side < 2; ++side) {
+        Wall& w = p_.wall[side];
+        w.y0 = s.scalars[k++];
+        w.t0 = s.scalars[k++];
+        w.vn = s.scalars[k++];
+        w.u[0] = s.scalars[k++];
+        w.u[2] = s.scalars[k++];
+    }
+    for (int side = 0; side < 2; ++side)
+        for (int a = 0; a < 3; ++a) wall_impulse_[side][a] = s.scalars[k++];
+    wall_work_[0] = s.scalars[k++];
+    wall_work_[1] = s.scalars[k++];
+    for (int a = 0; a < 9; ++a) virial_[a] = s.scalars[k++];
+    collisions_ = s.counters[0];
+    crossings_ = s.counters[1];
+    invalid_ = s.counters[2];
+    tc_elastic_ = s.counters[3];
+    resting_ = s.counters[4];
+    wall_collisions_ = s.counters[5];
+    log_seen_ = s.counters[6];
+    log_.clear();
     build_cells();
     if (events) {
         ev_t_ = s.ev_time;
@@ -591,6 +1080,7 @@ void EventDriven::set_state(const State& s) {
         co_count_ = s.co_count;
     } else {
         predict_all();
+        schedule_system();
     }
     heap_build();
 }
@@ -599,29 +1089,38 @@ std::int64_t EventDriven::memory_bytes() const {
     auto b = [](const auto& v) {
         return static_cast<std::int64_t>(v.capacity() * sizeof(v[0]));
     };
-    return b(P_) + b(order_) + b(w_) + b(last_) + b(m_) + b(count_) + b(cell_) +
-           b(head_) + b(next_) + b(prev_) + b(ev_t_) + b(ev_partner_) + b(ev_count_) +
-           b(co_t_) + b(co_partner_) + b(co_count_) +
-           b(heap_) + b(pos_in_heap_) + static_cast<std::int64_t>(sizeof(*this));
+    return b(P_) + b(order_) + b(w_) + b(last_) + b(m_) + b(count_) + b(cell_) + b(head_) +
+           b(next_) + b(prev_) + b(ev_t_) + b(ev_partner_) + b(ev_count_) + b(co_t_) +
+           b(co_partner_) + b(co_count_) + b(heap_) + b(pos_in_heap_) + b(stress_) + b(log_) +
+           static_cast<std::int64_t>(sizeof(*this));
 }
 
 double EventDriven::min_gap() const {
     double best = kInf;
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
-        const std::int32_t* ci = &cell_[3 * i];
-        const int zr = p_.dim == 3 ? 1 : 0;
-        for (int dz = -zr; dz <= zr; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    int c[3] = {ci[0] + dx, ci[1] + dy, ci[2] + dz};
-                    for (int a = 0; a < 3; ++a) c[a] = (c[a] + ncell_[a]) % ncell_[a];
-                    for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j]) {
-                        if (j <= i) continue;
-                        double dr[3];
-                        image(i, j, time_, dr);
-                        best = std::min(best, std::sqrt(dot3(dr, dr)) - P_[i].r - P_[j].r);
-                    }
-                }
+        double xi[3], vi[3];
+        state_at(i, time_, xi, vi);
+        for_neighbours(i, -1, 0, [&](std::int32_t j, const double* sh, const double*) {
+            if (j <= i) return;
+            double xj[3], vj[3];
+            state_at(j, time_, xj, vj);
+            double dr[3];
+            for (int a = 0; a < 3; ++a) dr[a] = xj[a] + sh[a] - xi[a];
+            best = std::min(best, std::sqrt(dot3(dr, dr)) - P_[i].r - P_[j].r);
+        });
+    }
+    return best;
+}
+
+double EventDriven::min_wall_gap() const {
+    double best = kInf;
+    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+        double x[3], v[3];
+        state_at(i, time_, x, v);
+        if (p_.wall[0].present)
+            best = std::min(best, x[1] - P_[i].r - p_.wall[0].position(time_));
+        if (p_.wall[1].present)
+            best = std::min(best, p_.wall[1].position(time_) - x[1] - P_[i].r);
     }
     return best;
 }

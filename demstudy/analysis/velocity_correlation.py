@@ -1,0 +1,492 @@
+"""Spatial velocity correlations C_aa(r) and Malik's orientational correlation Lambda(y).
+
+Dimensionless particle units: d = 1, m = 1 (r in particle diameters). Axes: x flow (periodic),
+y wall-normal (the bin axis; periodic or bounded by walls), z spanwise (3D, periodic).
+Particles belong to the y-bin of their *centre*; particles outside every bin are ignored.
+
+Fluctuations. Malik (2008, §4.1) takes fluctuations relative to the mean of the particle's
+cell, without saying whether the mean is instantaneous or time-averaged. Both readings exist:
+
+* ``reference=None`` (single pass): the *instantaneous* mean of the bin in that frame,
+  u'_i = c_i - (1/N_b) sum_{j in b} c_j;
+* ``reference=BinMeans(...).results`` (second pass, the default of the two-pass helpers
+  :func:`velocity_correlations` and :func:`orientational_correlation`, and of
+  ``demstudy analyze``): the *run-mean* of the bin from a first pass over the same frames,
+  u'_i = c_i - U(b_i) (number-weighted, like :mod:`demstudy.analysis.vdf`). The first-pass
+  mean is treated as exact (its error is not propagated).
+
+Lees-Edwards (y periodic, ``frame.tilt`` != 0): a centre outside ``[lo, lo + L_y)`` is wrapped
+into the box with x shifted by -turns * tilt and u by -turns * ``image_velocity_shift``
+(= shear rate * L_y). A partner seen through the y boundary is the explicit image shifted by
++-tilt along x; its *fluctuation* is that of the particle itself, because the image velocity
+and the image's local mean velocity differ by the same shear rate * L_y.
+
+VelocityCorrelation (Malik §4.9, eq. 4.1, on fluctuations). For particle i in bin b and each
+partner j != i at distance r_ij in shell k = [k dr, (k+1) dr) (partners anywhere, or with
+``in_bin=True`` only partners in the same bin, Malik's binwise convention), per frame and bin
+the sums S_a(b, k) = sum u'_ia u'_ja, P(b, k) = number of ordered pairs, Q_a(b) = sum_i u'_ia^2
+and N(b) are block-averaged, and
+
+    covariance_a(r_k) = <S_a> / <P>          (mean product over the pairs in the shell),
+    temperature_components_a = <Q_a> / <N>   (= m <u'_a^2>, m = 1: the temperature component),
+    C_a(r_k) = covariance_a / temperature_components_a,
+
+so C_a -> 1 as r -> 0+ for a velocity field that is smooth on the particle scale and C = 0 for
+independent velocities; covariance(0+) is the temperature component. ``C_malik`` is Malik's
+literal (4.1), sum_i sum_{j>i} u'_ia u'_ja delta(r - r_ij) / sum_i u'_ia^2 with the delta
+binned as 1/dr, i.e. <S_a> / (2 dr <Q_a>) (exactly Malik's for ``in_bin=True``; it mixes
+C with the pair density: C_malik = C * pairs_per_particle / (2 dr)). ``distance="planar"``
+(only with ``in_bin``) uses the separation in the periodic x(z) plane, Malik's reading for
+g(r). Only the diagonal components a = x, y(, z) are computed.
+
+OrientationalCorrelation (Malik §4.8): per particle cos^2 Psi = (C.W)^2 / (|C|^2 |W|^2) of the
+translational fluctuation C and the spin fluctuation W (particles with C = 0 or W = 0 are
+skipped), and
+
+    lambda(y) = < (1/N_b) sum_{i in b} cos^2 Psi_i >_frames   (Malik: time average of the
+                 per-frame bin averages, over the frames in which the bin holds particles),
+    lambda_pooled(y) = sum_frames sum_i cos^2 Psi_i / sum_frames N_b.
+
+Uncorrelated isotropic 3D vectors give 1/3, parallel ones 1, perpendicular ones 0. **3D
+only**: in 2D the spin is the scalar omega_z along z, perpendicular to every in-plane
+velocity, so cos Psi = 0 identically and Lambda carries no information; 2D is refused.
+
+Errors: delete-one-block jackknife over time blocks
+(:class:`~demstudy.analysis.blocking.BlockAccumulator`); memory is flat in the number of
+frames (the pair search is chunked so that memory is bounded by ``chunk`` particles' pairs).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.spatial import cKDTree
+
+from demstudy import UNITS_NOTE
+from demstudy.analysis.base import AnalysisBase
+from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.io.frames import Frame
+
+__all__ = [
+    "BinMeans",
+    "OrientationalCorrelation",
+    "VelocityCorrelation",
+    "orientational_correlation",
+    "velocity_correlations",
+]
+
+
+def _wrap(x: np.ndarray, length: float) -> np.ndarray:
+    """x mod length in [0, length) (np.mod can round up to length itself)."""
+    x = np.mod(x, length)
+    x[x >= length] = 0.0
+    return x
+
+
+def _check_edges(edges: ArrayLike | None) -> np.ndarray | None:
+    if edges is None:
+        return None
+    e = np.asarray(edges, float)
+    if e.ndim != 1 or e.size < 2 or np.any(np.diff(e) <= 0):
+        raise ValueError("edges must be increasing with at least 2 entries")
+    return e
+
+
+class _Binned(AnalysisBase):
+    """Common set-up: y-bins of the particle centres, periodic wrapping with LE shifts."""
+
+    def __init__(self, dim: int, edges: ArrayLike | None, n_bins: int, period: float,
+                 image_velocity_shift: float, max_blocks: int, verbose: bool) -> None:
+        super().__init__(verbose=verbose)
+        if dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        if period < 0:
+            raise ValueError(f"period must be >= 0, got {period!r}")
+        if image_velocity_shift and not period:
+            raise ValueError("image_velocity_shift needs a periodic y (period > 0)")
+        self.dim, self.n_rot = dim, (1 if dim == 2 else 3)
+        self._edges = _check_edges(edges)
+        self._n_bins = int(n_bins)
+        self.period = float(period)
+        self.image_velocity_shift = float(image_velocity_shift)
+        self.max_blocks = int(max_blocks)
+
+    def _set_edges(self, frame: Frame) -> None:
+        if frame.dim != self.dim:
+            raise ValueError(f"frame is {frame.dim}D, analysis is {self.dim}D")
+        if self._edges is None:
+            lo = float(np.asarray(frame.box_lo, float)[1])
+            hi = lo + self.period if self.period else float(np.asarray(frame.box_hi, float)[1])
+            self._edges = np.linspace(lo, hi, self._n_bins + 1)
+        self.edges = self._edges
+        self.n_bins = self.edges.size - 1
+
+    def _assign(self, frame: Frame) -> dict[str, np.ndarray]:
+        """Wrapped positions, LE-shifted velocities, spins and bin index of every particle
+        (bin -1: outside the bins)."""
+        pos = np.array(frame.position, float)
+        vel = np.array(frame.velocity, float)
+        omega = np.asarray(frame.angular_velocity, float)
+        omega = omega[:, None] if omega.ndim == 1 else omega
+        if vel.shape != pos.shape or omega.shape != (pos.shape[0], self.n_rot):
+            raise ValueError("velocity / angular_velocity do not match the positions")
+        if self.period:
+            turns = np.floor((pos[:, 1] - self.edges[0]) / self.period)
+            pos[:, 1] -= turns * self.period
+            pos[:, 0] -= turns * float(frame.tilt)
+            vel[:, 0] -= turns * self.image_velocity_shift
+        bins = np.searchsorted(self.edges, pos[:, 1], side="right") - 1
+        bins[(bins < 0) | (bins >= self.n_bins)] = -1
+        return {"pos": pos, "vel": vel, "omega": omega, "bins": bins}
+
+    def _bin_mean(self, bins: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """Per-bin mean of ``values`` (rows with bin -1 ignored; empty bins give 0)."""
+        keep = bins >= 0
+        n = np.bincount(bins[keep], minlength=self.n_bins).astype(float)
+        out = np.zeros((self.n_bins, values.shape[1]))
+        for c in range(values.shape[1]):
+            out[:, c] = np.bincount(bins[keep], weights=values[keep, c], minlength=self.n_bins)
+        return out / np.maximum(n, 1.0)[:, None]
+
+    def _reference_means(self, reference: Mapping[str, Any] | None) -> None:
+        self._ref = None
+        if reference is None:
+            return
+        ref_edges = np.asarray(reference["edges"], float)
+        if ref_edges.shape != self.edges.shape or not np.allclose(ref_edges, self.edges,
+                                                                  rtol=0, atol=1e-12):
+            raise ValueError("the reference was computed on other bin edges")
+        self._ref = {k: np.nan_to_num(np.asarray(reference[k], float))
+                     for k in ("velocity", "spin")}
+
+    def _fluctuations(self, a: dict[str, np.ndarray], spin: bool = False) -> tuple[np.ndarray, ...]:
+        bins = a["bins"]
+        b = np.maximum(bins, 0)
+        if self._ref is None:
+            u = a["vel"] - self._bin_mean(bins, a["vel"])[b]
+            w = a["omega"] - self._bin_mean(bins, a["omega"])[b] if spin else None
+        else:
+            u = a["vel"] - self._ref["velocity"][b]
+            w = a["omega"] - self._ref["spin"][b] if spin else None
+        return u, w
+
+    def _common_attrs(self) -> dict[str, Any]:
+        return {
+            "dim": self.dim,
+            "period": self.period,
+            "image_velocity_shift": self.image_velocity_shift,
+            "binning": "bin of the particle centre along y",
+            "samples": self.n_frames,
+            "block_length": self._acc.block_length,
+            "n_blocks": self._acc.n_blocks,
+            "units": UNITS_NOTE,
+        }
+
+
+class BinMeans(_Binned):
+    """First pass: number-weighted run-mean velocity and spin of each y-bin (centre binning).
+
+    Parameters: ``dim``, ``edges`` (or ``n_bins`` equal bins over the first frame's box, or
+    over ``period``), ``period`` (y period, 0 = walls), ``image_velocity_shift`` (LE: shear
+    rate * period), ``max_blocks``. Results: ``edges``, ``y``, ``count`` (mean particles per
+    frame), ``velocity`` (n_bins, dim), ``spin`` (n_bins, n_rot), each with ``_err``.
+    """
+
+    def __init__(self, dim: int = 2, edges: ArrayLike | None = None, n_bins: int = 1,
+                 period: float = 0.0, image_velocity_shift: float = 0.0, max_blocks: int = 64,
+                 verbose: bool = False) -> None:
+        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose)
+
+    def _prepare(self) -> None:
+        self._set_edges(self.first_frame)
+        self._nv = 1 + self.dim + self.n_rot
+        self._acc = BlockAccumulator(self.n_bins * self._nv, self.max_blocks)
+
+    def _single_frame(self, frame: Frame) -> None:
+        a = self._assign(frame)
+        keep = a["bins"] >= 0
+        bins = a["bins"][keep]
+        values = np.concatenate([np.ones((bins.size, 1)), a["vel"][keep], a["omega"][keep]], 1)
+        sample = np.zeros((self.n_bins, self._nv))
+        for c in range(self._nv):
+            sample[:, c] = np.bincount(bins, weights=values[:, c], minlength=self.n_bins)
+        self._acc.add(sample)
+
+    def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
+        s = mean.reshape(self.n_bins, self._nv)
+        n = s[:, :1]
+        return {"count": s[:, 0], "velocity": s[:, 1 : 1 + self.dim] / n,
+                "spin": s[:, 1 + self.dim :] / n}
+
+    def _conclude(self) -> None:
+        est, err = jackknife(self._acc, self._estimate)
+        self.results = {"edges": self.edges, "y": 0.5 * (self.edges[1:] + self.edges[:-1])}
+        for key in est:
+            self.results[key], self.results[f"{key}_err"] = est[key], err[key]
+        self.attrs = {**self._common_attrs(), "weighting": "number (one per particle)"}
+
+
+class VelocityCorrelation(_Binned):
+    """Spatial correlation C_aa(r) of velocity fluctuations per y-bin (see the module doc).
+
+    Parameters
+    ----------
+    dim: 2 (discs) or 3 (spheres).
+    edges: y-bin edges; None means ``n_bins`` equal bins over the first frame's box (or
+        ``[lo, lo + period)``).
+    r_max, dr: shells ``[0, dr), [dr, 2 dr), ...`` up to ``r_max``.
+    reference: None (instantaneous bin means, one pass) or ``BinMeans(...).results`` of the
+        same frames and edges (run-mean bin velocity, second pass).
+    in_bin: partners only in the particle's own bin (Malik's binwise reading); otherwise
+        partners anywhere (each with the fluctuation of its own bin).
+    distance: "full" (dim-D distance) or "planar" (x(z) separation; needs ``in_bin``).
+    period: y period (> 0: y periodic, Lees-Edwards images from ``frame.tilt``).
+    image_velocity_shift: Lees-Edwards shear rate * period (used to unwrap velocities).
+    chunk: particles per pair query (bounds the memory of one query).
+    max_blocks: bound on the stored time blocks.
+    """
+
+    def __init__(self, dim: int = 2, edges: ArrayLike | None = None, n_bins: int = 1,
+                 r_max: float = 5.0, dr: float = 0.1,
+                 reference: Mapping[str, Any] | None = None, in_bin: bool = False,
+                 distance: str = "full", period: float = 0.0,
+                 image_velocity_shift: float = 0.0, chunk: int = 4096, max_blocks: int = 64,
+                 verbose: bool = False) -> None:
+        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose)
+        if not (r_max > 0 and dr > 0):
+            raise ValueError("r_max and dr must be positive")
+        if distance not in ("full", "planar"):
+            raise ValueError(f"distance must be 'full' or 'planar', got {distance!r}")
+        if distance == "planar" and not in_bin:
+            raise ValueError("distance='planar' needs in_bin=True (pairs inside one bin)")
+        self.n_r = max(1, int(round(r_max / dr)))
+        self.dr = float(dr)
+        self.r_edges = self.dr * np.arange(self.n_r + 1)
+        self.in_bin, self.distance = bool(in_bin), distance
+        self.chunk = max(1, int(chunk))
+        self._reference = reference
+
+    def _prepare(self) -> None:
+        frame = self.first_frame
+        self._set_edges(frame)
+        self._reference_means(self._reference)
+        lengths = frame.lengths
+        periodic = [0] + ([2] if self.dim == 3 else []) + ([1] if self.period else [])
+        self.r_image_limit = 0.5 * float(min(lengths[periodic]))
+        # per bin: N | Q_a (dim) | P (n_r) | S_a (dim x n_r)
+        self._nv = 1 + self.dim + self.n_r * (1 + self.dim)
+        self._acc = BlockAccumulator(self.n_bins * self._nv, self.max_blocks)
+
+    # -- pair search -------------------------------------------------------------------
+    def _pairs(self, pos: np.ndarray, lengths: np.ndarray, tilt: float,
+               y_periodic: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Ordered pairs (i, j, r) with i != j and r < r_max; ``pos`` relative to box_lo,
+        x(z) wrapped; y periodic (with LE images when tilt != 0) or open."""
+        r_max = self.r_edges[-1]
+        if self.distance == "planar":
+            keep = [0, 2] if self.dim == 3 else [0]
+            pts, box, owner = pos[:, keep].copy(), lengths[keep].copy(), np.arange(len(pos))
+            others = pts
+        else:
+            pts, box = pos.copy(), lengths.copy()
+            owner = np.arange(len(pos))
+            others = pts
+            images = y_periodic and tilt != 0.0
+            if images or not y_periodic:
+                pad = r_max + 1.0
+                pts[:, 1] += pad
+                box[1] = lengths[1] + 2 * pad + r_max
+                others = pts
+            if images:
+                ly = lengths[1]
+                low = np.flatnonzero(pts[:, 1] - pad < r_max)
+                high = np.flatnonzero(pts[:, 1] - pad > ly - r_max)
+                up, down = pts[low].copy(), pts[high].copy()
+                up[:, 1] += ly
+                up[:, 0] = _wrap(up[:, 0] + tilt, lengths[0])
+                down[:, 1] -= ly
+                down[:, 0] = _wrap(down[:, 0] - tilt, lengths[0])
+                others = np.concatenate([pts, up, down])
+                owner = np.concatenate([owner, low, high])
+        other_tree = cKDTree(others, boxsize=box)
+        out_i, out_j, out_r = [], [], []
+        for start in range(0, len(pts), self.chunk):
+            sub = cKDTree(pts[start : start + self.chunk], boxsize=box)
+            res = sub.sparse_distance_matrix(other_tree, r_max, output_type="ndarray")
+            i = res["i"].astype(np.int64) + start
+            j = owner[res["j"]]
+            ok = i != j
+            out_i.append(i[ok])
+            out_j.append(j[ok])
+            out_r.append(res["v"][ok])
+        return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_r)
+
+    def _single_frame(self, frame: Frame) -> None:
+        a = self._assign(frame)
+        u, _ = self._fluctuations(a)
+        keep = a["bins"] >= 0
+        pos, u, bins = a["pos"][keep], u[keep], a["bins"][keep]
+        lo = np.asarray(frame.box_lo, float)
+        lengths = frame.lengths
+        pos = pos - lo
+        pos[:, 0] = _wrap(pos[:, 0], lengths[0])
+        if self.dim == 3:
+            pos[:, 2] = _wrap(pos[:, 2], lengths[2])
+        if self.period:
+            pos[:, 1] = _wrap(pos[:, 1] - (self.edges[0] - lo[1]), self.period)
+            lengths = lengths.copy()
+            lengths[1] = self.period
+        nb, nr, dim = self.n_bins, self.n_r, self.dim
+        sample = np.zeros((nb, self._nv))
+        sample[:, 0] = np.bincount(bins, minlength=nb)
+        for c in range(dim):
+            sample[:, 1 + c] = np.bincount(bins, weights=u[:, c] ** 2, minlength=nb)
+        whole_period = self.period and nb == 1 and np.isclose(self.edges[-1] - self.edges[0],
+                                                              self.period)
+        if self.in_bin and not whole_period:
+            groups = [np.flatnonzero(bins == b) for b in range(nb)]
+        else:
+            groups = [np.arange(len(bins))]
+        y_periodic = bool(self.period) and (whole_period or not self.in_bin)
+        for sel in groups:
+            if sel.size < 2:
+                continue
+            i, j, r = self._pairs(pos[sel], lengths, float(frame.tilt), y_periodic)
+            i, j = sel[i], sel[j]
+            k = np.minimum((r / self.dr).astype(np.int64), nr - 1)
+            idx = bins[i] * nr + k
+            sample[:, 1 + dim : 1 + dim + nr] += np.bincount(
+                idx, minlength=nb * nr).reshape(nb, nr)
+            for c in range(dim):
+                col = 1 + dim + nr * (1 + c)
+                sample[:, col : col + nr] += np.bincount(
+                    idx, weights=u[i, c] * u[j, c], minlength=nb * nr).reshape(nb, nr)
+        self._acc.add(sample)
+
+    def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
+        nb, nr, dim = self.n_bins, self.n_r, self.dim
+        s = mean.reshape(nb, self._nv)
+        n, q = s[:, 0], s[:, 1 : 1 + dim]
+        p = s[:, 1 + dim : 1 + dim + nr]
+        sums = s[:, 1 + dim + nr :].reshape(nb, dim, nr)
+        cov = sums / p[:, None, :]
+        temp = q / n[:, None]
+        return {
+            "C": cov / temp[:, :, None],
+            "covariance": cov,
+            "temperature_components": temp,
+            "C_malik": sums / (2 * self.dr * q[:, :, None]),
+            "pairs_per_particle": p / n[:, None],
+            "count": n,
+        }
+
+    def _conclude(self) -> None:
+        est, err = jackknife(self._acc, self._estimate)
+        self.results = {
+            "r": 0.5 * (self.r_edges[1:] + self.r_edges[:-1]),
+            "r_edges": self.r_edges,
+            "edges": self.edges,
+            "y": 0.5 * (self.edges[1:] + self.edges[:-1]),
+            "image_artefact": self.r_edges[1:] > self.r_image_limit + 1e-12,
+        }
+        for key in est:
+            self.results[key], self.results[f"{key}_err"] = est[key], err[key]
+        self.attrs = {
+            **self._common_attrs(),
+            "components": ",".join("xyz"[: self.dim]),
+            "shape": "C, covariance, C_malik: (n_bins, dim, n_r)",
+            "in_bin": self.in_bin,
+            "distance": self.distance,
+            "dr": self.dr,
+            "r_max": float(self.r_edges[-1]),
+            "r_image_limit": self.r_image_limit,
+            "mean": "instantaneous bin mean" if self._ref is None
+            else "run-mean bin velocity (first pass)",
+            "normalisation": "C = <sum_pairs u'_i u'_j>/<pairs> / (<sum_i u'_i^2>/<N>)",
+        }
+
+
+class OrientationalCorrelation(_Binned):
+    """Malik's Lambda(y) = <cos^2 Psi> between translational and spin fluctuations (3D only).
+
+    Parameters: ``edges`` / ``n_bins``, ``reference`` (None: instantaneous bin means of
+    velocity and spin; or ``BinMeans(...).results``: run means), ``period``,
+    ``image_velocity_shift``, ``max_blocks``; see the module docstring for the definitions.
+    """
+
+    def __init__(self, dim: int = 3, edges: ArrayLike | None = None, n_bins: int = 1,
+                 reference: Mapping[str, Any] | None = None, period: float = 0.0,
+                 image_velocity_shift: float = 0.0, max_blocks: int = 64,
+                 verbose: bool = False) -> None:
+        if dim != 3:
+            raise ValueError("Lambda needs 3D: in 2D the spin omega_z is perpendicular to "
+                             "every in-plane velocity, so cos(Psi) = 0 identically")
+        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose)
+        self._reference = reference
+
+    def _prepare(self) -> None:
+        self._set_edges(self.first_frame)
+        self._reference_means(self._reference)
+        self._acc = BlockAccumulator(self.n_bins * 4, self.max_blocks)
+
+    def _single_frame(self, frame: Frame) -> None:
+        a = self._assign(frame)
+        c, w = self._fluctuations(a, spin=True)
+        c2, w2 = (c * c).sum(1), (w * w).sum(1)
+        ok = (a["bins"] >= 0) & (c2 > 0) & (w2 > 0)
+        bins = a["bins"][ok]
+        cos2 = (c[ok] * w[ok]).sum(1) ** 2 / (c2[ok] * w2[ok])
+        nb = self.n_bins
+        n = np.bincount(bins, minlength=nb).astype(float)
+        total = np.bincount(bins, weights=cos2, minlength=nb)
+        has = n > 0
+        sample = np.stack([n, total, np.where(has, total / np.maximum(n, 1), 0.0),
+                           has.astype(float)], axis=1)
+        self._acc.add(sample)
+
+    def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
+        s = mean.reshape(self.n_bins, 4)
+        return {"lambda": s[:, 2] / s[:, 3], "lambda_pooled": s[:, 1] / s[:, 0],
+                "count": s[:, 0]}
+
+    def _conclude(self) -> None:
+        est, err = jackknife(self._acc, self._estimate)
+        self.results = {"edges": self.edges, "y": 0.5 * (self.edges[1:] + self.edges[:-1])}
+        for key in est:
+            self.results[key], self.results[f"{key}_err"] = est[key], err[key]
+        self.attrs = {
+            **self._common_attrs(),
+            "uncorrelated_value": 1.0 / 3.0,
+            "mean": "instantaneous bin means" if self._ref is None
+            else "run-mean bin velocity and spin (first pass)",
+            "definition": "lambda = <(1/N_b) sum_i (C.W)^2/(C^2 W^2)>_frames",
+        }
+
+
+def _two_pass(cls: type, frames: Callable[[], Iterable[Frame]] | Iterable[Frame],
+              options: dict[str, Any]) -> AnalysisBase:
+    if not callable(frames) and iter(frames) is frames:
+        raise TypeError("two passes read the frames twice: pass a list or a callable "
+                        "returning a fresh iterator, not an iterator")
+    source = frames if callable(frames) else (lambda: frames)
+    keys = ("dim", "edges", "n_bins", "period", "image_velocity_shift", "max_blocks")
+    first = BinMeans(**{k: options[k] for k in keys if k in options}).run(source())
+    options = {**options, "edges": first.edges, "reference": first.results}
+    return cls(**options).run(source())
+
+
+def velocity_correlations(frames: Callable[[], Iterable[Frame]] | Iterable[Frame],
+                          **options: Any) -> VelocityCorrelation:
+    """Two passes: run-mean bin velocities (:class:`BinMeans`), then C_aa(r) of the
+    fluctuations about them. ``frames``: a list or a callable returning fresh iterables."""
+    return _two_pass(VelocityCorrelation, frames, options)
+
+
+def orientational_correlation(frames: Callable[[], Iterable[Frame]] | Iterable[Frame],
+                              **options: Any) -> OrientationalCorrelation:
+    """Two passes: run-mean bin velocities and spins, then Lambda(y) about them."""
+    options.setdefault("dim", 3)
+    return _two_pass(OrientationalCorrelation, frames, options)
