@@ -1,8 +1,10 @@
-"""Main job: Campbell's (1982) 30° chute (10 × 4 rough discs) run in LAMMPS end to end.
+"""Main job: Campbell's (1982) 30° chute (10 × 4 rough discs), soft discs in LAMMPS and hard
+discs in the event-driven engine, from the same scene file.
 
-Writes results/campbell1982-chute-30-lammps.h5 (profiles with block-averaged errors,
-timeseries, the deck) and results/campbell1982-chute-30-profiles.png, and prints where they
-are and a short summary. Dimensionless particle units: d = 1, m = 1, g = 1.
+Writes results/campbell1982-chute-30-{lammps,edmd}.h5 (profiles with block-averaged errors,
+timeseries, stresses; the LAMMPS deck) and results/campbell1982-chute-30-profiles.png (both
+engines overlaid), and prints where they are and a short summary per engine.
+Dimensionless particle units: d = 1, m = 1, g = 1.
 
     python analysis/campbell_chute.py [--set run.production=100 ...]
 """
@@ -31,10 +33,21 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     scene = load_scene(SCENE, args.set)
-    h5 = args.out / "campbell1982-chute-30-lammps.h5"
-    get_engine("lammps").run(scene, RunOptions(out=h5))
-    fig = plot_profiles([h5], args.out / "campbell1982-chute-30-profiles.png")
+    print(f"scene:   {SCENE.relative_to(ROOT)} ({scene.n_particles} discs, "
+          f"{scene.gravity.angle:g}°)")
+    files = []
+    for engine in ("lammps", "edmd"):
+        h5 = args.out / f"campbell1982-chute-30-{engine}.h5"
+        get_engine(engine).run(scene, RunOptions(out=h5))
+        files.append(h5)
+    fig = plot_profiles(files, args.out / "campbell1982-chute-30-profiles.png")
+    print(f"figure:  {fig}")
+    for h5 in files:
+        summarise(scene, h5)
+    return 0
 
+
+def summarise(scene, h5: Path) -> None:
     res = read_results(h5)
     prof, ts = res.profiles, res.timeseries
     y, nu, u = prof["y"], prof["solid_fraction"], prof["velocity"][:, 0]
@@ -45,22 +58,22 @@ def main(argv: list[str] | None = None) -> int:
     production = ts["time"] > res.attrs["equilibration_end"]  # samples after equilibration
     ke = ts["kinetic_energy"][production] / n
     force = np.nanmean(ts["wall_force_lower"][production], axis=0)
-    print(f"scene:   {SCENE.relative_to(ROOT)} ({n} discs, {alpha:g}°)")
-    print(f"results: {h5}")
-    print(f"figure:  {fig}")
-    print(f"wall time {res.attrs['wall_seconds']:.1f} s; dt = {res.attrs['timestep']:.3g}; "
+    engine = res.attrs["engine"]
+    how = (f"dt = {res.attrs['timestep']:.3g}" if "timestep" in res.attrs else
+           f"{int(res.attrs['events'])} events, TC t_c = {res.attrs['tc']:g}")
+    print(f"\n[{engine}] results: {h5}")
+    print(f"  wall time {res.attrs['wall_seconds']:.1f} s; {how}; "
           f"{int(res.profile_attrs['samples'])} samples")
-    print(f"kinetic energy per disc in production: mean {ke.mean():.3f}, "
+    print(f"  kinetic energy per disc in production: mean {ke.mean():.3f}, "
           f"min {ke.min():.3f}, max {ke.max():.3f} (m g d)")
-    print(f"H = 2 × mass-mean height = {2 * mean_height:.2f} d; "
+    print(f"  H = 2 × mass-mean height = {2 * mean_height:.2f} d; "
           f"slip velocity u(y≈0.5) = {u[0]:.2f}, max u = {np.nanmax(u):.2f} (√(g d))")
-    print(f"base: shear/normal force {abs(force[0] / force[1]):.3f} "
+    print(f"  base: shear/normal force {abs(force[0] / force[1]):.3f} "
           f"(steady flow needs tan α = {np.tan(np.radians(alpha)):.3f}); normal force "
           f"{abs(force[1]):.2f} vs weight·cos α = {n * np.cos(np.radians(alpha)):.2f}")
     verdict = "steady" if res.attrs["steady"] else "NOT steady"
-    print(f"convergence (Campbell: KE within ~20 % with no trend): {verdict}, "
+    print(f"  convergence (Campbell: KE within ~20 % with no trend): {verdict}, "
           f"KE trend {100 * res.attrs['kinetic_energy_trend']:+.0f} % over production")
-    return 0
 
 
 if __name__ == "__main__":

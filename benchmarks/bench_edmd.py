@@ -1,6 +1,7 @@
 """Event rate and memory of the event-driven engine (``--engine edmd``), elastic spheres.
 
-Run: /tmp/venv/bin/python benchmarks/bench_edmd.py [--n 4000 32000 256000] [--seconds 10]
+Run: .venv/bin/python benchmarks/bench_edmd.py [--n 4000 32000 256000] [--seconds 10]
+     [--system elastic|sheared]
 Dimensionless particle units (d = 1, m = 1, T = 1). The issue-3 systems: elastic smooth hard
 spheres at number density 0.5 (φ = 0.262), fully periodic cubic box, fcc start (N = 4 m³),
 Maxwellian velocities with zero total momentum. Each N runs in a fresh child process:
@@ -8,8 +9,11 @@ a warm-up of 2 collisions per particle, then ``advance_to`` in chunks for ``--se
 wall time. Prints Markdown rows: events/s (collisions + cell crossings), collisions/s,
 ns per event, the engine's own arrays in bytes per particle (``memory_bytes``) and the
 child's peak RSS growth per particle (includes the numpy inputs). No assertions.
-(The issue's second system, inelastic spheres under Lees–Edwards shear, needs shear:
-not in milestone 1.)
+``--system sheared``: the issue's second system, inelastic smooth spheres (e = 0.9, TC model
+t_c = 1e-5) under Lees–Edwards shear (rate 1) at the same density, started from the fcc
+lattice with the linear profile u = y − L/2 on top of unit temperature; a warm-up of 2
+collisions per particle, then the same measurement (the shear heats up and the inelasticity
+cools: after the warm-up the temperature is near its steady value, ~ (γ̇ d)² × O(1)).
 """
 
 from __future__ import annotations
@@ -31,10 +35,12 @@ def fcc(m: int, a: float) -> np.ndarray:
     return ((grid[:, None, :] + basis[None]) * a).reshape(-1, 3)
 
 
-def measure(n: int, seconds: float, density: float = 0.5, seed: int = 1) -> dict:
+def measure(n: int, seconds: float, system: str = "elastic", density: float = 0.5,
+            seed: int = 1) -> dict:
     from demstudy._native import EventDriven
 
-    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    np.random.default_rng(0).normal(size=8)  # load numpy's generator before the baseline
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # after the imports
     m = round((n / 4) ** (1 / 3))
     if 4 * m**3 != n:
         raise SystemExit(f"--n {n}: the fcc start needs N = 4 m^3")
@@ -43,9 +49,14 @@ def measure(n: int, seconds: float, density: float = 0.5, seed: int = 1) -> dict
     rng = np.random.default_rng(seed)
     v = rng.normal(size=x.shape)
     v -= v.mean(axis=0)
-    s = EventDriven(x, v, np.zeros_like(x), np.ones(n), np.ones(n), [m * a] * 3, 3)
+    if system == "sheared":
+        v[:, 0] += x[:, 1] - m * a / 2
+        s = EventDriven(x, v, np.zeros_like(x), np.ones(n), np.ones(n), [m * a] * 3, 3,
+                        e=0.9, tc=1e-5, shear_rate=1.0)
+    else:
+        s = EventDriven(x, v, np.zeros_like(x), np.ones(n), np.ones(n), [m * a] * 3, 3)
     del x, v
-    t, dt = 0.0, 0.05
+    t, dt = 0.0, 0.5  # ~5 collisions per particle per chunk: synchronising costs O(N)
     while s.collisions < 2 * n:  # warm-up: melt the lattice
         t += dt
         s.advance_to(t)
@@ -66,18 +77,20 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--n", type=int, nargs="+", default=[4000, 32000, 256000])
     p.add_argument("--seconds", type=float, default=10.0)
+    p.add_argument("--system", choices=["elastic", "sheared"], default="elastic")
     p.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = p.parse_args()
     if args.child:
-        print(json.dumps(measure(args.child, args.seconds)))
+        print(json.dumps(measure(args.child, args.seconds, args.system)))
         return
     print(f"machine: {platform.processor() or platform.machine()}, {platform.system()}, "
-          f"Python {platform.python_version()}")
+          f"Python {platform.python_version()}; system: {args.system}")
     print("| N | events/s | collisions/s | ns/event | engine B/particle | peak RSS B/particle |")
     print("|---:|---:|---:|---:|---:|---:|")
     for n in args.n:
         out = subprocess.run([sys.executable, __file__, "--child", str(n), "--seconds",
-                              str(args.seconds)], capture_output=True, text=True, check=True)
+                              str(args.seconds), "--system", args.system],
+                             capture_output=True, text=True, check=True)
         r = json.loads(out.stdout.strip().splitlines()[-1])
         print(f"| {r['n']} | {r['events_per_s']:.3g} | {r['collisions_per_s']:.3g} | "
               f"{r['ns_per_event']:.0f} | {r['engine_bytes']:.0f} | {r['rss_bytes']:.0f} |",

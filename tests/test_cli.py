@@ -123,7 +123,7 @@ def test_analyze_stored_frames_adds_statistics(tmp_path, capsys):
 
 def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path):
     """`--engine edmd` goes through the same isolated child process as LAMMPS and writes the
-    same results layout; scenes outside its scope are refused with exit 2."""
+    same results layout; scenes outside its scope (bumpy walls) are refused with exit 2."""
     from demstudy.io.results import read_results
 
     scene = ROOT / "inputs" / "cooling" / "hcs-3d.toml"
@@ -135,7 +135,7 @@ def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path):
     ke = res.timeseries["kinetic_energy"]
     assert ke[-1] < ke[0]  # e = 0.9: it cools
     assert main(["run", str(CHUTE), "--engine", "edmd", "--out", str(tmp_path / "c.h5"),
-                 "-q"]) == 2
+                 "-q", "--set", "walls[0].kind=bumpy", "--set", "walls[0].bumps.spacing=1.0"]) == 2
 
 
 def test_stop_refusal_and_failure_have_distinct_exit_codes(tmp_path, capsys):

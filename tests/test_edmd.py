@@ -17,7 +17,6 @@ Runtime about a minute on a 2-core machine (the elastic drift tests take most of
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -178,21 +177,23 @@ def test_smooth_collisions_leave_spins_and_elastic_rough_ones_conserve_energy():
 
 # ---- conservation and overlaps -------------------------------------------------------------
 
-@pytest.mark.parametrize("dim, n, seconds", [(3, 4000, 12.0), (2, 4000, 8.0)])
-def test_elastic_gas_conserves_energy_and_momentum(dim, n, seconds):
-    """Number density 0.5 (3D: φ = 0.26; 2D: ν = 0.39), N = 4000, run for a fixed wall time.
-    Measured on the development machine: 3.4e6 collisions in 12 s (3D) and 5.6e6 in 8 s (2D);
-    largest relative energy drift 1.6e-13 (3D) / 3.9e-13 (2D), momentum change 2e-13."""
+@pytest.mark.parametrize("dim", [3, 2])
+def test_elastic_gas_conserves_energy_over_1e7_collisions(dim):
+    """The issue's hard case 1: number density 0.5 (3D: φ = 0.26; 2D: ν = 0.39), N = 4000,
+    1e7 collisions (about 30 s each on the 2-core development machine): relative energy
+    drift < 1e-10 at every check, momentum conserved to round-off, no overlap."""
+    n = 4000
     phi = 0.5 * (math.pi / 6 if dim == 3 else math.pi / 4)
     s = system(make_scene(dim, phi, n, seed=5))
     e0 = energy(s)
     p0 = s.velocities().sum(axis=0)
-    start, t = time.perf_counter(), 0.0
-    while time.perf_counter() - start < seconds:
-        t += 2.0
-        s.advance_to(t)
-        assert abs(energy(s) - e0) / e0 < 1e-10
-    assert s.collisions > 1e6
+    t, drift = 0.0, 0.0
+    while s.collisions < 10_000_000:
+        t += 20.0
+        s.advance_to(t, stop_collisions=10_000_000)
+        drift = max(drift, abs(energy(s) - e0) / e0)
+        assert drift < 1e-10
+    assert s.collisions == 10_000_000
     p = s.velocities().sum(axis=0)
     assert np.abs(p - p0).max() < 1e-10 * math.sqrt(n)
     assert s.min_gap() > -1e-9
@@ -491,33 +492,20 @@ def test_engine_resume_is_bit_identical(tmp_path):
 
 
 @pytest.mark.parametrize("overrides, field", [
-    ({"walls": [{"side": "lower", "restitution": 0.9}]}, "walls"),
-    ({"shear": {"rate": 1.0}}, "shear"),
-    ({"contact.tangential": {"model": "coulomb", "mu": 0.5}}, "contact.tangential.model"),
-    ({"contact.law": {"model": "campbell-exp"}}, "contact.law.model"),
-    ({"run.unit": "collisions"}, "run.unit"),
+    ({"box.periodic": ["x"], "gravity": {"angle": 20.0},
+      "walls": [{"side": "lower", "restitution": 0.9, "kind": "bumpy",
+                 "bumps": {"spacing": 1.0}}]}, "walls[lower].kind"),
+    ({"contact.law": {"model": "campbell-exp"}}, "contact.law.model"),  # needs g for √(gR)
+    ({"box.size": [20.0, 2.5]}, "box.size"),
 ])
-def test_engine_refuses_features_outside_the_milestone(overrides, field, tmp_path):
+def test_engine_refuses_what_it_cannot_do(overrides, field, tmp_path):
+    """Bumpy walls under gravity, Campbell's e(v) without gravity and periodic boxes too small
+    for the cell lists are refused before anything runs, naming the field."""
     scene = engine_scene(overrides)
     with pytest.raises(UnsupportedByEngine) as info:
         EdmdEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))
     assert info.value.engine == "edmd" and info.value.field_name == field
-
-
-def test_engine_refuses_gravity(tmp_path):
-    scene = engine_scene({"walls": [{"side": "lower", "restitution": 0.9}],
-                          "gravity": {"angle": 30.0}})
-    with pytest.raises(UnsupportedByEngine):
-        check_supported(scene)
-    data = parse_scene_text(ENGINE_SCENE)
-    data["gravity"] = {"direction": [0.0, -1.0]}
-    try:
-        scene = validate_scene(data)
-    except Exception:  # gravity may require walls in the scene rules
-        return
-    with pytest.raises(UnsupportedByEngine) as info:
-        check_supported(scene)
-    assert info.value.field_name == "gravity"
+    assert not (tmp_path / "x.h5").exists()
 
 
 def test_cli_runs_the_edmd_engine(tmp_path, capsys):
@@ -530,5 +518,5 @@ def test_cli_runs_the_edmd_engine(tmp_path, capsys):
                  "--set", "run.production=1.0"]) == 0
     assert read_results(out).attrs["engine"] == "edmd"
     assert main(["run", str(path), "--engine", "edmd", "--out", str(out), "--quiet",
-                 "--set", "shear={ rate = 1.0 }"]) != 0
-    assert "unsupported by edmd: shear" in capsys.readouterr().err
+                 "--set", "contact.law.model=campbell-exp"]) == 2
+    assert "unsupported by edmd: contact.law.model" in capsys.readouterr().err

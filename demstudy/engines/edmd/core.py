@@ -31,19 +31,21 @@ impulse). ``DEFAULT_TC`` = 1e-5 time units (the engine's default; 0 disables the
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from ..._native import EventDriven, edmd_collide_pair
 from ...decks.base import UnsupportedByEngine
+from ...decks.bumps import bump_rows
 from ...scene import Scene
 from ...scene.initial import InitialState
 
 DEFAULT_TC = 1e-5
 
 __all__ = ["DEFAULT_TC", "EventDriven", "collide_pair", "from_initial_state",
-           "scene_parameters", "y_range"]
+           "scene_parameters", "with_bumps", "y_range"]
 
 
 def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
@@ -94,15 +96,52 @@ def scene_parameters(scene: Scene) -> dict:
     if not scene.y_periodic:
         walls = []
         for wall in scene.walls:
-            if wall.kind == "bumpy":
+            if wall.kind == "bumpy" and scene.gravity is not None:
                 raise UnsupportedByEngine("edmd", f"walls[{wall.side}].kind", wall.kind,
-                                          "bumpy walls are not implemented in the event-driven "
-                                          "engine; use flat walls with a rough rule")
+                                          "bumpy walls under gravity are not implemented in the "
+                                          "event-driven engine (a bump and a falling particle "
+                                          "need quartic roots); use a flat wall with a rough "
+                                          "rule, or LAMMPS")
+            if wall.kind == "bumpy" and wall.servo is not None:
+                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].servo", "servo",
+                                          "a bumpy wall cannot be servo-controlled")
+            if wall.kind == "bumpy" and wall.tangential.model == "campbell-noslip":
+                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].tangential.model",
+                                          wall.tangential.model,
+                                          "bumps collide as particles: use beta, rough or "
+                                          "coulomb")
             rule = _rule(wall.restitution, wall.tangential, who=f"walls[{wall.side}]")
             walls.append({"side": wall.side, "position": scene.wall_position(wall.side),
                           "velocity": float(wall.velocity), **rule})
         params.update(periodic_y=False, walls=walls)
     return params
+
+
+def with_bumps(scene: Scene, state: InitialState) -> tuple[InitialState, np.ndarray]:
+    """The initial state with every bumpy wall's bumps appended (``decks.bumps.bump_rows``:
+    the same layout LAMMPS uses), and the core's ``fixed`` codes (0 mobile, 1 lower wall's
+    bump, 2 upper wall's). Bumps move with their wall's velocity along x; the flat plane of a
+    bumpy wall stays as a backstop with the same rule."""
+    rows = bump_rows(scene)
+    fixed = np.zeros(len(state.diameter), np.int8)
+    if not rows:
+        return state, fixed
+    dim = scene.dimension
+    pos, vel, omega = [state.position], [state.velocity], [state.angular_velocity]
+    diam, codes = [state.diameter], [fixed]
+    for row in rows:
+        n = len(row.centres)
+        v = np.zeros((n, dim))
+        v[:, 0] = scene.wall(row.side).velocity
+        pos.append(row.centres)
+        vel.append(v)
+        omega.append(np.zeros((n, state.angular_velocity.shape[1])))
+        diam.append(np.full(n, row.diameter))
+        codes.append(np.full(n, 1 if row.side == "lower" else 2, np.int8))
+    full = dataclasses.replace(state, position=np.concatenate(pos), velocity=np.concatenate(vel),
+                               angular_velocity=np.concatenate(omega),
+                               diameter=np.concatenate(diam))
+    return full, np.concatenate(codes)
 
 
 def y_range(scene: Scene, positions: np.ndarray) -> tuple[float, float]:

@@ -37,7 +37,7 @@ from ...scene.initial import build_initial_state
 from ..base import EngineError, RunOptions, RunStopped
 from ..child import in_worker, launch_child
 from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
-from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters, y_range
+from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters, with_bumps, y_range
 
 CHECKPOINT = "checkpoint.pkl"
 ENGINE_VERSION = (f"demstudy-edmd {__version__} (gravity, flat walls, servo, Lees-Edwards, "
@@ -149,9 +149,12 @@ class _Run:
         initial = build_initial_state(self.scene)
         self.radius = initial.diameter / 2
         self.mass = initial.mass
-        self.n = len(self.mass)
-        core = from_initial_state(initial, self.scene.box.size, tc=self.tc,
-                                  **self._core_options(initial))
+        self.n = len(self.mass)  # mobile particles; bumps follow them in the core
+        options = self._core_options(initial)
+        everything, fixed = with_bumps(self.scene, initial)
+        if fixed.any():
+            options["fixed"] = fixed
+        core = from_initial_state(everything, self.scene.box.size, tc=self.tc, **options)
         if not self.options.resume:
             servo = ServoController(self.scene, None) if has_servo(self.scene) else None
             state = EdmdRunState(keep_frames=self.keep_frames, servo=servo)
@@ -232,7 +235,8 @@ class _Run:
 
     def _sample(self, core: EventDriven, state: EdmdRunState, production: bool) -> None:
         dim, t = self.scene.dimension, core.time
-        velocity = core.velocities()
+        n = self.n
+        velocity = core.velocities()[:n]
         kinetic = core.kinetic_energy
         state.record("time", t)
         state.record("momentum", np.sum(self.mass[:, None] * velocity, axis=0))
@@ -286,8 +290,8 @@ class _Run:
         if not self.scene.y_periodic:
             lo[1] = core.wall_position(0) if self.scene.wall("lower") else 0.0
             hi[1] = core.wall_position(1) if self.scene.wall("upper") else hi[1]
-        frame = Frame(time=t, box_lo=lo, box_hi=hi, position=core.positions(),
-                      velocity=velocity, angular_velocity=core.angular_velocities(),
+        frame = Frame(time=t, box_lo=lo, box_hi=hi, position=core.positions()[:n],
+                      velocity=velocity, angular_velocity=core.angular_velocities()[:n],
                       radius=self.radius, tilt=core.shear_offset)
         if state.profiles is None:  # servo: bins between the walls where production starts
             state.profiles = profile_analysis(self.scene, (float(lo[1]), float(hi[1])))

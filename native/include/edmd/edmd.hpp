@@ -68,6 +68,11 @@ struct Params {
     // collisional stress per bin along y (0 bins: off)
     std::int64_t stress_bins = 0;
     double stress_lo = 0.0, stress_width = 1.0;
+    // bumps of bumpy walls: per particle 0 (mobile), 1 (lower wall's bump), 2 (upper wall's);
+    // empty = all mobile. Bumps keep their velocity (the wall's), feel no gravity (gravity
+    // with bumps is refused), collide with mobile particles by their wall's rule and count
+    // in that wall's impulse and work.
+    std::vector<std::int8_t> fixed;
     // collision log: every log_every-th collision, at most log_capacity records (0: off)
     std::int64_t log_every = 0, log_capacity = 0;
 };
@@ -159,7 +164,8 @@ public:
         // walls (y0, t0, vn, ux, uz) x 2, wall impulse 3 x 2, wall work x 2, virial 9
         std::vector<double> scalars;
         std::vector<std::int64_t> counters;  // collisions, crossings, invalid, tc, resting,
-                                             // wall collisions, log seen
+                                             // wall collisions, log seen, sorted at
+        std::vector<std::int32_t> order;     // internal index -> input index
     };
     State get_state() const;
     void set_state(const State& s);
@@ -177,6 +183,7 @@ private:
     static constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::min();
     // ev_partner codes below 0: -(axis + 1) crossing upwards, -(axis + 4) downwards, walls,
     // the Lees–Edwards re-scan (system slot)
+    static constexpr std::int64_t kSortEvery = 4;  // re-sort memory every 4 N events
     static constexpr std::int32_t kLowerWall = -7, kUpperWall = -8, kReshuffle = -9;
 
     Params p_;
@@ -194,6 +201,7 @@ private:
     std::vector<Particle> P_;
     std::vector<std::int32_t> order_;  // internal index -> input index (cell-sorted order)
     std::vector<double> w_, last_, m_;
+    std::vector<std::int8_t> fixed_;  // 0 mobile, 1/2 bump of the lower/upper wall
     std::vector<std::int64_t> count_;
     std::vector<std::int32_t> cell_;  // per particle 3 cell coordinates
     int ncell_[3] = {1, 1, 1};
@@ -202,9 +210,7 @@ private:
     double dmax_ = 1.0;
     std::vector<std::int32_t> head_, next_, prev_;
     // scheduled event per particle, plus the system slot n_ (Lees–Edwards re-scan)
-    std::vector<double> ev_t_;
     std::vector<std::int32_t> ev_partner_;
-    std::vector<std::int64_t> ev_count_;
     std::vector<double> co_t_;
     std::vector<std::int32_t> co_partner_;  // -1: none
     std::vector<std::int64_t> co_count_;
@@ -219,7 +225,7 @@ private:
     std::int32_t le_cell_ = 0;
 
     std::int64_t collisions_ = 0, crossings_ = 0, invalid_ = 0, tc_elastic_ = 0, resting_ = 0;
-    std::int64_t wall_collisions_ = 0, log_seen_ = 0;
+    std::int64_t wall_collisions_ = 0, log_seen_ = 0, sorted_at_ = 0;
     double virial_[9] = {0};
     double dissipated_ = 0.0, gravity_work_ = 0.0;
     double wall_impulse_[2][3] = {{0, 0, 0}, {0, 0, 0}};
@@ -227,8 +233,18 @@ private:
     std::vector<double> stress_;
     std::vector<LogRecord> log_;
 
+    // Cells are numbered tile by tile (tiles of 4×4×4 cells in 3D, 8×8 in 2D): the cells of a
+    // neighbourhood, and the particles stored in this order, sit close together in memory.
+    int tshift_[3] = {2, 2, 2};
+    std::int64_t ntile_[3] = {1, 1, 1};
     std::int64_t cell_index(const std::int32_t* c) const {
-        return (static_cast<std::int64_t>(c[2]) * ncell_[1] + c[1]) * ncell_[0] + c[0];
+        const std::int64_t tile = ((static_cast<std::int64_t>(c[2] >> tshift_[2]) * ntile_[1] +
+                                    (c[1] >> tshift_[1])) * ntile_[0] + (c[0] >> tshift_[0]));
+        const std::int64_t local =
+            ((static_cast<std::int64_t>(c[2] & ((1 << tshift_[2]) - 1)) << tshift_[1] |
+              (c[1] & ((1 << tshift_[1]) - 1))) << tshift_[0]) |
+            (c[0] & ((1 << tshift_[0]) - 1));
+        return (tile << (tshift_[0] + tshift_[1] + tshift_[2])) | local;
     }
     void setup_grid();
     int cell_of(double x, int axis) const;
@@ -265,8 +281,10 @@ private:
                        const double v[3], const double g[3]);
     void process_collision(std::int32_t i, std::int32_t j);
     void process_wall(std::int32_t i, int side);
+    void process_bump(std::int32_t i, std::int32_t b);
     void process_crossing(std::int32_t i, int axis);
     void process_reshuffle();
+    void reorder();
 };
 
 }  // namespace demstudy::edmd

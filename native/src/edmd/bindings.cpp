@@ -141,6 +141,10 @@ EventDriven* make(InArr pos, InArr vel, InArr omega, InArr diameter, InArr mass,
             p.stress_lo = b[0];
             p.stress_width = b[1];
             p.stress_bins = static_cast<std::int64_t>(b[2]);
+        } else if (key == "fixed") {
+            auto f = nb::cast<nb::ndarray<const std::int8_t, nb::c_contig, nb::device::cpu>>(v);
+            require(f.size() == n, "fixed needs one int8 entry per particle");
+            p.fixed.assign(f.data(), f.data() + n);
         } else if (key == "log_every") {
             p.log_every = nb::cast<std::int64_t>(v);
         } else if (key == "log_capacity") {
@@ -176,6 +180,7 @@ nb::dict state_dict(const EventDriven& s) {
     d["stress"] = from_vector(st.stress, {st.stress.size()});
     d["scalars"] = from_vector(st.scalars, {st.scalars.size()});
     d["counters"] = from_vector(st.counters, {st.counters.size()});
+    d["order"] = from_vector(st.order, {n});
     return d;
 }
 
@@ -205,7 +210,8 @@ void set_state(EventDriven& s, nb::dict d) {
     }
     st.stress = vec<double>(d["stress"], s.stress_sums().size(), "stress");
     st.scalars = vec<double>(d["scalars"], 33, "scalars");
-    st.counters = vec<std::int64_t>(d["counters"], 7, "counters");
+    st.counters = vec<std::int64_t>(d["counters"], 8, "counters");
+    st.order = vec<std::int32_t>(d["order"], n, "order");
     try {
         s.set_state(st);
     } catch (const std::invalid_argument& err) {

@@ -20,6 +20,29 @@ inline void cross3(const double* a, const double* b, double* out) {
 }
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+// v[k] <- v[perm[k]] for rows of `width` elements, in place (cycle following): no copy of
+// the array, so re-sorting does not raise the peak memory.
+template <typename T>
+void permute_rows(std::vector<T>& v, std::size_t width, const std::vector<std::int32_t>& perm,
+                  std::vector<char>& done) {
+    const std::size_t n = perm.size();
+    done.assign(n, 0);
+    std::vector<T> tmp(width);
+    for (std::size_t start = 0; start < n; ++start) {
+        if (done[start]) continue;
+        for (std::size_t a = 0; a < width; ++a) tmp[a] = v[width * start + a];
+        std::size_t k = start;
+        while (true) {
+            done[k] = 1;
+            const std::size_t from = static_cast<std::size_t>(perm[k]);
+            if (from == start) break;
+            for (std::size_t a = 0; a < width; ++a) v[width * k + a] = v[width * from + a];
+            k = from;
+        }
+        for (std::size_t a = 0; a < width; ++a) v[width * k + a] = tmp[a];
+    }
+}
+
 // Earliest t >= 0 at which y(t) = y0 + vy t + ay t²/2 reaches 0 while increasing (y0 <= 0:
 // before the target). Roots in the cancellation-free forms. At or past the target (y0 >= 0,
 // round-off or a penetration): now if moving on, else when the motion turns back onwards.
@@ -132,6 +155,19 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     }
     if (p.stress_bins < 0 || (p.stress_bins > 0 && !(p.stress_width > 0.0)))
         throw std::invalid_argument("stress bins need a positive width");
+    if (!p.fixed.empty()) {
+        if (static_cast<std::int64_t>(p.fixed.size()) != n)
+            throw std::invalid_argument("fixed needs one entry per particle");
+        for (auto f : p.fixed) {
+            if (f < 0 || f > 2) throw std::invalid_argument("fixed entries are 0, 1 or 2");
+            if (f > 0 && (gravity_ || !p.wall[f - 1].present || p.periodic_y))
+                throw std::invalid_argument(
+                    "bumps need their wall and no gravity (a bump and a falling particle "
+                    "would need quartic roots)");
+            if (f > 0 && p.wall[f - 1].rule.tangential == Rule::kNoSlip)
+                throw std::invalid_argument("bumps cannot use the no-slip rule");
+        }
+    }
     if (p.log_every < 0 || p.log_capacity < 0)
         throw std::invalid_argument("log_every and log_capacity must be >= 0");
     stress_.assign(static_cast<std::size_t>(9 * p.stress_bins), 0.0);
@@ -140,6 +176,9 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     w_.assign(3 * N, 0.0);
     last_.assign(N, -kInf);
     m_.resize(N);
+    fixed_ = p.fixed.empty() ? std::vector<std::int8_t>(N, 0) : p.fixed;
+    p_.fixed.clear();
+    p_.fixed.shrink_to_fit();
     count_.assign(N, 0);
     cell_.assign(3 * N, 0);
     dmax_ = 0.0;
@@ -170,39 +209,32 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     setup_grid();
     for (std::size_t i = 0; i < N; ++i)
         for (int a = 0; a < p.dim; ++a) cell_[3 * i + a] = cell_of(P_[i].x[a], a);
-    // internal order: by cell (neighbours close in memory); order_[internal] = input index
+    // internal order: by cell index (tiled: neighbours close in memory); order_[internal] =
+    // input index
     order_.resize(N);
     for (std::size_t i = 0; i < N; ++i) order_[i] = static_cast<std::int32_t>(i);
     std::stable_sort(order_.begin(), order_.end(), [&](std::int32_t a, std::int32_t b) {
         return cell_index(&cell_[3 * a]) < cell_index(&cell_[3 * b]);
     });
     {
-        std::vector<Particle> P(N);
-        std::vector<double> w(3 * N), m(N);
-        std::vector<std::int32_t> cell(3 * N);
-        for (std::size_t k = 0; k < N; ++k) {
-            const std::size_t i = static_cast<std::size_t>(order_[k]);
-            P[k] = P_[i];
-            m[k] = m_[i];
-            for (int a = 0; a < 3; ++a) {
-                w[3 * k + a] = w_[3 * i + a];
-                cell[3 * k + a] = cell_[3 * i + a];
-            }
-        }
-        P_.swap(P);
-        w_.swap(w);
-        m_.swap(m);
-        cell_.swap(cell);
+        std::vector<char> done;
+        permute_rows(P_, 1, order_, done);
+        permute_rows(w_, 3, order_, done);
+        permute_rows(m_, 1, order_, done);
+        permute_rows(fixed_, 1, order_, done);
+        permute_rows(cell_, 3, order_, done);
     }
     build_cells();
     co_t_.assign(N, kInf);
     co_partner_.assign(N, -1);
     co_count_.assign(N, 0);
-    ev_t_.assign(N + 1, kInf);
     ev_partner_.assign(N + 1, kNone);
-    ev_count_.assign(N + 1, 0);
     heap_.resize(N + 1);
     pos_in_heap_.resize(N + 1);
+    for (std::int32_t k = 0; k <= static_cast<std::int32_t>(n_); ++k) {
+        heap_[k] = Node{kInf, k};
+        pos_in_heap_[k] = k;
+    }
     predict_all();
     schedule_system();
     heap_build();
@@ -238,6 +270,11 @@ void EventDriven::setup_grid() {
         cw_[2] = p_.box[2];
         org_[2] = 0.0;
     }
+    for (int a = 0; a < 3; ++a) {
+        tshift_[a] = p_.dim == 3 ? 2 : (a < 2 ? 3 : 0);
+        const int t = 1 << tshift_[a];
+        ntile_[a] = (ncell_[a] + t - 1) / t;
+    }
 }
 
 int EventDriven::cell_of(double x, int axis) const {
@@ -246,7 +283,8 @@ int EventDriven::cell_of(double x, int axis) const {
 }
 
 void EventDriven::build_cells() {
-    const std::int64_t total = static_cast<std::int64_t>(ncell_[0]) * ncell_[1] * ncell_[2];
+    const std::int64_t total = (ntile_[0] * ntile_[1] * ntile_[2])
+                               << (tshift_[0] + tshift_[1] + tshift_[2]);
     head_.assign(static_cast<std::size_t>(total), -1);
     next_.assign(static_cast<std::size_t>(n_), -1);
     prev_.assign(static_cast<std::size_t>(n_), -1);
@@ -378,8 +416,17 @@ void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& vis
             for (int cu = x0; cu <= x1; ++cu) {
                 if (only_axis == 0 && cu - ci[0] != dir) continue;
                 const int nx = ncell_[0];
-                c[0] = ((cu % nx) + nx) % nx;
-                const double s0 = shift[0] + static_cast<double>((cu - c[0]) / nx) * p_.box[0];
+                int wraps = 0;  // cu is within a few cells of [0, nx): no integer division
+                c[0] = cu;
+                while (c[0] < 0) {
+                    c[0] += nx;
+                    --wraps;
+                }
+                while (c[0] >= nx) {
+                    c[0] -= nx;
+                    ++wraps;
+                }
+                const double s0 = shift[0] + wraps * p_.box[0];
                 const double sh[3] = {s0, shift[1], shift[2]};
                 for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j]) {
                     if (j == i) continue;
@@ -399,19 +446,12 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
     double best = co_t_[i] - time_;  // relative to now (inf when there is no candidate)
     std::int32_t partner = co_partner_[i];
     std::int64_t partner_count = co_count_[i];
-    const double* g = p_.gravity;
-    for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
-        const Particle& pj = P_[j];
-        const double dtj = time_ - pj.t;
-        double dr[3], dv[3];
-        for (int a = 0; a < 3; ++a) {
-            const double vj = pj.v[a] + g[a] * dtj;
-            dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj + sh[a] - xi[a];
-            dv[a] = vj + vs[a] - vi[a];
-        }
+    const bool i_fixed = fixed_[i] != 0;
+    auto consider = [&](std::int32_t j, const double* dr, const double* dv) {
+        if (i_fixed && fixed_[j] != 0) return;  // bumps never meet
         const double b = dot3(dr, dv);
         if (b >= 0.0) return;
-        const double sigma = ri + pj.r;
+        const double sigma = ri + P_[j].r;
         const double cc = dot3(dr, dr) - sigma * sigma;
         double t;
         if (cc <= 0.0) {
@@ -427,7 +467,31 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             partner = j;
             partner_count = count_[j];
         }
-    });
+    };
+    if (gravity_) {
+        const double* g = p_.gravity;
+        for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
+            const Particle& pj = P_[j];
+            const double dtj = time_ - pj.t;
+            double dr[3], dv[3];
+            for (int a = 0; a < 3; ++a) {
+                dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj + sh[a] - xi[a];
+                dv[a] = pj.v[a] + g[a] * dtj + vs[a] - vi[a];
+            }
+            consider(j, dr, dv);
+        });
+    } else {
+        for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
+            const Particle& pj = P_[j];
+            const double dtj = time_ - pj.t;
+            double dr[3], dv[3];
+            for (int a = 0; a < 3; ++a) {
+                dr[a] = pj.x[a] + pj.v[a] * dtj + sh[a] - xi[a];
+                dv[a] = pj.v[a] + vs[a] - vi[a];
+            }
+            consider(j, dr, dv);
+        });
+    }
     if (partner >= 0) {
         co_t_[i] = time_ + best;
         co_partner_[i] = partner;
@@ -454,6 +518,17 @@ void EventDriven::schedule(std::int32_t i) {
         const bool open = a == 1 && !p_.periodic_y;
         const double lo = org_[a] + ci[a] * cw_[a];
         const double hi = ci[a] + 1 == ncell_[a] && !open ? p_.box[a] : lo + cw_[a];
+        if (p_.gravity[a] == 0.0) {  // straight flight: one boundary ahead
+            if (vi[a] == 0.0) continue;
+            const bool up = vi[a] > 0.0;
+            if (open && ci[a] == (up ? ncell_[a] - 1 : 0)) continue;
+            const double t = std::max(0.0, ((up ? hi : lo) - xi[a]) / vi[a]);
+            if (t < best) {
+                best = t;
+                kind = up ? -(a + 1) : -(a + 4);
+            }
+            continue;
+        }
         if (!(open && ci[a] + 1 == ncell_[a])) {
             const double t = first_hit(xi[a] - hi, vi[a], p_.gravity[a]);
             if (t < best) {
@@ -470,7 +545,7 @@ void EventDriven::schedule(std::int32_t i) {
         }
     }
     for (int s = 0; s < 2; ++s) {
-        if (!p_.wall[s].present) continue;
+        if (!p_.wall[s].present || fixed_[i] != 0) continue;
         const double t = wall_time(i, s);
         if (t < best) {
             best = t;
@@ -479,13 +554,11 @@ void EventDriven::schedule(std::int32_t i) {
     }
     const double other = time_ + best;
     if (co_partner_[i] >= 0 && co_t_[i] <= other) {
-        ev_t_[i] = co_t_[i];
+        heap_[pos_in_heap_[i]].t = co_t_[i];
         ev_partner_[i] = co_partner_[i];
-        ev_count_[i] = co_count_[i];
     } else {
-        ev_t_[i] = other;
+        heap_[pos_in_heap_[i]].t = other;
         ev_partner_[i] = kind;
-        ev_count_[i] = 0;
     }
 }
 
@@ -533,8 +606,8 @@ void EventDriven::predict_rows() {
 
 void EventDriven::schedule_system() {
     ev_partner_[n_] = kReshuffle;
-    ev_count_[n_] = 0;
-    ev_t_[n_] = p_.shear_rate != 0.0 ? le_t_ + cw_[0] / (p_.shear_rate * p_.box[1]) : kInf;
+    heap_[pos_in_heap_[n_]].t =
+        p_.shear_rate != 0.0 ? le_t_ + cw_[0] / (p_.shear_rate * p_.box[1]) : kInf;
 }
 
 void EventDriven::heap_up(std::int64_t k) {
@@ -566,21 +639,15 @@ void EventDriven::heap_down(std::int64_t k) {
     pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
 }
 
+// The node of i already holds its new time (schedule writes it): restore the heap order.
 void EventDriven::heap_update(std::int32_t i) {
     const std::int64_t k = pos_in_heap_[i];
-    const double old = heap_[k].t;
-    heap_[k].t = ev_t_[i];
-    if (ev_t_[i] < old)
-        heap_up(k);
-    else
-        heap_down(k);
+    heap_up(k);
+    heap_down(pos_in_heap_[i]);
 }
 
+// Re-establish the heap order of the node array (node times are current).
 void EventDriven::heap_build() {
-    for (std::int32_t i = 0; i <= static_cast<std::int32_t>(n_); ++i) {
-        heap_[i] = Node{ev_t_[i], i};
-        pos_in_heap_[i] = i;
-    }
     for (std::int64_t k = (n_ + 1) / 2 - 1; k >= 0; --k) heap_down(k);
 }
 
@@ -644,6 +711,10 @@ std::vector<LogRecord> EventDriven::take_log() {
 }
 
 void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
+    if (fixed_[i] != 0 || fixed_[j] != 0) {
+        process_bump(fixed_[i] != 0 ? j : i, fixed_[i] != 0 ? i : j);
+        return;
+    }
     advance(i, time_);
     advance(j, time_);
     double dr[3], vs[3];
@@ -702,6 +773,70 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
     heap_update(i);
     predict(j);
     heap_update(j);
+}
+
+// A mobile particle i meets bump b of a bumpy wall: the wall's rule with m* = m_i (the bump
+// keeps its velocity, the wall's); the impulse and work count for that wall.
+void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
+    advance(i, time_);
+    advance(b, time_);
+    const int side = fixed_[b] - 1;
+    const Rule& rule = p_.wall[side].rule;
+    double dr[3], vs[3];
+    separation(i, b, dr, vs);
+    const double dist = std::sqrt(dot3(dr, dr));
+    const double n[3] = {dr[0] / dist, dr[1] / dist, dr[2] / dist};
+    double* v = P_[i].v;
+    double* om = &w_[3 * i];
+    double ub[3], zero[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < 3; ++a) ub[a] = P_[b].v[a] + vs[a];
+    const double r = P_[i].r, m = m_[i], K = p_.inertia_k;
+    double vrel[3], rw[3], rwxn[3], g[3];
+    for (int a = 0; a < 3; ++a) {
+        vrel[a] = v[a] - ub[a];
+        rw[a] = r * om[a];
+    }
+    cross3(rw, n, rwxn);
+    for (int a = 0; a < 3; ++a) g[a] = vrel[a] + rwxn[a];
+    const double gn = dot3(g, n);
+    double gt2 = 0.0;
+    for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
+    double e, beta;
+    if (p_.tc > 0.0 && time_ - last_[i] < p_.tc) {
+        e = 1.0;
+        beta = -1.0;
+        ++tc_elastic_;
+    } else {
+        e = rule.restitution(std::max(gn, 0.0));
+        beta = rule.beta_for(e, K, std::max(gn, 0.0), std::sqrt(gt2));
+    }
+    auto energy = [&]() {  // in the bump's frame
+        double u[3];
+        for (int a = 0; a < 3; ++a) u[a] = v[a] - ub[a];
+        return 0.5 * m * (dot3(u, u) + K * r * r * dot3(om, om));
+    };
+    const double before = energy();
+    double J[3], ubc[3] = {ub[0], ub[1], ub[2]};
+    collide(n, r, P_[b].r, 1.0 / m, 0.0, K, e, beta, v, ubc, om, zero, J);
+    dissipated_ += before - energy();
+    wall_work_[side] += dot3(J, ub);
+    for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
+    if (p_.log_every > 0) {
+        double point[3], branch[3];
+        for (int a = 0; a < 3; ++a) {
+            branch[a] = r * n[a];
+            point[a] = P_[i].x[a] + branch[a];
+        }
+        log_collision(side + 1, i, b, point, n, branch, J, vrel, g);
+    }
+    last_[i] = time_;
+    ++count_[i];
+    ++count_[b];
+    ++wall_collisions_;
+    predict(i);
+    heap_update(i);
+    predict(b);
+    heap_update(b);
 }
 
 // A wall is a body of infinite mass moving with (u_x, v_n, u_z). A particle pressed onto it by
@@ -838,6 +973,11 @@ bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t sto
         const std::int32_t i = heap_[0].i;
         const double et = heap_[0].t;
         if (!(et <= t)) break;
+        if (events() - sorted_at_ >= kSortEvery * n_) {
+            for (std::int32_t k = 0; k < static_cast<std::int32_t>(n_); ++k) advance(k, time_);
+            reorder();
+            continue;
+        }
         time_ = et;
         if (i == static_cast<std::int32_t>(n_)) {
             process_reshuffle();
@@ -845,7 +985,7 @@ bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t sto
         }
         const std::int32_t p = ev_partner_[i];
         if (p >= 0) {
-            if (count_[p] != ev_count_[i]) {
+            if (count_[p] != co_count_[i]) {  // the event is i's collision candidate
                 ++invalid_;
                 predict(i);
                 heap_update(i);
@@ -863,6 +1003,52 @@ bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t sto
     if (reached) time_ = t;
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) advance(i, time_);
     return reached;
+}
+
+// Store the particles in cell order again (they drift apart in memory as they move, and the
+// neighbour scans then miss the cache). Called every kSortEvery · N events;
+// indices change, so every stored index is remapped (the event order (time, index) may then
+// break exact ties differently: deterministic, since the points are part of the state).
+// The particles are synchronised first (scheduled events stay valid).
+void EventDriven::reorder() {
+    const std::size_t N = static_cast<std::size_t>(n_);
+    std::vector<std::int32_t> perm(N), inv(N);
+    for (std::size_t i = 0; i < N; ++i) perm[i] = static_cast<std::int32_t>(i);
+    std::stable_sort(perm.begin(), perm.end(), [&](std::int32_t a, std::int32_t b) {
+        return cell_index(&cell_[3 * a]) < cell_index(&cell_[3 * b]);
+    });
+    for (std::size_t k = 0; k < N; ++k) inv[static_cast<std::size_t>(perm[k])] =
+        static_cast<std::int32_t>(k);
+    std::vector<char> done;
+    auto permute = [&](auto& v, std::size_t width) { permute_rows(v, width, perm, done); };
+    permute(P_, 1);
+    permute(order_, 1);
+    permute(w_, 3);
+    permute(last_, 1);
+    permute(m_, 1);
+    permute(fixed_, 1);
+    permute(count_, 1);
+    permute(cell_, 3);
+    permute(co_t_, 1);
+    permute(co_partner_, 1);
+    permute(co_count_, 1);
+    {
+        // the system slot n_ stays where it is: permute the first N entries only
+        const std::int32_t sys_p = ev_partner_[N];
+        ev_partner_.pop_back();
+        permute(ev_partner_, 1);
+        ev_partner_.push_back(sys_p);
+    }
+    for (auto& node : heap_)
+        if (node.i < static_cast<std::int32_t>(n_)) node.i = inv[static_cast<std::size_t>(node.i)];
+    for (std::size_t k = 0; k < heap_.size(); ++k) pos_in_heap_[heap_[k].i] = static_cast<std::int32_t>(k);
+    for (std::size_t k = 0; k < N; ++k) {
+        if (co_partner_[k] >= 0) co_partner_[k] = inv[static_cast<std::size_t>(co_partner_[k])];
+        if (ev_partner_[k] >= 0) ev_partner_[k] = inv[static_cast<std::size_t>(ev_partner_[k])];
+    }
+    build_cells();
+    heap_build();
+    sorted_at_ = events();
 }
 
 void EventDriven::set_wall(int side, double y, double vn, double ux, double uz) {
@@ -945,6 +1131,7 @@ double EventDriven::kinetic_energy() const {
     double e = 0.0;
     for (std::int64_t i = 0; i < n_; ++i) {
         double x[3], v[3];
+        if (fixed_[i] != 0) continue;
         state_at(static_cast<std::int32_t>(i), time_, x, v);
         e += 0.5 * m_[i] * dot3(v, v);
     }
@@ -954,11 +1141,13 @@ double EventDriven::kinetic_energy() const {
 double EventDriven::rotational_energy() const {
     double e = 0.0;
     for (std::int64_t i = 0; i < n_; ++i)
-        e += 0.5 * p_.inertia_k * m_[i] * P_[i].r * P_[i].r * dot3(&w_[3 * i], &w_[3 * i]);
+        if (fixed_[i] == 0)
+            e += 0.5 * p_.inertia_k * m_[i] * P_[i].r * P_[i].r * dot3(&w_[3 * i], &w_[3 * i]);
     return e;
 }
 
 EventDriven::State EventDriven::get_state() const {
+    const std::size_t N = static_cast<std::size_t>(n_);
     State s;
     s.pos.resize(3 * n_);
     s.vel.resize(3 * n_);
@@ -974,9 +1163,13 @@ EventDriven::State EventDriven::get_state() const {
     s.last = last_;
     s.count = count_;
     s.cell = cell_;
-    s.ev_time = ev_t_;
+    s.ev_time.resize(N + 1);
+    s.ev_count.assign(N + 1, 0);
+    for (std::size_t i = 0; i <= N; ++i) {
+        s.ev_time[i] = heap_[pos_in_heap_[i]].t;
+        if (i < N && ev_partner_[i] >= 0) s.ev_count[i] = co_count_[i];
+    }
     s.ev_partner = ev_partner_;
-    s.ev_count = ev_count_;
     s.co_time = co_t_;
     s.co_partner = co_partner_;
     s.co_count = co_count_;
@@ -992,7 +1185,8 @@ EventDriven::State EventDriven::get_state() const {
     s.scalars.insert(s.scalars.end(), {wall_work_[0], wall_work_[1]});
     s.scalars.insert(s.scalars.end(), virial_, virial_ + 9);
     s.counters = {collisions_, crossings_, invalid_, tc_elastic_, resting_, wall_collisions_,
-                  log_seen_};
+                  log_seen_, sorted_at_};
+    s.order = order_;
     return s;
 }
 
@@ -1000,7 +1194,8 @@ void EventDriven::set_state(const State& s) {
     const std::size_t N = static_cast<std::size_t>(n_);
     if (s.pos.size() != 3 * N || s.vel.size() != 3 * N || s.omega.size() != 3 * N ||
         s.last.size() != N || s.count.size() != N || s.cell.size() != 3 * N ||
-        s.scalars.size() != 33 || s.counters.size() != 7 || s.stress.size() != stress_.size())
+        s.scalars.size() != 33 || s.counters.size() != 8 || s.stress.size() != stress_.size() ||
+        s.order.size() != N)
         throw std::invalid_argument("set_state: array sizes do not match this system");
     const bool events = !s.ev_time.empty();
     if (events && (s.ev_time.size() != N + 1 || s.ev_partner.size() != N + 1 ||
@@ -1069,12 +1264,38 @@ void EventDriven::set_state(const State& s) {
     resting_ = s.counters[4];
     wall_collisions_ = s.counters[5];
     log_seen_ = s.counters[6];
+    sorted_at_ = s.counters[7];
+    {
+        std::vector<char> seen(N, 0);
+        for (std::size_t i = 0; i < N; ++i) {
+            const std::int32_t o = s.order[i];
+            if (o < 0 || o >= n_ || seen[static_cast<std::size_t>(o)])
+                throw std::invalid_argument("set_state: order is not a permutation");
+            seen[static_cast<std::size_t>(o)] = 1;
+        }
+        // masses and radii follow the stored order (the system may have been re-sorted)
+        std::vector<double> m(N), r(N);
+        std::vector<std::int8_t> f(N);
+        for (std::size_t k = 0; k < N; ++k) {
+            m[static_cast<std::size_t>(order_[k])] = m_[k];
+            r[static_cast<std::size_t>(order_[k])] = P_[k].r;
+            f[static_cast<std::size_t>(order_[k])] = fixed_[k];
+        }
+        order_ = s.order;
+        for (std::size_t k = 0; k < N; ++k) {
+            m_[k] = m[static_cast<std::size_t>(order_[k])];
+            P_[k].r = r[static_cast<std::size_t>(order_[k])];
+            fixed_[k] = f[static_cast<std::size_t>(order_[k])];
+        }
+    }
     log_.clear();
     build_cells();
     if (events) {
-        ev_t_ = s.ev_time;
+        for (std::int32_t k = 0; k <= static_cast<std::int32_t>(n_); ++k) {
+            heap_[k] = Node{s.ev_time[k], k};
+            pos_in_heap_[k] = k;
+        }
         ev_partner_ = s.ev_partner;
-        ev_count_ = s.ev_count;
         co_t_ = s.co_time;
         co_partner_ = s.co_partner;
         co_count_ = s.co_count;
@@ -1089,8 +1310,8 @@ std::int64_t EventDriven::memory_bytes() const {
     auto b = [](const auto& v) {
         return static_cast<std::int64_t>(v.capacity() * sizeof(v[0]));
     };
-    return b(P_) + b(order_) + b(w_) + b(last_) + b(m_) + b(count_) + b(cell_) + b(head_) +
-           b(next_) + b(prev_) + b(ev_t_) + b(ev_partner_) + b(ev_count_) + b(co_t_) +
+    return b(P_) + b(order_) + b(w_) + b(last_) + b(m_) + b(fixed_) + b(count_) + b(cell_) + b(head_) +
+           b(next_) + b(prev_) + b(ev_partner_) + b(co_t_) +
            b(co_partner_) + b(co_count_) + b(heap_) + b(pos_in_heap_) + b(stress_) + b(log_) +
            static_cast<std::int64_t>(sizeof(*this));
 }
@@ -1101,7 +1322,7 @@ double EventDriven::min_gap() const {
         double xi[3], vi[3];
         state_at(i, time_, xi, vi);
         for_neighbours(i, -1, 0, [&](std::int32_t j, const double* sh, const double*) {
-            if (j <= i) return;
+            if (j <= i || (fixed_[i] != 0 && fixed_[j] != 0)) return;
             double xj[3], vj[3];
             state_at(j, time_, xj, vj);
             double dr[3];
@@ -1115,6 +1336,7 @@ double EventDriven::min_gap() const {
 double EventDriven::min_wall_gap() const {
     double best = kInf;
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+        if (fixed_[i] != 0) continue;
         double x[3], v[3];
         state_at(i, time_, x, v);
         if (p_.wall[0].present)
