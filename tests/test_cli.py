@@ -121,7 +121,7 @@ def test_analyze_stored_frames_adds_statistics(tmp_path, capsys):
         main(["analyze", str(out), "--what", "nonsense"]) and capsys.readouterr().err)
 
 
-def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path):
+def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path, capsys):
     """`--engine edmd` goes through the same isolated child process as LAMMPS and writes the
     same results layout; scenes outside its scope (bumpy walls) are refused with exit 2."""
     from demstudy.io.results import read_results
@@ -135,7 +135,8 @@ def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path):
     ke = res.timeseries["kinetic_energy"]
     assert ke[-1] < ke[0]  # e = 0.9: it cools
     assert main(["run", str(CHUTE), "--engine", "edmd", "--out", str(tmp_path / "c.h5"),
-                 "-q", "--set", "walls[0].kind=bumpy", "--set", "walls[0].bumps.spacing=1.0"]) == 2
+                 "-q", "--set", "walls[0].kind=bumpy", "--set", "walls.0.bumps.spacing=1.0"]) == 2
+    assert "unsupported by edmd: walls[lower].kind" in capsys.readouterr().err
 
 
 def test_stop_refusal_and_failure_have_distinct_exit_codes(tmp_path, capsys):

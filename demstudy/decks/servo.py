@@ -130,7 +130,9 @@ class ServoController:
             # stress the particles exert on this wall (positive = pushing it outwards)
             sigma = (normal_force[side] if side == "lower" else -normal_force[side]) / area
             sigma_n = servo.normal_stress
-            excess = max(-sigma_n, min(sigma_n, sigma - sigma_n))
+            excess = sigma - sigma_n
+            if servo.clamp:  # Campbell's rule
+                excess = max(-sigma_n, min(sigma_n, excess))
             outward = -1.0 if side == "lower" else 1.0
             wall.vy = 0.5 * wall.vy + outward * servo.gain * excess
             if not math.isfinite(wall.vy):

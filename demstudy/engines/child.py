@@ -52,7 +52,8 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     cmd = [sys.executable, "-m", "demstudy.engines.child", str(job)]
     if options.np > 1:
         cmd = [mpirun_executable(), "-np", str(options.np), *cmd]
-    proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL)
+    proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL,
+                            preexec_fn=_die_with_parent if sys.platform == "linux" else None)
     try:
         returncode = proc.wait()
     except KeyboardInterrupt:
@@ -77,6 +78,15 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     return out
 
 
+def _die_with_parent() -> None:
+    """In the child before exec: SIGTERM when the parent dies (killed by a batch system's
+    timeout, say), so no orphaned engine keeps running (Linux prctl PR_SET_PDEATHSIG)."""
+    import ctypes  # noqa: PLC0415
+    import signal  # noqa: PLC0415
+
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
+
+
 def worker(job: str) -> int:
     from .base import get_engine  # noqa: PLC0415 - the engines import this module
 
@@ -89,12 +99,13 @@ def worker(job: str) -> int:
                          checkpoint_interval=payload["checkpoint_interval"],
                          wall_limit=payload["wall_limit"], extra=payload["extra"])
     from ..decks.base import UnsupportedByEngine  # noqa: PLC0415
+    from ..scene.load import SceneError  # noqa: PLC0415
 
     try:
         get_engine(payload["engine"]).run(scene, options)
     except RunStopped:
         return STOPPED  # the parent says so, once
-    except (UnsupportedByEngine, ValueError) as exc:
+    except (UnsupportedByEngine, SceneError) as exc:  # refused before anything ran
         print(f"error: {exc}", file=sys.stderr)
         return REFUSED
     except Exception as exc:  # one line, never a bare traceback

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import re
 import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -87,7 +88,8 @@ def parse_value(text: str) -> Any:
 
 
 def apply_overrides(data: dict, overrides: Iterable[str], source: str = "--set") -> dict:
-    """Return a copy of ``data`` with ``key.path=value`` overrides applied.
+    """Return a copy of ``data`` with ``key.path=value`` overrides applied (list items by
+    index: ``walls.0.restitution`` or ``walls[0].restitution``).
 
     Unknown top-level sections are reported with the nearest valid name; the full
     validation then checks the keys inside.
@@ -96,7 +98,7 @@ def apply_overrides(data: dict, overrides: Iterable[str], source: str = "--set")
     problems = []
     for item in overrides:
         key, sep, text = item.partition("=")
-        key = key.strip()
+        key = re.sub(r"\[(\d+)\]", r".\1", key.strip())  # walls[0].x is walls.0.x
         if not sep or not key:
             problems.append(f"{item!r}: expected key.path=value, e.g. run.production=20")
             continue

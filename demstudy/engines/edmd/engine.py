@@ -82,6 +82,7 @@ class EdmdRunState:
     stress_durations: list = field(default_factory=list)
     log: dict[str, list] = field(default_factory=dict)
     logged: int = 0
+    stress_edges: np.ndarray | None = None  # servo runs: bins fixed when production starts
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
@@ -173,6 +174,8 @@ class _Run:
             raise EngineError("--resume: the checkpoint belongs to a different scene")
         core.set_state(saved["core"])
         self.keep_frames = saved["run"].keep_frames  # frames for the whole run or not at all
+        if saved["run"].stress_edges is not None:
+            self.stress_edges = saved["run"].stress_edges
         return core, saved["run"]
 
     def _checkpoint(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
@@ -295,6 +298,14 @@ class _Run:
                       radius=self.radius, tilt=core.shear_offset)
         if state.profiles is None:  # servo: bins between the walls where production starts
             state.profiles = profile_analysis(self.scene, (float(lo[1]), float(hi[1])))
+            if self.stress:  # the collisional stress in the same bins, from now on
+                n_bins = max(1, round((hi[1] - lo[1]) / self.scene.measure.bin_width))
+                width = (hi[1] - lo[1]) / n_bins
+                self.stress_edges = lo[1] + width * np.arange(n_bins + 1)
+                core.set_stress_bins(float(lo[1]), float(width), n_bins)
+                state.stress_edges = self.stress_edges
+                state.stress_chunks, state.stress_durations = [], []
+                state.last_stress = core.stress_sums[:, :dim, :dim].transpose(0, 2, 1)
         state.profiles.feed(frame)
         if self.keep_frames:
             keep_frame(state.frames, frame)

@@ -139,8 +139,11 @@ public:
     // Move a wall: position y at the current time, normal velocity vn, surface velocity (x, z).
     // Every prediction is redone (walls change rarely: the servo).
     void set_wall(int side, double y, double vn, double ux, double uz);
-    // Scale x positions and the x period by `factor` (servo width scaling); re-predicts.
-    void scale_width(double factor);
+    // New collisional-stress bins along y (sums restart from zero).
+    void set_stress_bins(double lo, double width, std::int64_t n);
+    // Scale x positions and the x period by `factor` (servo width scaling), limited so that
+    // no pair overlaps; re-predicts. Returns the factor applied.
+    double scale_width(double factor);
 
     // Drain the collision log (records since the last call).
     std::vector<LogRecord> take_log();
@@ -183,7 +186,7 @@ private:
     static constexpr std::int32_t kNone = std::numeric_limits<std::int32_t>::min();
     // ev_partner codes below 0: -(axis + 1) crossing upwards, -(axis + 4) downwards, walls,
     // the Lees–Edwards re-scan (system slot)
-    static constexpr std::int64_t kSortEvery = 4;  // re-sort memory every 4 N events
+    static constexpr std::int64_t kSortEvery = 16;  // re-sort memory every 16 N events
     static constexpr std::int32_t kLowerWall = -7, kUpperWall = -8, kReshuffle = -9;
 
     Params p_;
@@ -233,19 +236,15 @@ private:
     std::vector<double> stress_;
     std::vector<LogRecord> log_;
 
-    // Cells are numbered tile by tile (tiles of 4×4×4 cells in 3D, 8×8 in 2D): the cells of a
-    // neighbourhood, and the particles stored in this order, sit close together in memory.
-    int tshift_[3] = {2, 2, 2};
-    std::int64_t ntile_[3] = {1, 1, 1};
+    // Cells are numbered row by row (x fastest): an interior cell's neighbours are at fixed
+    // index offsets (nb_off_), the fast path of the neighbour scan. Particles are stored in
+    // Morton order of their cells instead (neighbours close in memory along every axis).
     std::int64_t cell_index(const std::int32_t* c) const {
-        const std::int64_t tile = ((static_cast<std::int64_t>(c[2] >> tshift_[2]) * ntile_[1] +
-                                    (c[1] >> tshift_[1])) * ntile_[0] + (c[0] >> tshift_[0]));
-        const std::int64_t local =
-            ((static_cast<std::int64_t>(c[2] & ((1 << tshift_[2]) - 1)) << tshift_[1] |
-              (c[1] & ((1 << tshift_[1]) - 1))) << tshift_[0]) |
-            (c[0] & ((1 << tshift_[0]) - 1));
-        return (tile << (tshift_[0] + tshift_[1] + tshift_[2])) | local;
+        return (static_cast<std::int64_t>(c[2]) * ncell_[1] + c[1]) * ncell_[0] + c[0];
     }
+    std::int64_t nb_off_[27] = {0};
+    std::int8_t nb_d_[27][3] = {{0}};
+    int n_nb_ = 27;
     void setup_grid();
     int cell_of(double x, int axis) const;
     void insert_cell(std::int32_t i);
@@ -285,6 +284,7 @@ private:
     void process_crossing(std::int32_t i, int axis);
     void process_reshuffle();
     void reorder();
+    void sort_by_cell(std::vector<std::int32_t>& perm) const;
 };
 
 }  // namespace demstudy::edmd

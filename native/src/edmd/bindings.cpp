@@ -5,6 +5,7 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -208,8 +209,9 @@ void set_state(EventDriven& s, nb::dict d) {
         st.co_partner = vec<std::int32_t>(d["co_partner"], n, "co_partner");
         st.co_count = vec<std::int64_t>(d["co_count"], n, "co_count");
     }
-    st.stress = vec<double>(d["stress"], s.stress_sums().size(), "stress");
-    st.scalars = vec<double>(d["scalars"], 33, "scalars");
+    st.scalars = vec<double>(d["scalars"], 36, "scalars");
+    const auto bins = static_cast<std::size_t>(std::max(0.0, st.scalars[35]));
+    st.stress = vec<double>(d["stress"], 9 * bins, "stress");
     st.counters = vec<std::int64_t>(d["counters"], 8, "counters");
     st.order = vec<std::int32_t>(d["order"], n, "order");
     try {
@@ -348,15 +350,26 @@ void bind(nb::module_& m) {
              },
              "side"_a, "position"_a, "normal_velocity"_a, "velocity"_a, "velocity_z"_a = 0.0,
              "Move a wall now: position, normal velocity, surface velocity (x, z).")
-        .def("scale_width",
-             [](EventDriven& s, double f) {
+        .def("set_stress_bins",
+             [](EventDriven& s, double lo, double width, std::int64_t n) {
                  try {
-                     s.scale_width(f);
+                     s.set_stress_bins(lo, width, n);
                  } catch (const std::invalid_argument& err) {
                      throw nb::value_error(err.what());
                  }
              },
-             "factor"_a, "Scale x positions and the x period by factor.")
+             "lo"_a, "width"_a, "n"_a, "New stress bins along y; the sums restart at zero.")
+        .def("scale_width",
+             [](EventDriven& s, double f) {
+                 try {
+                     return s.scale_width(f);
+                 } catch (const std::invalid_argument& err) {
+                     throw nb::value_error(err.what());
+                 }
+             },
+             "factor"_a,
+             "Scale x positions and the x period by factor, limited so that no pair overlaps "
+             "(a jammed packing keeps its width); returns the factor applied.")
         .def_prop_ro("stress_sums",
                      [](const EventDriven& s) {
                          const auto& v = s.stress_sums();

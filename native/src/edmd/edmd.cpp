@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace demstudy::edmd {
 
@@ -19,6 +20,23 @@ inline void cross3(const double* a, const double* b, double* out) {
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Morton (Z-order) key of a cell: neighbouring cells along every axis stay close in memory
+// order, unlike the row-major cell index (there a z neighbour is nx·ny cells away).
+inline std::uint64_t spread3(std::uint64_t x) {
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffULL;
+    x = (x | x << 16) & 0x1f0000ff0000ffULL;
+    x = (x | x << 8) & 0x100f00f00f00f00fULL;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+    x = (x | x << 2) & 0x1249249249249249ULL;
+    return x;
+}
+inline std::uint64_t morton(const std::int32_t* c) {
+    return spread3(static_cast<std::uint64_t>(c[0])) |
+           spread3(static_cast<std::uint64_t>(c[1])) << 1 |
+           spread3(static_cast<std::uint64_t>(c[2])) << 2;
+}
 
 // v[k] <- v[perm[k]] for rows of `width` elements, in place (cycle following): no copy of
 // the array, so re-sorting does not raise the peak memory.
@@ -172,58 +190,60 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
         throw std::invalid_argument("log_every and log_capacity must be >= 0");
     stress_.assign(static_cast<std::size_t>(9 * p.stress_bins), 0.0);
     const std::size_t N = static_cast<std::size_t>(n);
+    const int nrot = p.dim == 2 ? 1 : 3;
+    // wrapped input position (periodic axes)
+    auto wrapped = [&](std::size_t i, int a) {
+        double x = pos[i * p.dim + a];
+        if (a != 1 || p_.periodic_y) {
+            const double L = p_.box[a];
+            x = x - L * std::floor(x / L);
+            if (x >= L) x -= L;
+        }
+        return x;
+    };
+    dmax_ = 0.0;
+    for (std::size_t i = 0; i < N; ++i) {
+        for (int a = 0; a < p.dim; ++a)
+            if (!std::isfinite(pos[i * p.dim + a]) || !std::isfinite(vel[i * p.dim + a]))
+                throw std::invalid_argument("non-finite position or velocity");
+        if (!(diameter[i] > 0.0) || !(mass[i] > 0.0))
+            throw std::invalid_argument("diameters and masses must be positive");
+        dmax_ = std::max(dmax_, diameter[i]);
+    }
+    setup_grid();
+    // internal order: by cell, in Morton order (neighbours close in memory); order_[internal]
+    // = input index. Sorted before the particle arrays exist (keeps the peak memory low),
+    // then every array is filled in that order.
+    cell_.assign(3 * N, 0);
+    for (std::size_t i = 0; i < N; ++i)
+        for (int a = 0; a < p.dim; ++a) cell_[3 * i + a] = cell_of(wrapped(i, a), a);
+    sort_by_cell(order_);
+    {
+        std::vector<char> done;
+        permute_rows(cell_, 3, order_, done);
+    }
     P_.assign(N, Particle{});
     w_.assign(3 * N, 0.0);
     last_.assign(N, -kInf);
     m_.resize(N);
-    fixed_ = p.fixed.empty() ? std::vector<std::int8_t>(N, 0) : p.fixed;
-    p_.fixed.clear();
-    p_.fixed.shrink_to_fit();
+    fixed_.assign(N, 0);
     count_.assign(N, 0);
-    cell_.assign(3 * N, 0);
-    dmax_ = 0.0;
-    const int nrot = p.dim == 2 ? 1 : 3;
-    for (std::size_t i = 0; i < N; ++i) {
+    for (std::size_t k = 0; k < N; ++k) {
+        const std::size_t i = static_cast<std::size_t>(order_[k]);
         for (int a = 0; a < p.dim; ++a) {
-            const double L = p_.box[a];
-            double x = pos[i * p.dim + a];
-            if (!std::isfinite(x) || !std::isfinite(vel[i * p.dim + a]))
-                throw std::invalid_argument("non-finite position or velocity");
-            if (a != 1 || p_.periodic_y) {
-                x = x - L * std::floor(x / L);
-                if (x >= L) x -= L;
-            }
-            P_[i].x[a] = x;
-            P_[i].v[a] = vel[i * p.dim + a];
+            P_[k].x[a] = wrapped(i, a);
+            P_[k].v[a] = vel[i * p.dim + a];
         }
         if (nrot == 1)
-            w_[3 * i + 2] = omega[i];
+            w_[3 * k + 2] = omega[i];
         else
-            for (int a = 0; a < 3; ++a) w_[3 * i + a] = omega[3 * i + a];
-        if (!(diameter[i] > 0.0) || !(mass[i] > 0.0))
-            throw std::invalid_argument("diameters and masses must be positive");
-        P_[i].r = 0.5 * diameter[i];
-        m_[i] = mass[i];
-        dmax_ = std::max(dmax_, diameter[i]);
+            for (int a = 0; a < 3; ++a) w_[3 * k + a] = omega[3 * i + a];
+        P_[k].r = 0.5 * diameter[i];
+        m_[k] = mass[i];
+        if (!p.fixed.empty()) fixed_[k] = p.fixed[i];
     }
-    setup_grid();
-    for (std::size_t i = 0; i < N; ++i)
-        for (int a = 0; a < p.dim; ++a) cell_[3 * i + a] = cell_of(P_[i].x[a], a);
-    // internal order: by cell index (tiled: neighbours close in memory); order_[internal] =
-    // input index
-    order_.resize(N);
-    for (std::size_t i = 0; i < N; ++i) order_[i] = static_cast<std::int32_t>(i);
-    std::stable_sort(order_.begin(), order_.end(), [&](std::int32_t a, std::int32_t b) {
-        return cell_index(&cell_[3 * a]) < cell_index(&cell_[3 * b]);
-    });
-    {
-        std::vector<char> done;
-        permute_rows(P_, 1, order_, done);
-        permute_rows(w_, 3, order_, done);
-        permute_rows(m_, 1, order_, done);
-        permute_rows(fixed_, 1, order_, done);
-        permute_rows(cell_, 3, order_, done);
-    }
+    p_.fixed.clear();
+    p_.fixed.shrink_to_fit();
     build_cells();
     co_t_.assign(N, kInf);
     co_partner_.assign(N, -1);
@@ -270,11 +290,17 @@ void EventDriven::setup_grid() {
         cw_[2] = p_.box[2];
         org_[2] = 0.0;
     }
-    for (int a = 0; a < 3; ++a) {
-        tshift_[a] = p_.dim == 3 ? 2 : (a < 2 ? 3 : 0);
-        const int t = 1 << tshift_[a];
-        ntile_[a] = (ncell_[a] + t - 1) / t;
-    }
+    n_nb_ = 0;
+    const int zr = p_.dim == 3 ? 1 : 0;
+    for (int dz = -zr; dz <= zr; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                nb_off_[n_nb_] = (static_cast<std::int64_t>(dz) * ncell_[1] + dy) * ncell_[0] + dx;
+                nb_d_[n_nb_][0] = static_cast<std::int8_t>(dx);
+                nb_d_[n_nb_][1] = static_cast<std::int8_t>(dy);
+                nb_d_[n_nb_][2] = static_cast<std::int8_t>(dz);
+                ++n_nb_;
+            }
 }
 
 int EventDriven::cell_of(double x, int axis) const {
@@ -283,8 +309,7 @@ int EventDriven::cell_of(double x, int axis) const {
 }
 
 void EventDriven::build_cells() {
-    const std::int64_t total = (ntile_[0] * ntile_[1] * ntile_[2])
-                               << (tshift_[0] + tshift_[1] + tshift_[2]);
+    const std::int64_t total = static_cast<std::int64_t>(ncell_[0]) * ncell_[1] * ncell_[2];
     head_.assign(static_cast<std::size_t>(total), -1);
     next_.assign(static_cast<std::size_t>(n_), -1);
     prev_.assign(static_cast<std::size_t>(n_), -1);
@@ -378,6 +403,21 @@ void EventDriven::separation(std::int32_t i, std::int32_t j, double dr[3], doubl
 template <typename F>
 void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& visit) const {
     const std::int32_t* ci = &cell_[3 * i];
+    // fast path: every neighbour cell inside the grid (no image shift, fixed index offsets)
+    bool interior = true;
+    for (int a = 0; a < p_.dim; ++a) interior = interior && ci[a] >= 1 && ci[a] + 1 < ncell_[a];
+    if (interior) {
+        static constexpr double zero[3] = {0.0, 0.0, 0.0};
+        const std::int64_t base = cell_index(ci);
+        for (int k = 0; k < n_nb_; ++k) {
+            if (only_axis >= 0 && nb_d_[k][only_axis] != dir) continue;
+            for (std::int32_t j = head_[base + nb_off_[k]]; j >= 0; j = next_[j]) {
+                if (j == i) continue;
+                visit(j, zero, zero);
+            }
+        }
+        return;
+    }
     const int zr = p_.dim == 3 ? 1 : 0;
     for (int dz = -zr; dz <= zr; ++dz) {
         if (only_axis == 2 && dz != dir) continue;
@@ -821,6 +861,10 @@ void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
     dissipated_ += before - energy();
     wall_work_[side] += dot3(J, ub);
     for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
+    {
+        const double branch[3] = {r * n[0], r * n[1], r * n[2]};  // to the contact point
+        add_stress(P_[i].x[1], P_[i].x[1] + branch[1], branch, J);
+    }
     if (p_.log_every > 0) {
         double point[3], branch[3];
         for (int a = 0; a < 3; ++a) {
@@ -903,6 +947,12 @@ void EventDriven::process_wall(std::int32_t i, int side) {
     dissipated_ += before - energy();
     wall_work_[side] += dot3(J, uw);
     for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
+    {
+        // the wall acts at the contact point: branch r n from the centre (as the LAMMPS
+        // contact stress), so the bins next to the wall carry its stress too
+        const double branch[3] = {r * n[0], r * n[1], r * n[2]};
+        add_stress(P_[i].x[1], P_[i].x[1] + branch[1], branch, J);
+    }
     if (p_.log_every > 0) {
         double point[3], branch[3];
         for (int a = 0; a < 3; ++a) {
@@ -1005,6 +1055,17 @@ bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t sto
     return reached;
 }
 
+// perm <- the indices 0..N-1 ordered by (Morton key of the cell, index): keys computed once.
+void EventDriven::sort_by_cell(std::vector<std::int32_t>& perm) const {
+    const std::size_t N = static_cast<std::size_t>(n_);
+    std::vector<std::pair<std::uint64_t, std::int32_t>> key(N);
+    for (std::size_t i = 0; i < N; ++i)
+        key[i] = {morton(&cell_[3 * i]), static_cast<std::int32_t>(i)};
+    std::sort(key.begin(), key.end());
+    perm.resize(N);
+    for (std::size_t k = 0; k < N; ++k) perm[k] = key[k].second;
+}
+
 // Store the particles in cell order again (they drift apart in memory as they move, and the
 // neighbour scans then miss the cache). Called every kSortEvery · N events;
 // indices change, so every stored index is remapped (the event order (time, index) may then
@@ -1014,9 +1075,7 @@ void EventDriven::reorder() {
     const std::size_t N = static_cast<std::size_t>(n_);
     std::vector<std::int32_t> perm(N), inv(N);
     for (std::size_t i = 0; i < N; ++i) perm[i] = static_cast<std::int32_t>(i);
-    std::stable_sort(perm.begin(), perm.end(), [&](std::int32_t a, std::int32_t b) {
-        return cell_index(&cell_[3 * a]) < cell_index(&cell_[3 * b]);
-    });
+    sort_by_cell(perm);
     for (std::size_t k = 0; k < N; ++k) inv[static_cast<std::size_t>(perm[k])] =
         static_cast<std::int32_t>(k);
     std::vector<char> done;
@@ -1069,14 +1128,40 @@ void EventDriven::set_wall(int side, double y, double vn, double ux, double uz) 
     heap_build();
 }
 
-void EventDriven::scale_width(double factor) {
+void EventDriven::set_stress_bins(double lo, double width, std::int64_t n) {
+    if (n < 0 || (n > 0 && !(width > 0.0)) || !std::isfinite(lo))
+        throw std::invalid_argument("set_stress_bins: need n >= 0 bins of positive width");
+    p_.stress_lo = lo;
+    p_.stress_width = width;
+    p_.stress_bins = n;
+    stress_.assign(static_cast<std::size_t>(9 * n), 0.0);
+}
+
+// Shrinking x affinely must not make touching pairs overlap: the factor is limited to the
+// smallest one every neighbouring pair allows (f² dx² + dy² + dz² >= σ²), with a margin of
+// 1e-9 d; a jammed packing thus keeps its width. Returns the factor applied.
+double EventDriven::scale_width(double factor) {
     if (!(factor > 0.0) || !std::isfinite(factor))
         throw std::invalid_argument("scale_width: factor must be positive");
     if (p_.shear_rate != 0.0) throw std::invalid_argument("scale_width: not with Lees-Edwards");
-    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
-        advance(i, time_);
-        P_[i].x[0] *= factor;
+    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) advance(i, time_);
+    if (factor < 1.0) {
+        double f_min = 0.0;
+        for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
+            for_neighbours(i, -1, 0, [&](std::int32_t j, const double* sh, const double*) {
+                if (j <= i || (fixed_[i] != 0 && fixed_[j] != 0)) return;
+                double dr[3];
+                for (int a = 0; a < 3; ++a) dr[a] = P_[j].x[a] + sh[a] - P_[i].x[a];
+                const double sigma = P_[i].r + P_[j].r + 1e-9;
+                const double need = sigma * sigma - dr[1] * dr[1] - dr[2] * dr[2];
+                if (need > 0.0 && dr[0] != 0.0)
+                    f_min = std::max(f_min, std::sqrt(need) / std::fabs(dr[0]));
+            });
+        }
+        factor = std::min(1.0, std::max(factor, f_min));
     }
+    if (factor == 1.0) return 1.0;
+    for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) P_[i].x[0] *= factor;
     p_.box[0] *= factor;
     setup_grid();
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
@@ -1088,6 +1173,7 @@ void EventDriven::scale_width(double factor) {
     build_cells();
     predict_all();
     heap_build();
+    return factor;
 }
 
 void EventDriven::positions(double* out) const {
@@ -1184,6 +1270,8 @@ EventDriven::State EventDriven::get_state() const {
         s.scalars.insert(s.scalars.end(), wall_impulse_[k], wall_impulse_[k] + 3);
     s.scalars.insert(s.scalars.end(), {wall_work_[0], wall_work_[1]});
     s.scalars.insert(s.scalars.end(), virial_, virial_ + 9);
+    s.scalars.insert(s.scalars.end(), {p_.stress_lo, p_.stress_width,
+                                       static_cast<double>(p_.stress_bins)});
     s.counters = {collisions_, crossings_, invalid_, tc_elastic_, resting_, wall_collisions_,
                   log_seen_, sorted_at_};
     s.order = order_;
@@ -1194,7 +1282,8 @@ void EventDriven::set_state(const State& s) {
     const std::size_t N = static_cast<std::size_t>(n_);
     if (s.pos.size() != 3 * N || s.vel.size() != 3 * N || s.omega.size() != 3 * N ||
         s.last.size() != N || s.count.size() != N || s.cell.size() != 3 * N ||
-        s.scalars.size() != 33 || s.counters.size() != 8 || s.stress.size() != stress_.size() ||
+        s.scalars.size() != 36 || s.counters.size() != 8 ||
+        s.stress.size() != 9 * static_cast<std::size_t>(std::max(0.0, s.scalars[35])) ||
         s.order.size() != N)
         throw std::invalid_argument("set_state: array sizes do not match this system");
     const bool events = !s.ev_time.empty();
@@ -1257,6 +1346,9 @@ void EventDriven::set_state(const State& s) {
     wall_work_[0] = s.scalars[k++];
     wall_work_[1] = s.scalars[k++];
     for (int a = 0; a < 9; ++a) virial_[a] = s.scalars[k++];
+    p_.stress_lo = s.scalars[k++];
+    p_.stress_width = s.scalars[k++];
+    p_.stress_bins = static_cast<std::int64_t>(s.scalars[k++]);
     collisions_ = s.counters[0];
     crossings_ = s.counters[1];
     invalid_ = s.counters[2];
