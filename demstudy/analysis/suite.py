@@ -18,13 +18,14 @@ from .collisions import CollisionAngles, collision_chunks
 from .pair_correlation import PairCorrelation
 from .profiles import ProfileAnalysis
 from .stress import stress_results
+from .structure import StructureDistributions
 from .vdf import velocity_distributions
 from .velocity_correlation import orientational_correlation, velocity_correlations
 from .waves import DensityWaves
 
 #: Statistics ``demstudy analyze --what`` can compute from frames.
-AVAILABLE = ("profiles", "vdf", "gr", "angles", "stress", "vcorr", "lambda", "waves",
-             "cgprofiles")
+AVAILABLE = ("profiles", "vdf", "gr", "structure", "angles", "stress", "vcorr", "lambda",
+             "waves", "cgprofiles")
 
 
 def profile_bounds(scene: Scene) -> tuple[float, float, float]:
@@ -78,6 +79,14 @@ def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
             r_max = min(5.0, 0.5 * min(periodic) - 0.05) if periodic else 5.0
             ana = PairCorrelation(dim=scene.dimension, r_max=r_max, dr=0.05,
                                   periodic_y=scene.y_periodic).run(frames()).finish()
+        elif name == "structure":  # Campbell's normal and parallel distributions
+            periodic = [scene.box.size[i] for i, a in enumerate("xyz"[: scene.dimension])
+                        if a != "y"]
+            r_max = min(4.0, 0.5 * min(periodic) - 0.05)
+            y_mid = 0.5 * (lo + hi)
+            ana = StructureDistributions(dim=scene.dimension, r_max=r_max, dr=0.08,
+                                         half_width=scene.measure.bin_width,
+                                         y_mid=y_mid).run(frames()).finish()
         elif name == "angles":
             ana = collision_angle_analysis(scene, results)
         elif name == "stress":

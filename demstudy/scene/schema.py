@@ -333,8 +333,8 @@ class Soft(StrictModel):
 
 
 #: Statistics the engines compute today (issue 4 extends the list).
-Statistic = Literal["profiles", "angles", "stress", "vcorr", "lambda", "waves",
-                    "cgprofiles"]
+Statistic = Literal["profiles", "vdf", "gr", "structure", "angles", "stress", "vcorr",
+                    "lambda", "waves", "cgprofiles"]
 
 
 class Measure(StrictModel):
