@@ -176,6 +176,13 @@ class Servo(StrictModel):
     the periodic width proportional to the gap; ``hold_shear_rate`` scales the upper wall's
     speed with the gap so that (u_upper − u_lower)/gap stays constant.
 
+    ``interval_unit``: what event-driven engines count between updates — ``collisions``
+    (Campbell: every ``interval_collisions`` × N pair collisions) or ``time`` (every
+    ``interval_time``, as time-stepped engines always do). Counting collisions makes the rule
+    equalise the mean stress *per interval*; intervals are short when the cell is dense and
+    stressed, so the time-mean wall stress differs from σ_n; with ``time`` intervals and
+    ``clamp = false`` the time-mean wall stress converges to σ_n.
+
     ``clamp = false`` drops Campbell's clamp (v ← ½ v ± gain · (σ_measured − σ_n)): the
     clamp cuts the high tail of the interval stress, whose distribution is skewed when an
     interval holds few wall collisions, so with it the servo settles where the *clamped*
@@ -190,6 +197,13 @@ class Servo(StrictModel):
     scale_width: bool = True
     hold_shear_rate: bool = True
     clamp: bool = True
+    interval_unit: Literal["collisions", "time"] = "collisions"
+
+    @model_validator(mode="after")
+    def _time_needs_interval_time(self) -> Servo:
+        if self.interval_unit == "time" and self.interval_time is None:
+            raise ValueError("interval_unit = 'time' needs interval_time")
+        return self
 
 
 class Wall(StrictModel):

@@ -74,7 +74,8 @@ class EdmdRunState:
     last_impulse: dict[str, np.ndarray] = field(default_factory=dict)
     keep_frames: bool = False  # fixed when the run starts, kept on resume
     servo: ServoController | None = None
-    next_servo: int = 0  # collision count of the next servo update
+    next_servo: int = 0  # collision count of the next servo update (interval_unit collisions)
+    next_servo_time: float = 0.0  # time of the next servo update (interval_unit time)
     servo_impulse: dict[str, np.ndarray] = field(default_factory=dict)
     servo_time: float = 0.0
     last_stress: np.ndarray | None = None
@@ -162,7 +163,10 @@ class _Run:
             if servo is None:
                 state.profiles = profile_analysis(self.scene)
             else:
-                state.next_servo = self._servo_interval()
+                if self._servo_by_time:
+                    state.next_servo_time = self._servo_settings().interval_time
+                else:
+                    state.next_servo = self._servo_interval()
                 state.servo_impulse = self._impulses(core)
             return core, state
         path = self.workdir / CHECKPOINT
@@ -191,9 +195,15 @@ class _Run:
                 for w in self.scene.walls}
 
     # -- servo ----------------------------------------------------------------------------
+    def _servo_settings(self):
+        return next(w.servo for w in self.scene.walls if w.servo is not None)
+
+    @property
+    def _servo_by_time(self) -> bool:
+        return has_servo(self.scene) and self._servo_settings().interval_unit == "time"
+
     def _servo_interval(self) -> int:
-        servo = next(w.servo for w in self.scene.walls if w.servo is not None)
-        return max(1, round(servo.interval_collisions * self.n))
+        return max(1, round(self._servo_settings().interval_collisions * self.n))
 
     def _servo_update(self, core: EventDriven, state: EdmdRunState) -> None:
         """Campbell's servo step after every interval_collisions × N pair collisions: the
@@ -213,7 +223,10 @@ class _Run:
         if servo.scale_width:
             core.scale_width(servo.shape * servo.gap / float(core.box[0]))
         state.servo_impulse, state.servo_time = impulses, t
-        state.next_servo += self._servo_interval()
+        if self._servo_by_time:
+            state.next_servo_time += self._servo_settings().interval_time
+        else:
+            state.next_servo += self._servo_interval()
 
     # -- sampling -------------------------------------------------------------------------
     def _advance_interval(self, core: EventDriven, state: EdmdRunState) -> None:
@@ -224,11 +237,21 @@ class _Run:
             guard = 1000 * max(1, target - core.collisions) + 10_000_000
         else:
             t_end, target, guard = state.samples * self.dt, 0, 0
+        by_time = state.servo is not None and self._servo_by_time
+        by_count = state.servo is not None and not by_time
         while True:
-            stops = [c for c in (target, state.next_servo if state.servo else 0) if c > 0]
-            if core.advance_to(t_end, max_events=guard, stop_collisions=min(stops, default=0)):
+            stops = [c for c in (target, state.next_servo if by_count else 0) if c > 0]
+            t_stop = min(t_end, state.next_servo_time) if by_time else t_end
+            reached = core.advance_to(t_stop, max_events=guard,
+                                      stop_collisions=min(stops, default=0))
+            if reached and by_time and core.time >= state.next_servo_time:
+                self._servo_update(core, state)
+                if core.time >= t_end:
+                    return
+                continue
+            if reached:
                 return
-            if state.servo is not None and core.collisions >= state.next_servo:
+            if by_count and core.collisions >= state.next_servo:
                 self._servo_update(core, state)
                 continue
             if target and core.collisions >= target:

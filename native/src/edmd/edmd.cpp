@@ -1163,12 +1163,12 @@ double EventDriven::scale_width(double factor) {
     if (factor == 1.0) return 1.0;
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) P_[i].x[0] *= factor;
     p_.box[0] *= factor;
-    setup_grid();
+    setup_grid();  // the cell widths may change along every axis (the cell budget is global)
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
         double& x = P_[i].x[0];
         x -= p_.box[0] * std::floor(x / p_.box[0]);
         if (x >= p_.box[0]) x -= p_.box[0];
-        cell_[3 * i] = cell_of(x, 0);
+        for (int a = 0; a < p_.dim; ++a) cell_[3 * i + a] = cell_of(P_[i].x[a], a);
     }
     build_cells();
     predict_all();

@@ -1,0 +1,115 @@
+"""Figures from results files, one per kind, in the seed theses' forms (Campbell 1982,
+Malik 2008). Dimensionless particle units: d = 1, m = 1, g = 1 with gravity.
+
+Kinds (``demstudy plot RUN.h5 … --kind``; see docs/plots.md):
+
+* ``profiles``: ν, u_x, T, rotational T against y, or (y − y_0)/H with ``scaled``;
+* ``stress``: kinetic, contact / collisional and total P_xy, P_yy against y, wall stresses,
+  momentum balance;
+* ``vdf``: Campbell's P(X1…X5) with folded Maxwellians, Malik's P(C/σ) with the Gaussian;
+* ``angles``: P(θ) in both conventions with Savage–Jeffrey;
+* ``gr``: g(r) (whole box, in-bin when stored);
+* ``vcorr``: C_αα(r) per component;
+* ``lambda``: Λ(y) with 1/3;
+* ``waves``: power spectrum of the dominant plane, its density contour, mode amplitudes.
+
+Every ``draw_<kind>(runs, …)`` returns a :class:`matplotlib.figure.Figure` (Agg canvas, no
+pyplot); :func:`plot_files` loads files, skips kinds a file lacks with a one-line notice and
+writes the PNGs.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from matplotlib.figure import Figure
+
+from .common import Run, missing_notice, save
+from .correlations import draw_gr, draw_lambda, draw_vcorr
+from .distributions import draw_angles, draw_vdf
+from .profiles import draw_profiles, draw_stress, reference_height
+from .waves import draw_waves
+
+#: the kinds, in the order ``--kind all`` draws them
+KINDS = ("profiles", "stress", "vdf", "angles", "gr", "vcorr", "lambda", "waves")
+
+__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_gr", "draw_lambda", "draw_profiles",
+           "draw_stress", "draw_vcorr", "draw_vdf", "draw_waves", "output_path", "parse_kinds",
+           "plot_files", "plot_profiles", "reference_height"]
+
+
+def parse_kinds(values: Sequence[str] | None) -> list[str]:
+    """Kinds from ``--kind`` values (repeatable, comma-separated, ``all``); ValueError naming
+    the allowed kinds for an unknown one."""
+    kinds: list[str] = []
+    for value in values or ["profiles"]:
+        for item in (v.strip() for v in value.split(",")):
+            if not item:
+                continue
+            if item == "all":
+                kinds.extend(KINDS)
+            elif item in KINDS:
+                kinds.append(item)
+            else:
+                raise ValueError(f"unknown plot kind {item!r} (allowed: {', '.join(KINDS)}, all)")
+    return list(dict.fromkeys(kinds)) or ["profiles"]
+
+
+def draw(kind: str, runs: Sequence[Run], *, scaled: bool = False,
+         bins: Sequence[int] | None = None) -> Figure:
+    """The Figure of ``kind`` for ``runs`` (each must hold the kind)."""
+    if kind not in KINDS:
+        raise ValueError(f"unknown plot kind {kind!r} (allowed: {', '.join(KINDS)})")
+    if kind == "profiles":
+        return draw_profiles(runs, scaled=scaled)
+    if kind in ("stress", "lambda", "waves"):
+        return {"stress": draw_stress, "lambda": draw_lambda, "waves": draw_waves}[kind](runs)
+    fn: dict[str, Callable[..., Figure]] = {"vdf": draw_vdf, "angles": draw_angles,
+                                            "gr": draw_gr, "vcorr": draw_vcorr}
+    return fn[kind](runs, bins=bins)
+
+
+def output_path(out: str | Path | None, kind: str, several: bool) -> Path:
+    """OUT for one kind, OUT-<kind>.png for several (default: <kind>.png)."""
+    if out is None:
+        return Path(f"{kind}.png")
+    out = Path(out)
+    if not several:
+        return out
+    suffix = out.suffix or ".png"
+    return out.with_name(f"{out.stem if out.suffix else out.name}-{kind}{suffix}")
+
+
+def plot_files(paths: Sequence[str | Path], kinds: Sequence[str], out: str | Path | None,
+               *, scaled: bool = False, bins: Sequence[int] | None = None,
+               notice: Callable[[str], Any] | None = None) -> list[Path]:
+    """Write one PNG per kind present in at least one of ``paths`` (files lacking a kind are
+    left out of its figure, with a one-line ``notice``); returns the paths written."""
+    notice = notice or (lambda text: print(text, file=sys.stderr))
+    runs = [Run.load(p) for p in paths]
+    several = len(kinds) > 1
+    written = []
+    for kind in kinds:
+        have = []
+        for run in runs:
+            if run.group(kind) is None:
+                notice(missing_notice(run, kind))
+            else:
+                have.append(run)
+        if have:
+            written.append(save(draw(kind, have, scaled=scaled, bins=bins),
+                                output_path(out, kind, several)))
+    return written
+
+
+def plot_profiles(paths: Sequence[str | Path], out: str | Path, scaled: bool = False) -> Path:
+    """ν, u and T (translational and rotational) against y, one curve per results file,
+    written to ``out`` (returns the path; :func:`draw_profiles` returns the Figure)."""
+    runs = [Run.load(p) for p in paths]
+    for run in runs:
+        if run.group("profiles") is None:
+            raise ValueError(f"{run.path}: the results file holds no profiles")
+    return save(draw_profiles(runs, scaled=scaled), out)

@@ -1,0 +1,197 @@
+"""Shared plumbing of the figures: loading results files, run labels, bin choice, the units /
+engine footer, saving. Dimensionless particle units: d = 1, m = 1, g = 1 with gravity.
+
+Figures are built on :class:`matplotlib.figure.Figure` with the Agg canvas (no pyplot state,
+nothing to close); every drawing function returns its Figure so that tests can read back the
+plotted data.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ..io.results import Results
+
+#: results-file groups holding each kind (first present wins)
+GROUPS = {
+    "stress": ("statistics/stress", "stress"),
+    "vdf": ("statistics/vdf",),
+    "angles": ("statistics/angles",),
+    "gr": ("statistics/gr",),
+    "vcorr": ("statistics/vcorr",),
+    "lambda": ("statistics/lambda",),
+    "waves": ("statistics/waves",),
+}
+#: a dataset that must be present for the kind to be drawable
+REQUIRED = {"stress": "total", "vdf": "X", "angles": "p_text", "gr": "g", "vcorr": "C",
+            "lambda": "lambda", "waves": "series_time"}
+#: how to obtain a missing kind ({file}: the results file's name)
+HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
+       "stress": "add it with measure.statistics = [\"stress\"] or "
+                 "`demstudy analyze {file} --what stress`",
+       "angles": "add it with `demstudy analyze {file} --what angles`, which needs an "
+                 "event-driven run's /collisions log",
+       "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only"}
+
+LINESTYLES = ("-", "--", ":", "-.")
+MARKERS = ("o", "s", "^", "v", "D", "P")
+
+
+def _decode(value: Any) -> Any:
+    return value.decode() if isinstance(value, bytes) else value
+
+
+def load_results(path: str | Path) -> Results:
+    """A results file without its (possibly huge) ``/frames`` and ``/collisions``: what the
+    figures need (same layout as :func:`demstudy.io.results.read_results`)."""
+    skip = ("timeseries", "profiles", "frames", "collisions")
+    with h5py.File(path, "r") as f:
+        def load(name: str) -> dict[str, np.ndarray]:
+            return {k: v[()] for k, v in f[name].items()
+                    if isinstance(v, h5py.Dataset)} if name in f else {}
+
+        res = Results(attrs={k: _decode(v) for k, v in f.attrs.items()},
+                      timeseries=load("timeseries"), profiles=load("profiles"))
+        if "profiles" in f:
+            res.profile_attrs = {k: _decode(v) for k, v in f["profiles"].attrs.items()}
+
+        def collect(group: h5py.Group) -> None:
+            data = {k: v[()] for k, v in group.items() if isinstance(v, h5py.Dataset)}
+            if data:
+                key = group.name.lstrip("/")
+                res.groups[key] = data
+                res.group_attrs[key] = {k: _decode(v) for k, v in group.attrs.items()}
+            for item in group.values():
+                if isinstance(item, h5py.Group):
+                    collect(item)
+
+        for name, item in f.items():
+            if name not in skip and isinstance(item, h5py.Group):
+                collect(item)
+    return res
+
+
+@dataclass
+class Run:
+    """One results file: its content, its scene (None if it cannot be rebuilt) and label."""
+
+    path: Path
+    results: Results
+    scene: Any = None
+
+    @classmethod
+    def load(cls, path: str | Path) -> Run:
+        res = load_results(path)
+        scene = None
+        text = res.attrs.get("analysis_scene_toml") or res.attrs.get("scene_toml")
+        if text:
+            from ..scene import parse_scene_text, validate_scene
+
+            try:
+                scene = validate_scene(parse_scene_text(text, str(path)), str(path))
+            except Exception:  # an older or foreign scene: the figures do without it
+                scene = None
+        return cls(Path(path), res, scene)
+
+    @property
+    def attrs(self) -> dict[str, Any]:
+        return self.results.attrs
+
+    @property
+    def engine(self) -> str:
+        name = str(self.attrs.get("engine", "unknown engine"))
+        version = self.attrs.get("engine_version")
+        return f"{name} ({version})" if version else name
+
+    @property
+    def label(self) -> str:
+        name = self.attrs.get("scene_name") or self.path.stem
+        return f"{name} ({self.attrs.get('engine', '?')})"
+
+    @property
+    def gravity(self) -> bool | None:
+        return None if self.scene is None else self.scene.gravity is not None
+
+    def group(self, kind: str) -> tuple[dict[str, np.ndarray], dict[str, Any]] | None:
+        """(datasets, attrs) of ``kind`` in this file, or None when absent."""
+        if kind == "profiles":
+            prof = self.results.profiles
+            return (prof, self.results.profile_attrs) if prof and "y" in prof else None
+        for name in GROUPS[kind]:
+            data = self.results.groups.get(name)
+            if data and REQUIRED[kind] in data:
+                return data, self.results.group_attrs.get(name, {})
+        return None
+
+    def where(self, kind: str) -> str:
+        return "/profiles" if kind == "profiles" else " or ".join(f"/{g}" for g in GROUPS[kind])
+
+
+def missing_notice(run: Run, kind: str) -> str:
+    how = HOW.get(kind, "add it with `demstudy analyze {file} --what " + kind + "`")
+    return (f"notice: {run.path}: no {run.where(kind)}: {kind} skipped "
+            f"({how.format(file=run.path.name)})")
+
+
+def units_text(runs: Sequence[Run]) -> str:
+    """The units statement of a figure, with whether gravity acts in these runs."""
+    gravity = {run.gravity for run in runs}
+    text = "units: d = 1, m = 1, g = 1 with gravity"
+    if gravity == {True}:
+        return text + " (gravity acts here)"
+    if gravity == {False}:
+        return text + " (no gravity here: the wall speed or shear rate sets the time scale)"
+    return text + " (otherwise the wall speed or shear rate sets the time scale)"
+
+
+def new_figure(n_rows: int, n_cols: int, width: float = 4.0, height: float = 3.6,
+               **kwargs: Any) -> tuple[Figure, np.ndarray]:
+    """A Figure on the Agg canvas and its axes as a 2D array."""
+    fig = Figure(figsize=(width * n_cols, height * n_rows + 0.6))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(n_rows, n_cols, squeeze=False, **kwargs)
+    return fig, axes
+
+
+def finish(fig: Figure, runs: Sequence[Run], title: str) -> Figure:
+    """Title, the units and engine footer, tight layout (applied when the figure is drawn)."""
+    engines = ", ".join(dict.fromkeys(run.engine for run in runs))
+    fig.suptitle(title, fontsize=10)
+    fig.text(0.005, 0.005, f"{units_text(runs)}  |  engine: {engines}", fontsize=7,
+             ha="left", va="bottom")
+    fig.set_layout_engine("tight", rect=(0, 0.03, 1, 0.96))  # applied when drawn (saved)
+    return fig
+
+
+def save(fig: Figure, out: str | Path) -> Path:
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    return out
+
+
+def pick_bins(valid: np.ndarray, requested: Sequence[int] | None = None) -> list[int]:
+    """Bins (0-based) to draw: ``requested`` (1-based bin numbers, Malik's "bin 1" touches
+    the lower wall) that exist, else Malik's choice generalised: the first occupied bin, the
+    fourth and the middle of the occupied range."""
+    valid = np.asarray(valid, bool)
+    if requested:
+        return [b - 1 for b in requested if 1 <= b <= valid.size]
+    occupied = np.flatnonzero(valid)
+    if occupied.size == 0:
+        return []
+    first, last = int(occupied[0]), int(occupied[-1])
+    picks = [first, min(first + 3, last), (first + last + 1) // 2]
+    return [b for b in dict.fromkeys(picks) if valid[b]]
+
+
+def bin_label(y: np.ndarray, b: int) -> str:
+    return f"bin {b + 1} (y = {float(y[b]):.3g})"

@@ -1,0 +1,122 @@
+"""Pair correlation g(r), velocity correlations C_αα(r) and Malik's Λ(y).
+
+Dimensionless particle units: d = 1, m = 1, g = 1 with gravity (r in particle diameters).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .common import LINESTYLES, Run, bin_label, finish, new_figure, pick_bins
+
+
+def _artefact(ax, r_edges: np.ndarray, flags: np.ndarray | None) -> None:
+    """Shade the shells beyond half the shortest periodic length (several images counted)."""
+    if flags is not None and np.any(flags):
+        ax.axvspan(float(r_edges[:-1][np.asarray(flags, bool)][0]), float(r_edges[-1]),
+                   color="0.85", zorder=0, label="beyond L_min/2 (image artefact)")
+
+
+def _gr_variants(run: Run) -> list[tuple[str, dict, dict]]:
+    """The stored g(r) groups: ``statistics/gr`` and any in-bin variant (``statistics/gr*``
+    holding ``g``), each (name, data, attrs)."""
+    groups = run.results.groups
+    names = sorted(k for k in groups if k.startswith("statistics/gr") and "g" in groups[k])
+    return [(k.split("/", 1)[1], groups[k], run.results.group_attrs.get(k, {})) for k in names]
+
+
+def draw_gr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
+    """g(r) against r/d: the whole-box g(r) (one row of ``g``) and, when stored with y-bins
+    (``attrs in_bin``, or a ``statistics/gr*`` in-bin variant), g(r) in chosen bins (Malik's
+    in-bin reading); grey: shells beyond half the shortest periodic length."""
+    variants = {}
+    for run in runs:
+        for name, data, attrs in _gr_variants(run):
+            in_bin = bool(attrs.get("in_bin", False)) or np.asarray(data["g"]).shape[0] > 1
+            variants.setdefault("in-bin g(r)" if in_bin else "g(r)", []).append(
+                (run, name, data, in_bin))
+    panels = sorted(variants, key=len)
+    fig, axes = new_figure(1, len(panels), width=5.0, height=4.0)
+    for ax, panel in zip(axes[0], panels, strict=True):
+        for r, (run, name, data, in_bin) in enumerate(variants[panel]):
+            g = np.atleast_2d(np.asarray(data["g"], float))
+            rr = np.asarray(data["r"], float)
+            prefix = f"{run.label}, " if len(runs) > 1 else ""
+            ls = LINESTYLES[r % len(LINESTYLES)]
+            if in_bin:
+                y = np.asarray(data["y"], float)
+                valid = np.asarray(data.get("mean_count", np.ones(g.shape[0])), float) > 1
+                rows = pick_bins(valid, bins)
+                labels = [f"{prefix}{bin_label(y, b)}" for b in rows]
+            else:
+                rows, labels = [0], [f"{prefix}whole box".rstrip(", ")]
+            for i, (b, label) in enumerate(zip(rows, labels, strict=True)):
+                ax.plot(rr, g[b], ls=ls, color=f"C{i}", lw=1.2, label=label,
+                        gid=f"{run.path.name}:{name}:{b}")
+            if r == 0:
+                _artefact(ax, np.asarray(data["r_edges"], float), data.get("image_artefact"))
+        ax.axhline(1.0, color="0.5", lw=0.8)
+        ax.set_title(panel, fontsize=9)
+        ax.set_xlabel("r (particle diameters)")
+        ax.set_ylabel("g(r)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper right")
+    return finish(fig, runs, "pair correlation function")
+
+
+def draw_vcorr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
+    """Malik's C_αα(r) per component (x, y[, z]) in chosen y-bins: the normalised correlation
+    of the velocity fluctuations about the run-mean bin velocities (C → 1 as r → 0+)."""
+    dim = max(int(run.group("vcorr")[0]["C"].shape[1]) for run in runs)
+    fig, axes = new_figure(1, dim, width=4.5, height=4.0, sharey=True)
+    for r, run in enumerate(runs):
+        data, _attrs = run.group("vcorr")
+        c, rr = np.asarray(data["C"], float), np.asarray(data["r"], float)
+        y = np.asarray(data["y"], float)
+        chosen = pick_bins(np.asarray(data.get("count", np.ones(c.shape[0])), float) > 0, bins)
+        prefix = f"{run.label}, " if len(runs) > 1 else ""
+        ls = LINESTYLES[r % len(LINESTYLES)]
+        for a in range(c.shape[1]):
+            ax = axes[0, a]
+            for i, b in enumerate(chosen):
+                ax.plot(rr, c[b, a], ls=ls, marker=".", ms=3, color=f"C{i}",
+                        label=f"{prefix}{bin_label(y, b)}", gid=f"{run.path.name}:C:{b}:{a}")
+            if r == 0:
+                _artefact(ax, np.asarray(data["r_edges"], float), data.get("image_artefact"))
+                comp = "xyz"[a]
+                ax.set_title(f"C_{comp}{comp}(r)", fontsize=9)
+                ax.axhline(0.0, color="0.5", lw=0.8)
+                ax.set_xlabel("r (particle diameters)")
+                ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("C_αα(r)")
+    axes[0, 0].legend(fontsize=7, loc="upper right")
+    return finish(fig, runs, "spatial velocity correlations (fluctuations about the "
+                             "run-mean bin velocity)")
+
+
+def draw_lambda(runs: Sequence[Run]) -> Figure:
+    """Malik's Λ(y) = ⟨cos² Ψ⟩ (horizontal) against y (vertical) with error bars, the pooled
+    estimate dotted, and the uncorrelated value 1/3 (vertical line)."""
+    fig, axes = new_figure(1, 1, width=5.0, height=5.0)
+    ax = axes[0, 0]
+    for r, run in enumerate(runs):
+        data, _attrs = run.group("lambda")
+        y, lam = np.asarray(data["y"], float), np.asarray(data["lambda"], float)
+        mask = np.asarray(data.get("count", np.ones_like(y)), float) > 0
+        err = data.get("lambda_err")
+        ax.errorbar(lam[mask], y[mask], xerr=None if err is None else np.asarray(err)[mask],
+                    marker="o", ms=3, capsize=2, color=f"C{r}", label=f"{run.label}: Λ",
+                    gid=f"{run.path.name}:lambda")
+        if "lambda_pooled" in data:
+            ax.plot(np.asarray(data["lambda_pooled"])[mask], y[mask], ls=":", color=f"C{r}",
+                    label=f"{run.label}: pooled Σcos²Ψ/ΣN", gid=f"{run.path.name}:lambda_pooled")
+    ax.axvline(1 / 3, color="brown", lw=1.2, label="uncorrelated 1/3")
+    ax.set_xlabel("Λ = ⟨cos² Ψ⟩ (translational vs spin fluctuation)")
+    ax.set_ylabel("y (particle diameters)")
+    ax.set_xlim(0, 1)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper right")
+    return finish(fig, runs, "orientational correlation Λ(y)")

@@ -1,0 +1,150 @@
+"""Profiles ν, u_x, T, rotational T against y (or y/H) and the stress profiles P_xy, P_yy.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 with gravity. Stresses are compressive
+positive, P = −σ (Campbell: τ_yy = P_yy, τ_xy = −P_xy), force per length in 2D, per area in 3D.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .common import MARKERS, Run, finish, new_figure
+
+PANELS = (
+    ("solid_fraction", "solid fraction ν"),
+    ("velocity", "mean velocity u_x"),
+    ("temperature", "temperature T (per d.o.f.)"),
+    ("rotational_temperature", "rotational temperature"),
+)
+
+
+def _edges(prof: dict) -> np.ndarray:
+    if "edges" in prof:
+        return np.asarray(prof["edges"], float)
+    y = np.asarray(prof["y"], float)
+    h = float(y[1] - y[0]) if y.size > 1 else 1.0
+    return np.append(y - 0.5 * h, y[-1] + 0.5 * h)
+
+
+def reference_height(run: Run) -> tuple[float, float, str]:
+    """(y_0, H, what H is) for y/H: the gap between the walls (channels, Couette cells; the
+    mean servo gap over production), Campbell's flow depth 2 × mass-mean centre height above
+    the base (open top), the periodic height (no walls) or, without a scene, the profile span."""
+    from ..analysis.derived import campbell_depth
+
+    prof, scene = run.results.profiles, run.scene
+    edges = _edges(prof)
+    if scene is None:
+        return float(edges[0]), float(edges[-1] - edges[0]), "profile span"
+    if scene.y_periodic or not scene.walls:
+        return float(edges[0]), float(edges[-1] - edges[0]), "periodic height L_y"
+    base = scene.wall_position("lower")
+    if scene.has_open_top:
+        return base, campbell_depth(prof, base), "flow depth (2 × mass-mean height)"
+    ts = run.results.timeseries
+    if "gap" in ts and "time" in ts:
+        keep = ts["time"] >= float(run.attrs.get("equilibration_end", 0.0))
+        keep = keep if np.any(keep) else np.ones_like(keep)
+        lower = ts.get("wall_position_lower")
+        base = float(np.mean(lower[keep])) if lower is not None else base
+        return base, float(np.mean(ts["gap"][keep])), "gap between the walls (mean)"
+    return base, scene.wall_position("upper") - base, "gap between the walls"
+
+
+def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
+    """ν, u_x and T (translational and rotational) against y, one curve per results file;
+    ``scaled``: against (y − y_0)/H (see :func:`reference_height`)."""
+    fig, axes = new_figure(1, len(PANELS), height=4.5, sharey=True)
+    axes = axes[0]
+    what: set[str] = set()
+    for run in runs:
+        prof = run.results.profiles
+        y = np.asarray(prof["y"], float)
+        label = run.label
+        if scaled:
+            y0, height, kind = reference_height(run)
+            y = (y - y0) / height
+            what.add(kind)
+            label += f", H = {height:.3g}"
+        if "steady" in run.attrs and not run.attrs["steady"]:
+            trend = 100 * run.attrs["kinetic_energy_trend"]
+            label += f"\nNOT STEADY: kinetic energy changed {trend:+.0f} % over production"
+        occupied = prof["solid_fraction"] > 1e-3
+        for ax, (key, title) in zip(axes, PANELS, strict=True):
+            if key not in prof:
+                continue
+            val, err = prof[key], prof.get(f"{key}_err")
+            if val.ndim == 2:  # vectors: the flow (x) component
+                val, err = val[:, 0], None if err is None else err[:, 0]
+            mask = occupied if key != "solid_fraction" else np.ones_like(occupied)
+            ax.errorbar(val[mask], y[mask], xerr=None if err is None else err[mask],
+                        marker="o", ms=3, capsize=2, label=label, gid=f"{run.path.name}:{key}")
+            ax.set_xlabel(title)
+            ax.grid(alpha=0.3)
+    axis = runs[0].results.profile_attrs.get("axis", "y")
+    if scaled:
+        kind = what.pop() if len(what) == 1 else "see the legend"
+        axes[0].set_ylabel(f"({axis} − {axis}_0)/H,  H = {kind}")
+    else:
+        axes[0].set_ylabel(f"{axis} (particle diameters)")
+    axes[0].legend(fontsize=8, loc="upper right")
+    return finish(fig, runs, "profiles: solid fraction, mean velocity, temperatures")
+
+
+STRESS_PARTS = ("kinetic", "contact", "collisional", "total")
+STRESS_STYLE = {"kinetic": ":", "contact": "--", "collisional": "--", "total": "-"}
+
+
+def draw_stress(runs: Sequence[Run]) -> Figure:
+    """Kinetic, contact / collisional and total P_xy and P_yy against y with error bars, the
+    wall stresses (the column P_ay at each wall) as markers at the walls and, with gravity,
+    Campbell's momentum-balance curves (P_xy = −τ_xy, P_yy = τ_yy) with their error band."""
+    fig, axes = new_figure(1, 2, width=5.0, height=5.0, sharey=True)
+    axes = axes[0]
+    comps = (("xy", 0, 1), ("yy", 1, 1))
+    colours = [f"C{i}" for i in range(10)]
+    for r, run in enumerate(runs):
+        data, _attrs = run.group("stress")
+        y = np.asarray(data["y"], float)
+        edges = np.asarray(data.get("edges", _edges({"y": y})), float)
+        prefix = f"{run.label}: " if len(runs) > 1 else ""
+        for ax, (name, a, b) in zip(axes, comps, strict=True):
+            for p, key in enumerate(STRESS_PARTS):
+                if key not in data:
+                    continue
+                val = np.asarray(data[key], float)[:, a, b]
+                err = data.get(f"{key}_err")
+                err = None if err is None else np.asarray(err, float)[:, a, b]
+                ax.errorbar(val, y, xerr=err, ls=STRESS_STYLE[key], marker=MARKERS[p], ms=3,
+                            capsize=2, color=colours[(r * 4 + p) % 10], label=f"{prefix}{key}",
+                            gid=f"{run.path.name}:{key}:{name}")
+            for side, y_wall in (("lower", edges[0]), ("upper", edges[-1])):
+                if f"wall_{side}" not in data:
+                    continue
+                val = float(np.asarray(data[f"wall_{side}"], float)[a])
+                err = data.get(f"wall_{side}_err")
+                ax.errorbar([val], [y_wall], xerr=None if err is None else [float(err[a])],
+                            marker="D" if side == "lower" else "v", ms=8, ls="none",
+                            color="k", mfc="none", capsize=3,
+                            label=f"{prefix}{side} wall", gid=f"{run.path.name}:wall_{side}:{name}")
+            key = f"balance_tau_{name}"
+            if key in data:
+                sign = -1.0 if name == "xy" else 1.0  # Campbell's tau_xy = -P_xy
+                val = sign * np.asarray(data[key], float)
+                err = np.asarray(data.get(f"{key}_err", np.zeros_like(val)), float)
+                ax.plot(val, y, color="0.3", lw=1.5, gid=f"{run.path.name}:balance:{name}",
+                        label=f"{prefix}momentum balance"
+                              + (" (−τ_xy)" if name == "xy" else " (τ_yy)"))
+                ax.fill_betweenx(y, val - err, val + err, color="0.3", alpha=0.15, lw=0)
+            ax.axvline(0.0, color="0.7", lw=0.8)
+            ax.set_xlabel(f"P_{name} (compressive positive, P = −σ)")
+            ax.grid(alpha=0.3)
+    axes[0].set_ylabel("y (particle diameters)")
+    axes[1].legend(fontsize=7, loc="upper left")
+    dims = {int(run.group("stress")[1].get("dim", 2)) for run in runs}
+    per = "force per length (2D)" if dims == {2} else "force per area (3D)" if dims == {3} \
+        else "force per length (2D) or area (3D)"
+    return finish(fig, runs, f"stress profiles in {per}; markers: wall stresses at the walls")
