@@ -142,3 +142,35 @@ def test_lees_edwards_images_are_wrapped_with_their_velocity_shift():
                                image_velocity_shift=shift).results
     for key in ("mean", "variance", "kurtosis", "X", "malik_P"):
         np.testing.assert_allclose(b[key], a[key], rtol=1e-9, atol=1e-9, err_msg=key)
+
+
+def test_malik_cell_convention_removes_a_spanwise_mean_flow():
+    """3D gas with a mean flow varying along z, u = A sin(2π z/L_z), A = 2, plus a unit
+    Maxwellian: relative to the strip mean (Campbell) the u variance is 1 + A²/2 = 3 and the
+    distribution is not Gaussian; relative to the means of 16 z-cells (Malik) it is
+    1 + A² (2π/16)²/24 ≈ 1.026 (the mean's variation inside a cell) with kurtosis ≈ 3."""
+    from demstudy.analysis.vdf import velocity_distributions
+    from demstudy.io.frames import Frame
+
+    rng = np.random.default_rng(11)
+    n, L, A = 6000, 12.0, 2.0
+    frames = []
+    for t in range(12):
+        pos = rng.uniform(0, L, (n, 3))
+        vel = rng.normal(size=(n, 3))
+        vel[:, 0] += A * np.sin(2 * np.pi * pos[:, 2] / L)
+        frames.append(Frame(time=float(t), box_lo=np.zeros(3), box_hi=np.full(3, L),
+                            position=pos, velocity=vel, angular_velocity=rng.normal(size=(n, 3)),
+                            radius=np.full(n, 0.5)))
+    strip = velocity_distributions(frames, dim=3, n_bins=2)
+    cells = velocity_distributions(frames, dim=3, n_bins=2, z_cells=16)
+    assert strip.results["variance"][:, 0] == pytest.approx(1 + A**2 / 2, rel=0.05)
+    expected = 1 + A**2 * (2 * np.pi / 16) ** 2 / 24
+    var, err = cells.results["variance"][:, 0], cells.results["variance_err"][:, 0]
+    assert np.all(np.abs(var - expected) < 4 * err + 0.01)
+    assert np.all(np.abs(cells.results["kurtosis"][:, 0] - 3.0) < 0.15)
+    assert np.all(np.abs(strip.results["kurtosis"][:, 0] - 3.0) > 0.3)
+    assert cells.results["cell_mean"].shape == (2 * 16, cells.n_comp)
+    assert cells.attrs["z_cells"] == 16
+    with pytest.raises(ValueError, match="z_cells"):
+        velocity_distributions(frames[:1], dim=2, z_cells=4)

@@ -41,6 +41,14 @@ running moments are used. With M the reference mean and S the variance of the bi
   References: ``gaussian`` = exp(-x^2/2) at the bin centres, ``gaussian_binned`` = the
   normal density averaged over each bin and scaled by the same P0 rule.
 
+Malik's cell convention (``z_cells`` > 1, 3D): fluctuations are taken relative to the means of
+cells that split each y-bin into ``z_cells`` slabs along z (Malik 2008 §4.1: "cellwise",
+bins in y and z; his number of z cells is not stated). Moments and references are computed
+per cell; the reported ``variance``, ``skewness``, ``kurtosis`` and histograms pool the cells
+of a y-bin (count-weighted central moments about the cell means), ``mean`` is the bin's mean,
+and ``cell_mean`` / ``cell_variance`` (n_bins · z_cells, n_comp) are kept for the second pass.
+``z_cells = 1`` is Campbell's strip convention.
+
 Errors (``*_err``): delete-one-block jackknife over time blocks of the per-frame sums
 (:class:`~demstudy.analysis.blocking.BlockAccumulator`); memory is flat in the number of
 frames. The bin mean includes any mean-velocity gradient across the bin, which widens the
@@ -111,12 +119,17 @@ class VelocityDistribution(AnalysisBase):
         image_velocity_shift: float = 0.0,
         x_bins: int = 50,
         x_width: float = 0.1,
+        z_cells: int = 1,
         max_blocks: int = 64,
         verbose: bool = False,
     ) -> None:
         super().__init__(verbose=verbose)
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        if int(z_cells) < 1 or (dim == 2 and int(z_cells) != 1):
+            raise ValueError(f"z_cells = {z_cells!r}: a positive number of cells along z (3D "
+                             "only; 1 is Campbell's strip convention)")
+        self.z_cells = int(z_cells)
         self.dim = dim
         self.n_rot = 1 if dim == 2 else 3
         self.inertia_factor = float(
@@ -145,8 +158,9 @@ class VelocityDistribution(AnalysisBase):
         self.reference = None
         if reference is not None:
             self.reference = {
-                "mean": np.asarray(reference["mean"], float),
-                "variance": np.asarray(reference["variance"], float),
+                "mean": np.asarray(reference.get("cell_mean", reference["mean"]), float),
+                "variance": np.asarray(reference.get("cell_variance", reference["variance"]),
+                                       float),
                 "edges": np.asarray(reference["edges"], float),
             }
             if self.reference["mean"].shape[1] != self.n_comp:
@@ -174,12 +188,18 @@ class VelocityDistribution(AnalysisBase):
             self._edges = np.linspace(lo, hi, self._n_bins + 1)
         self.edges = self._edges
         self.n_bins = self.edges.size - 1
+        self.n_cells = self.n_bins * self.z_cells
+        if self.dim == 3:
+            self._z_lo = float(np.asarray(frame.box_lo, float)[2])
+            self._z_len = float(np.asarray(frame.box_hi, float)[2]) - self._z_lo
         if self.reference is not None:
             ref_edges = self.reference["edges"]
             if ref_edges.shape != self.edges.shape or not np.allclose(
                 ref_edges, self.edges, rtol=0, atol=1e-12
             ):
                 raise ValueError("the reference was computed on other bin edges")
+            if self.reference["mean"].shape[0] != self.n_cells:
+                raise ValueError("the reference was computed with other z cells")
             var = self.reference["variance"]
             self._ref_mean = self.reference["mean"]
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -187,16 +207,17 @@ class VelocityDistribution(AnalysisBase):
                 self._ref_inv_var4 = 1.0 / var[:, self._trans].sum(1)
                 self._ref_inv_var5 = 1.0 / var[:, self._total].sum(1)
         self._layout()
-        self._acc = BlockAccumulator(self.n_bins * self.n_values, self.max_blocks)
+        self._acc = BlockAccumulator(self.n_cells * self.n_values, self.max_blocks)
         bins, comps = self._assign(frame)
-        counts = np.bincount(bins, minlength=self.n_bins).astype(float)
-        sums = np.zeros((self.n_bins, self.n_comp))
+        counts = np.bincount(bins, minlength=self.n_cells).astype(float)
+        sums = np.zeros((self.n_cells, self.n_comp))
         np.add.at(sums, bins, comps)
         with np.errstate(invalid="ignore"):
             self._shift = np.where(counts[:, None] > 0, sums / counts[:, None], 0.0)
 
     def _assign(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
-        """Bin index and component matrix of the particles whose centre lies in a bin."""
+        """Cell index (y-bin · z_cells + z-cell) and component matrix of the particles whose
+        centre lies in a bin."""
         pos = np.asarray(frame.position, float)
         vel = np.array(frame.velocity, float)
         omega = np.asarray(frame.angular_velocity, float)
@@ -210,13 +231,17 @@ class VelocityDistribution(AnalysisBase):
                 vel[:, 0] -= turns * self.image_velocity_shift
         bins = np.searchsorted(self.edges, y, side="right") - 1
         keep = (bins >= 0) & (bins < self.n_bins)
+        if self.z_cells > 1:  # z is periodic: wrap, then slab index
+            z = np.mod(pos[:, 2] - self._z_lo, self._z_len)
+            zc = np.minimum((z / self._z_len * self.z_cells).astype(np.intp), self.z_cells - 1)
+            bins = bins * self.z_cells + zc
         sqrt_j = np.sqrt(self.inertia_factor) * radius
         comps = np.concatenate([vel, omega, sqrt_j[:, None] * omega], axis=1)
         return bins[keep], comps[keep]
 
     def _single_frame(self, frame: Frame) -> None:
         bins, comps = self._assign(frame)
-        nb, nv = self.n_bins, self.n_values
+        nb, nv = self.n_cells, self.n_values
         sample = np.zeros((nb, nv))
         sample[:, 0] = np.bincount(bins, minlength=nb)
         dev = comps - self._shift[bins]
@@ -255,24 +280,35 @@ class VelocityDistribution(AnalysisBase):
 
     # -- estimates ---------------------------------------------------------------------
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
-        s = mean.reshape(self.n_bins, self.n_values)
+        s = mean.reshape(self.n_cells, self.n_values)
         n = s[:, 0]
+        nb, zc = self.n_bins, self.z_cells
         with np.errstate(invalid="ignore", divide="ignore"):
             m1, m2, m3, m4 = (s[:, sl] / n[:, None] for sl in self._c_pow)
             mu2 = m2 - m1**2
             mu3 = m3 - 3 * m1 * m2 + 2 * m1**3
             mu4 = m4 - 4 * m1 * m3 + 6 * m1**2 * m2 - 3 * m1**4
+            cell_mean = self._shift + m1
+
+            def pool(values: np.ndarray) -> np.ndarray:  # count-weighted over a bin's cells
+                w = np.nan_to_num(values * n[:, None]).reshape(nb, zc, -1).sum(1)
+                return w / n.reshape(nb, zc).sum(1)[:, None]
+
+            var = pool(mu2)
             out = {
-                "count": n,
-                "mean": self._shift + m1,
-                "variance": mu2,
-                "skewness": mu3 / mu2**1.5,
-                "kurtosis": mu4 / mu2**2,
+                "count": n.reshape(nb, zc).sum(1),
+                "mean": pool(cell_mean),
+                "variance": var,
+                "skewness": pool(mu3) / var**1.5,
+                "kurtosis": pool(mu4) / var**2,
             }
+            if zc > 1:
+                out.update({"cell_mean": cell_mean, "cell_variance": mu2})
             if self.reference is not None:
-                norm = n[:, None, None] * self.dx
-                x = s[:, self._c_x].reshape(self.n_bins, 5, self.nx) / norm
-                pdf = s[:, self._c_m].reshape(self.n_bins, self.n_malik, 2 * self.nx) / norm
+                total = s.reshape(nb, zc, self.n_values).sum(1)
+                norm = out["count"][:, None, None] * self.dx
+                x = total[:, self._c_x].reshape(nb, 5, self.nx) / norm
+                pdf = total[:, self._c_m].reshape(nb, self.n_malik, 2 * self.nx) / norm
                 p0 = 0.5 * (pdf[:, :, self.nx - 1] + pdf[:, :, self.nx])
                 out.update({"X": x, "malik_pdf": pdf, "malik_P": pdf / p0[:, :, None]})
         return out
@@ -288,6 +324,10 @@ class VelocityDistribution(AnalysisBase):
             "components": ",".join(self.components),
             "inertia_factor": self.inertia_factor,
             "binning": "strip of the particle centre, number-weighted, pooled over the run",
+            "z_cells": self.z_cells,
+            "fluctuations": ("relative to the strip (bin) mean: Campbell" if self.z_cells == 1
+                             else f"relative to the means of {self.z_cells} z-cells per bin: "
+                                  "Malik's cell convention"),
             "passes": 2 if self.reference is not None else 1,
             "samples": self.n_frames,
             "block_length": self._acc.block_length,
