@@ -98,10 +98,11 @@ def scene_parameters(scene: Scene) -> dict:
         for wall in scene.walls:
             if wall.kind == "bumpy" and scene.gravity is not None:
                 raise UnsupportedByEngine("edmd", f"walls[{wall.side}].kind", wall.kind,
-                                          "bumpy walls under gravity are not implemented in the "
-                                          "event-driven engine (a bump and a falling particle "
-                                          "need quartic roots); use a flat wall with a rough "
-                                          "rule, or LAMMPS")
+                                          "bumpy walls under gravity are not supported by the "
+                                          "event-driven engine: particles resting in the "
+                                          "hollows between bumps jam (contacts with vanishing "
+                                          "gaps collide ever faster); use a flat wall with a "
+                                          "rough rule, or LAMMPS")
             if wall.kind == "bumpy" and wall.servo is not None:
                 raise UnsupportedByEngine("edmd", f"walls[{wall.side}].servo", "servo",
                                           "a bumpy wall cannot be servo-controlled")

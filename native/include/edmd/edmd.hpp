@@ -69,9 +69,10 @@ struct Params {
     std::int64_t stress_bins = 0;
     double stress_lo = 0.0, stress_width = 1.0;
     // bumps of bumpy walls: per particle 0 (mobile), 1 (lower wall's bump), 2 (upper wall's);
-    // empty = all mobile. Bumps keep their velocity (the wall's), feel no gravity (gravity
-    // with bumps is refused), collide with mobile particles by their wall's rule and count
-    // in that wall's impulse and work.
+    // empty = all mobile. Bumps keep their velocity (the wall's), feel no gravity (under
+    // gravity they must be static: a falling particle meets a bump at a root of a quartic,
+    // found by conservative advancement), collide with mobile particles by their wall's rule
+    // and count in that wall's impulse and work.
     std::vector<std::int8_t> fixed;
     // collision log: every log_every-th collision, at most log_capacity records (0: off)
     std::int64_t log_every = 0, log_capacity = 0;
@@ -205,6 +206,11 @@ private:
     std::vector<std::int32_t> order_;  // internal index -> input index (cell-sorted order)
     std::vector<double> w_, last_, m_;
     std::vector<std::int8_t> fixed_;  // 0 mobile, 1/2 bump of the lower/upper wall
+    bool has_bumps_ = false;
+    const double* grav(std::int32_t i) const {
+        static constexpr double none[3] = {0.0, 0.0, 0.0};
+        return fixed_[i] != 0 ? none : p_.gravity;
+    }
     std::vector<std::int64_t> count_;
     std::vector<std::int32_t> cell_;  // per particle 3 cell coordinates
     int ncell_[3] = {1, 1, 1};
@@ -262,6 +268,7 @@ private:
     template <typename F>
     void for_neighbours(std::int32_t i, int only_axis, int dir, F&& visit) const;
     void schedule(std::int32_t i);
+    double next_boundary(std::int32_t i, std::int32_t& kind) const;
     double wall_time(std::int32_t i, int side) const;
     void predict_crossed(std::int32_t i, int axis, int dir);
     void predict_rows();
@@ -281,6 +288,7 @@ private:
     void process_collision(std::int32_t i, std::int32_t j);
     void process_wall(std::int32_t i, int side);
     void process_bump(std::int32_t i, std::int32_t b);
+    void rebound_floor(const double n[3], const double u[3], double m, double v[3], double J[3]);
     void process_crossing(std::int32_t i, int axis);
     void process_reshuffle();
     void reorder();

@@ -80,6 +80,38 @@ double first_hit(double y0, double vy, double ay) {
     if (vy <= 0.0 || disc < 0.0) return kInfinity;
     return -2.0 * y0 / (vy + std::sqrt(disc));
 }
+// First contact time in [0, horizon] of a particle and a fixed bump under gravity: the
+// separation d(t) = d0 + dv t + ½ a t² (a = −g) makes |d|² − σ² a quartic, so the root is
+// found by conservative advancement (safe steps from the gap h and the current relative speed:
+// no contact is stepped over) until the gap is below 1e-10 σ. Returns inf when there is none before the
+// horizon; after 2000 steps (a grazing approach) it returns the time reached, where the
+// engine re-checks the pair (an event with no impulse).
+double bump_contact_time(const double* d0, const double* dv, const double* a, double sigma,
+                         double horizon) {
+    const double amag = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double t = 0.0;
+    for (int step = 0; step < 2000; ++step) {
+        double d[3], u[3];
+        for (int k = 0; k < 3; ++k) {
+            d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
+            u[k] = dv[k] + a[k] * t;
+        }
+        const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        const double h = dist - sigma;
+        const double speed = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        if (h <= 1e-10 * sigma) {
+            const double approach = -(d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / dist;
+            if (approach > 0.0) return t;  // within 1e-10 σ of contact, approaching
+            t += 1e-9 * sigma / (speed + amag * 1e-3 + 1e-300);  // touching, receding
+        } else {
+            // safe step τ: over [t, t + τ] |d'| <= speed + |a| τ, so the gap shrinks by at
+            // most (speed + |a| τ) τ = h
+            t += 2.0 * h / (speed + std::sqrt(speed * speed + 4.0 * amag * h));
+        }
+        if (t > horizon) return kInfinity;
+    }
+    return t;  // grazing: re-check there
+}
 }  // namespace
 
 double Rule::restitution(double gn) const {
@@ -178,10 +210,8 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
             throw std::invalid_argument("fixed needs one entry per particle");
         for (auto f : p.fixed) {
             if (f < 0 || f > 2) throw std::invalid_argument("fixed entries are 0, 1 or 2");
-            if (f > 0 && (gravity_ || !p.wall[f - 1].present || p.periodic_y))
-                throw std::invalid_argument(
-                    "bumps need their wall and no gravity (a bump and a falling particle "
-                    "would need quartic roots)");
+            if (f > 0 && (!p.wall[f - 1].present || p.periodic_y))
+                throw std::invalid_argument("bumps need their wall");
             if (f > 0 && p.wall[f - 1].rule.tangential == Rule::kNoSlip)
                 throw std::invalid_argument("bumps cannot use the no-slip rule");
         }
@@ -244,6 +274,13 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     }
     p_.fixed.clear();
     p_.fixed.shrink_to_fit();
+    for (std::size_t k = 0; k < N; ++k) {
+        if (fixed_[k] == 0) continue;
+        has_bumps_ = true;
+        if (gravity_ && (P_[k].v[0] != 0.0 || P_[k].v[1] != 0.0 || P_[k].v[2] != 0.0))
+            throw std::invalid_argument("bumps under gravity must be static (their wall at "
+                                        "rest)");
+    }
     build_cells();
     co_t_.assign(N, kInf);
     co_partner_.assign(N, -1);
@@ -335,7 +372,7 @@ void EventDriven::remove_cell(std::int32_t i) {
 
 void EventDriven::state_at(std::int32_t i, double tt, double x[3], double v[3]) const {
     const double dt = tt - P_[i].t;
-    const double* g = p_.gravity;
+    const double* g = grav(i);
     for (int a = 0; a < 3; ++a) {
         x[a] = P_[i].x[a] + (P_[i].v[a] + 0.5 * g[a] * dt) * dt;
         v[a] = P_[i].v[a] + g[a] * dt;
@@ -345,7 +382,7 @@ void EventDriven::state_at(std::int32_t i, double tt, double x[3], double v[3]) 
 void EventDriven::advance(std::int32_t i, double t) {
     const double dt = t - P_[i].t;
     if (dt == 0.0) return;
-    if (gravity_) {
+    if (gravity_ && fixed_[i] == 0) {  // bumps feel no gravity
         const double* g = p_.gravity;
         double dx[3];
         for (int a = 0; a < 3; ++a) {
@@ -510,10 +547,27 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
     };
     if (gravity_) {
         const double* g = p_.gravity;
+        std::int32_t kind = kNone;
+        const double horizon = has_bumps_ ? next_boundary(i, kind) : kInf;
+        const double minus_g[3] = {-g[0], -g[1], -g[2]};
         for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
             const Particle& pj = P_[j];
             const double dtj = time_ - pj.t;
             double dr[3], dv[3];
+            if (fixed_[j] != 0) {  // a static bump: the relative motion is a parabola
+                for (int a = 0; a < 3; ++a) {
+                    dr[a] = pj.x[a] + pj.v[a] * dtj + sh[a] - xi[a];
+                    dv[a] = pj.v[a] + vs[a] - vi[a];
+                }
+                const double t = bump_contact_time(dr, dv, minus_g, ri + pj.r,
+                                                   std::min(horizon, best));
+                if (t < best || (t == best && partner >= 0 && j < partner)) {
+                    best = t;
+                    partner = j;
+                    partner_count = count_[j];
+                }
+                return;
+            }
             for (int a = 0; a < 3; ++a) {
                 dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj + sh[a] - xi[a];
                 dv[a] = pj.v[a] + g[a] * dtj + vs[a] - vi[a];
@@ -549,16 +603,31 @@ double EventDriven::wall_time(std::int32_t i, int side) const {
 
 // i's event: the earliest of its cell crossings, wall collisions and collision candidate.
 void EventDriven::schedule(std::int32_t i) {
+    std::int32_t kind = kNone;
+    const double best = next_boundary(i, kind);
+    const double other = time_ + best;
+    if (co_partner_[i] >= 0 && co_t_[i] <= other) {
+        heap_[pos_in_heap_[i]].t = co_t_[i];
+        ev_partner_[i] = co_partner_[i];
+    } else {
+        heap_[pos_in_heap_[i]].t = other;
+        ev_partner_[i] = kind;
+    }
+}
+
+// Time from now until i (synchronised) leaves its cell or meets a wall, and which.
+double EventDriven::next_boundary(std::int32_t i, std::int32_t& kind) const {
     const double* xi = P_[i].x;
     const double* vi = P_[i].v;
+    const double* g = grav(i);
     const std::int32_t* ci = &cell_[3 * i];
     double best = kInf;
-    std::int32_t kind = kNone;
+    kind = kNone;
     for (int a = 0; a < p_.dim; ++a) {
         const bool open = a == 1 && !p_.periodic_y;
         const double lo = org_[a] + ci[a] * cw_[a];
         const double hi = ci[a] + 1 == ncell_[a] && !open ? p_.box[a] : lo + cw_[a];
-        if (p_.gravity[a] == 0.0) {  // straight flight: one boundary ahead
+        if (g[a] == 0.0) {  // straight flight: one boundary ahead
             if (vi[a] == 0.0) continue;
             const bool up = vi[a] > 0.0;
             if (open && ci[a] == (up ? ncell_[a] - 1 : 0)) continue;
@@ -570,14 +639,14 @@ void EventDriven::schedule(std::int32_t i) {
             continue;
         }
         if (!(open && ci[a] + 1 == ncell_[a])) {
-            const double t = first_hit(xi[a] - hi, vi[a], p_.gravity[a]);
+            const double t = first_hit(xi[a] - hi, vi[a], g[a]);
             if (t < best) {
                 best = t;
                 kind = -(a + 1);
             }
         }
         if (!(open && ci[a] == 0)) {
-            const double t = first_hit(lo - xi[a], -vi[a], -p_.gravity[a]);
+            const double t = first_hit(lo - xi[a], -vi[a], -g[a]);
             if (t < best) {
                 best = t;
                 kind = -(a + 4);
@@ -592,14 +661,7 @@ void EventDriven::schedule(std::int32_t i) {
             kind = s == 0 ? kLowerWall : kUpperWall;
         }
     }
-    const double other = time_ + best;
-    if (co_partner_[i] >= 0 && co_t_[i] <= other) {
-        heap_[pos_in_heap_[i]].t = co_t_[i];
-        ev_partner_[i] = co_partner_[i];
-    } else {
-        heap_[pos_in_heap_[i]].t = other;
-        ev_partner_[i] = kind;
-    }
+    return best;
 }
 
 void EventDriven::predict(std::int32_t i) {
@@ -607,7 +669,7 @@ void EventDriven::predict(std::int32_t i) {
     co_t_[i] = kInf;
     co_partner_[i] = -1;
     co_count_[i] = 0;
-    scan(i, -1, 0);
+    if (!(gravity_ && fixed_[i] != 0)) scan(i, -1, 0);  // static bumps under gravity: none
     schedule(i);
 }
 
@@ -618,7 +680,9 @@ void EventDriven::predict(std::int32_t i) {
 // row next to a Lees–Edwards boundary (its image cells slide).
 void EventDriven::predict_crossed(std::int32_t i, int axis, int dir) {
     const std::int32_t p = co_partner_[i];
-    if ((p >= 0 && count_[p] != co_count_[i]) || le_row(i)) {
+    // a full scan also when bumps meet falling particles: their contact times were only
+    // searched up to this crossing
+    if ((p >= 0 && count_[p] != co_count_[i]) || le_row(i) || (gravity_ && has_bumps_)) {
         predict(i);
         return;
     }
@@ -839,6 +903,15 @@ void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
     cross3(rw, n, rwxn);
     for (int a = 0; a < 3; ++a) g[a] = vrel[a] + rwxn[a];
     const double gn = dot3(g, n);
+    if (dot3(vrel, n) <= 0.0) {
+        // not approaching (a re-check after a grazing search, or round-off): no impulse
+        ++invalid_;
+        predict(i);
+        heap_update(i);
+        predict(b);
+        heap_update(b);
+        return;
+    }
     double gt2 = 0.0;
     for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
     double e, beta;
@@ -858,6 +931,7 @@ void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
     const double before = energy();
     double J[3], ubc[3] = {ub[0], ub[1], ub[2]};
     collide(n, r, P_[b].r, 1.0 / m, 0.0, K, e, beta, v, ubc, om, zero, J);
+    rebound_floor(n, ub, m, v, J);  // resting on bumps under gravity, as on a wall
     dissipated_ += before - energy();
     wall_work_[side] += dot3(J, ub);
     for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
@@ -874,13 +948,34 @@ void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
         log_collision(side + 1, i, b, point, n, branch, J, vrel, g);
     }
     last_[i] = time_;
-    ++count_[i];
-    ++count_[b];
+    ++count_[i];  // not the bump's: its trajectory never changes
     ++wall_collisions_;
     predict(i);
     heap_update(i);
     predict(b);
     heap_update(b);
+}
+
+// Minimum rebound when gravity presses the particle onto the body it hit (n from the particle
+// to the body, u the body's velocity): it leaves at least at ½ t_r (g·n), t_r = t_c (1e-8
+// without the TC model), so it hops with a period of at least t_r instead of colliding
+// infinitely often. Adds to the velocity v and the impulse J.
+void EventDriven::rebound_floor(const double n[3], const double u[3], double m, double v[3],
+                                double J[3]) {
+    const double gnorm = dot3(p_.gravity, n);
+    if (!(gnorm > 0.0)) return;
+    const double rest = p_.tc > 0.0 ? p_.tc : 1e-8;
+    const double vmin = 0.5 * rest * gnorm;
+    double out[3];
+    for (int a = 0; a < 3; ++a) out[a] = v[a] - u[a];
+    const double vout = -dot3(out, n);  // > 0: leaving
+    if (vout >= vmin) return;
+    const double dv = vout - vmin;
+    for (int a = 0; a < 3; ++a) {
+        v[a] += dv * n[a];
+        J[a] += m * dv * n[a];
+    }
+    ++resting_;
 }
 
 // A wall is a body of infinite mass moving with (u_x, v_n, u_z). A particle pressed onto it by
@@ -927,23 +1022,7 @@ void EventDriven::process_wall(std::int32_t i, int side) {
         double dummy[3] = {0.0, 0.0, 0.0};
         collide(n, r, 0.0, 1.0 / m, 0.0, K, e, beta, v, uw, om, dummy, J);
     }
-    // minimum rebound under gravity
-    const double gnorm = dot3(p_.gravity, n);
-    if (gnorm > 0.0) {
-        const double rest = p_.tc > 0.0 ? p_.tc : 1e-8;
-        const double vmin = 0.5 * rest * gnorm;
-        double out[3];
-        for (int a = 0; a < 3; ++a) out[a] = v[a] - uw[a];
-        const double vout = -dot3(out, n);  // > 0: leaving the wall
-        if (vout < vmin) {
-            const double dv = vout - vmin;  // add (vmin - vout) away from the wall
-            for (int a = 0; a < 3; ++a) {
-                v[a] += dv * n[a];
-                J[a] += m * dv * n[a];
-            }
-            ++resting_;
-        }
-    }
+    rebound_floor(n, uw, m, v, J);
     dissipated_ += before - energy();
     wall_work_[side] += dot3(J, uw);
     for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
