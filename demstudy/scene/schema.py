@@ -180,8 +180,9 @@ class Servo(StrictModel):
     (Campbell: every ``interval_collisions`` × N pair collisions) or ``time`` (every
     ``interval_time``, as time-stepped engines always do). Counting collisions makes the rule
     equalise the mean stress *per interval*; intervals are short when the cell is dense and
-    stressed, so the time-mean wall stress differs from σ_n; with ``time`` intervals and
-    ``clamp = false`` the time-mean wall stress converges to σ_n.
+    stressed, so the time-mean wall stress differs from σ_n; with ``time`` intervals,
+    ``clamp = false`` and a gain ∝ 1/σ_n (≈ 1e-3/σ_n) the time-mean wall stress converges to
+    σ_n (to 0.1 % ± 2 % at 10× Campbell's stress in the event-driven engine).
 
     ``clamp = false`` drops Campbell's clamp (v ← ½ v ± gain · (σ_measured − σ_n)): the
     clamp cuts the high tail of the interval stress, whose distribution is skewed when an
