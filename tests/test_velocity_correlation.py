@@ -223,3 +223,30 @@ def test_analyze_cli_stores_the_new_statistics(tmp_path, capsys):
     assert main(["analyze", str(flat), "--what", "lambda"]) == 1
     err = capsys.readouterr().err
     assert "3D" in err and "Traceback" not in err
+
+
+def test_lambda_in_malik_cells_removes_a_spanwise_mean_field():
+    """Velocity and spin share a mean field varying along z, A sin(2π z/L_z) x̂, on top of
+    independent isotropic noise: about the bin (strip) means the shared field aligns the
+    fluctuations (Λ ≈ 0.40 > 1/3); about the means of 16 z-cells (Malik's cells) it is gone
+    and Λ = 1/3 within errors (the residual variation of the field inside a cell is small)."""
+    rng = np.random.default_rng(21)
+    n, L, A = 4000, 12.0, 2.0
+    frames = []
+    for t in range(10):
+        pos = rng.uniform(0, L, (n, 3))
+        field = A * np.sin(2 * np.pi * pos[:, 2] / L)
+        vel = rng.normal(size=(n, 3))
+        spin = rng.normal(size=(n, 3))
+        vel[:, 0] += field
+        spin[:, 0] += field
+        frames.append(Frame(time=float(t), box_lo=np.zeros(3), box_hi=np.full(3, L),
+                            position=pos, velocity=vel, angular_velocity=spin,
+                            radius=np.full(n, 0.5)))
+    strip = orientational_correlation(frames, n_bins=2).results
+    cells = orientational_correlation(frames, n_bins=2, z_cells=16)
+    assert np.all(strip["lambda"] > 1 / 3 + 0.04)
+    assert np.all(strip["lambda"] - 1 / 3 > 5 * strip["lambda_err"])
+    lam, err = cells.results["lambda"], cells.results["lambda_err"]
+    assert np.all(np.abs(lam - 1 / 3) < 4 * err + 0.01)
+    assert cells.attrs["z_cells"] == 16

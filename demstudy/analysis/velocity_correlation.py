@@ -99,10 +99,15 @@ class _Binned(AnalysisBase):
     """Common set-up: y-bins of the particle centres, periodic wrapping with LE shifts."""
 
     def __init__(self, dim: int, edges: ArrayLike | None, n_bins: int, period: float,
-                 image_velocity_shift: float, max_blocks: int, verbose: bool) -> None:
+                 image_velocity_shift: float, max_blocks: int, verbose: bool,
+                 z_cells: int = 1) -> None:
         super().__init__(verbose=verbose)
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        if int(z_cells) < 1 or (dim == 2 and int(z_cells) != 1):
+            raise ValueError(f"z_cells = {z_cells!r}: a positive number of cells along z (3D "
+                             "only; 1 = the bin mean)")
+        self.z_cells = int(z_cells)
         if period < 0:
             raise ValueError(f"period must be >= 0, got {period!r}")
         if image_velocity_shift and not period:
@@ -140,15 +145,25 @@ class _Binned(AnalysisBase):
             vel[:, 0] -= turns * self.image_velocity_shift
         bins = np.searchsorted(self.edges, pos[:, 1], side="right") - 1
         bins[(bins < 0) | (bins >= self.n_bins)] = -1
-        return {"pos": pos, "vel": vel, "omega": omega, "bins": bins}
+        cells = bins
+        if self.z_cells > 1:  # Malik's cells: y-bin × z-slab (z periodic)
+            lo, hi = float(np.asarray(frame.box_lo, float)[2]), float(np.asarray(frame.box_hi,
+                                                                                  float)[2])
+            z = np.mod(pos[:, 2] - lo, hi - lo)
+            zc = np.minimum((z / (hi - lo) * self.z_cells).astype(np.intp), self.z_cells - 1)
+            cells = np.where(bins >= 0, bins * self.z_cells + zc, -1)
+        return {"pos": pos, "vel": vel, "omega": omega, "bins": bins, "cells": cells}
 
-    def _bin_mean(self, bins: np.ndarray, values: np.ndarray) -> np.ndarray:
-        """Per-bin mean of ``values`` (rows with bin -1 ignored; empty bins give 0)."""
+    def _bin_mean(self, bins: np.ndarray, values: np.ndarray,
+                  size: int | None = None) -> np.ndarray:
+        """Per-bin (or per-cell, ``size`` of them) mean of ``values`` (rows with index -1
+        ignored; empty ones give 0)."""
+        size = self.n_bins if size is None else size
         keep = bins >= 0
-        n = np.bincount(bins[keep], minlength=self.n_bins).astype(float)
-        out = np.zeros((self.n_bins, values.shape[1]))
+        n = np.bincount(bins[keep], minlength=size).astype(float)
+        out = np.zeros((size, values.shape[1]))
         for c in range(values.shape[1]):
-            out[:, c] = np.bincount(bins[keep], weights=values[keep, c], minlength=self.n_bins)
+            out[:, c] = np.bincount(bins[keep], weights=values[keep, c], minlength=size)
         return out / np.maximum(n, 1.0)[:, None]
 
     def _reference_means(self, reference: Mapping[str, Any] | None) -> None:
@@ -159,15 +174,18 @@ class _Binned(AnalysisBase):
         if ref_edges.shape != self.edges.shape or not np.allclose(ref_edges, self.edges,
                                                                   rtol=0, atol=1e-12):
             raise ValueError("the reference was computed on other bin edges")
-        self._ref = {k: np.nan_to_num(np.asarray(reference[k], float))
+        self._ref = {k: np.nan_to_num(np.asarray(reference.get(f"cell_{k}", reference[k]),
+                                                 float))
                      for k in ("velocity", "spin")}
+        if self._ref["velocity"].shape[0] != self.n_bins * self.z_cells:
+            raise ValueError("the reference was computed with other z cells")
 
     def _fluctuations(self, a: dict[str, np.ndarray], spin: bool = False) -> tuple[np.ndarray, ...]:
-        bins = a["bins"]
-        b = np.maximum(bins, 0)
+        cells, size = a["cells"], self.n_bins * self.z_cells
+        b = np.maximum(cells, 0)
         if self._ref is None:
-            u = a["vel"] - self._bin_mean(bins, a["vel"])[b]
-            w = a["omega"] - self._bin_mean(bins, a["omega"])[b] if spin else None
+            u = a["vel"] - self._bin_mean(cells, a["vel"], size)[b]
+            w = a["omega"] - self._bin_mean(cells, a["omega"], size)[b] if spin else None
         else:
             u = a["vel"] - self._ref["velocity"][b]
             w = a["omega"] - self._ref["spin"][b] if spin else None
@@ -179,6 +197,9 @@ class _Binned(AnalysisBase):
             "period": self.period,
             "image_velocity_shift": self.image_velocity_shift,
             "binning": "bin of the particle centre along y",
+            "z_cells": self.z_cells,
+            "fluctuations": "relative to the bin mean" if self.z_cells == 1 else
+            f"relative to the means of {self.z_cells} z-cells per bin (Malik's cells)",
             "samples": self.n_frames,
             "block_length": self._acc.block_length,
             "n_blocks": self._acc.n_blocks,
@@ -197,29 +218,37 @@ class BinMeans(_Binned):
 
     def __init__(self, dim: int = 2, edges: ArrayLike | None = None, n_bins: int = 1,
                  period: float = 0.0, image_velocity_shift: float = 0.0, max_blocks: int = 64,
-                 verbose: bool = False) -> None:
-        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose)
+                 verbose: bool = False, z_cells: int = 1) -> None:
+        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose,
+                         z_cells)
 
     def _prepare(self) -> None:
         self._set_edges(self.first_frame)
         self._nv = 1 + self.dim + self.n_rot
-        self._acc = BlockAccumulator(self.n_bins * self._nv, self.max_blocks)
+        self._n_cells = self.n_bins * self.z_cells
+        self._acc = BlockAccumulator(self._n_cells * self._nv, self.max_blocks)
 
     def _single_frame(self, frame: Frame) -> None:
         a = self._assign(frame)
-        keep = a["bins"] >= 0
-        bins = a["bins"][keep]
-        values = np.concatenate([np.ones((bins.size, 1)), a["vel"][keep], a["omega"][keep]], 1)
-        sample = np.zeros((self.n_bins, self._nv))
+        keep = a["cells"] >= 0
+        cells = a["cells"][keep]
+        values = np.concatenate([np.ones((cells.size, 1)), a["vel"][keep], a["omega"][keep]], 1)
+        sample = np.zeros((self._n_cells, self._nv))
         for c in range(self._nv):
-            sample[:, c] = np.bincount(bins, weights=values[:, c], minlength=self.n_bins)
+            sample[:, c] = np.bincount(cells, weights=values[:, c], minlength=self._n_cells)
         self._acc.add(sample)
 
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
-        s = mean.reshape(self.n_bins, self._nv)
+        cells = mean.reshape(self._n_cells, self._nv)
+        s = cells.reshape(self.n_bins, self.z_cells, self._nv).sum(1)
         n = s[:, :1]
-        return {"count": s[:, 0], "velocity": s[:, 1 : 1 + self.dim] / n,
-                "spin": s[:, 1 + self.dim :] / n}
+        out = {"count": s[:, 0], "velocity": s[:, 1 : 1 + self.dim] / n,
+               "spin": s[:, 1 + self.dim :] / n}
+        if self.z_cells > 1:  # Malik's cell means, the second pass's reference
+            nc = cells[:, :1]
+            out.update({"cell_velocity": cells[:, 1 : 1 + self.dim] / nc,
+                        "cell_spin": cells[:, 1 + self.dim :] / nc})
+        return out
 
     def _conclude(self) -> None:
         est, err = jackknife(self._acc, self._estimate)
@@ -254,8 +283,9 @@ class VelocityCorrelation(_Binned):
                  reference: Mapping[str, Any] | None = None, in_bin: bool = False,
                  distance: str = "full", period: float = 0.0,
                  image_velocity_shift: float = 0.0, chunk: int = 4096, max_blocks: int = 64,
-                 verbose: bool = False) -> None:
-        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose)
+                 verbose: bool = False, z_cells: int = 1) -> None:
+        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose,
+                         z_cells)
         if not (r_max > 0 and dr > 0):
             raise ValueError("r_max and dr must be positive")
         if distance not in ("full", "planar"):
@@ -420,11 +450,12 @@ class OrientationalCorrelation(_Binned):
     def __init__(self, dim: int = 3, edges: ArrayLike | None = None, n_bins: int = 1,
                  reference: Mapping[str, Any] | None = None, period: float = 0.0,
                  image_velocity_shift: float = 0.0, max_blocks: int = 64,
-                 verbose: bool = False) -> None:
+                 verbose: bool = False, z_cells: int = 1) -> None:
         if dim != 3:
             raise ValueError("Lambda needs 3D: in 2D the spin omega_z is perpendicular to "
                              "every in-plane velocity, so cos(Psi) = 0 identically")
-        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose)
+        super().__init__(dim, edges, n_bins, period, image_velocity_shift, max_blocks, verbose,
+                         z_cells)
         self._reference = reference
 
     def _prepare(self) -> None:
@@ -472,7 +503,7 @@ def _two_pass(cls: type, frames: Callable[[], Iterable[Frame]] | Iterable[Frame]
         raise TypeError("two passes read the frames twice: pass a list or a callable "
                         "returning a fresh iterator, not an iterator")
     source = frames if callable(frames) else (lambda: frames)
-    keys = ("dim", "edges", "n_bins", "period", "image_velocity_shift", "max_blocks")
+    keys = ("dim", "edges", "n_bins", "period", "image_velocity_shift", "max_blocks", "z_cells")
     first = BinMeans(**{k: options[k] for k in keys if k in options}).run(source())
     options = {**options, "edges": first.edges, "reference": first.results}
     return cls(**options).run(source())
