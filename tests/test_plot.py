@@ -261,3 +261,25 @@ def test_output_names():
     assert output_path("a/fig.png", "vdf", True) == Path("a/fig-vdf.png")
     assert output_path("a/fig", "gr", True) == Path("a/fig-gr.png")
     assert output_path(None, "waves", True) == Path("waves.png")
+
+
+def test_equation_of_state_plots_chi_against_nu(chute):
+    """χ per bin from the stored total P_yy and the profiles (derived.equation_of_state), at
+    each bin's ν; the theory curve is campbell_chi for the scene's e."""
+    from demstudy.analysis.derived import equation_of_state
+    from demstudy.theory import campbell_chi
+
+    run = Run.load(chute)
+    res = read_results(chute)
+    st, prof = res.groups["statistics/stress"], res.profiles
+    chi, _err = equation_of_state(prof, st["total"][:, 1, 1], st["total_err"][:, 1, 1])
+    nu = prof["solid_fraction"]
+    ok = np.isfinite(chi) & (nu > 0.02)
+    assert ok.sum() >= 3
+    fig = draw("eos", [run])
+    same(line(fig, f"{chute.name}:chi"), nu[ok], chi[ok])
+    theory = line(fig, f"{chute.name}:chi_theory")
+    x = np.asarray(theory.get_xdata(), float)
+    e = run.scene.contact.restitution
+    np.testing.assert_allclose(theory.get_ydata(), campbell_chi(x, 2, e), rtol=1e-12)
+    assert "Henderson" in fig._suptitle.get_text()

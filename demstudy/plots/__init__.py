@@ -30,13 +30,14 @@ from matplotlib.figure import Figure
 from .common import Run, missing_notice, save
 from .correlations import draw_gr, draw_lambda, draw_vcorr
 from .distributions import draw_angles, draw_vdf
-from .profiles import draw_profiles, draw_stress, reference_height
+from .profiles import draw_eos, draw_profiles, draw_stress, reference_height
 from .waves import draw_waves
 
 #: the kinds, in the order ``--kind all`` draws them
-KINDS = ("profiles", "stress", "vdf", "angles", "gr", "vcorr", "lambda", "waves")
+KINDS = ("profiles", "stress", "eos", "vdf", "angles", "gr", "vcorr", "lambda", "waves")
 
-__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_gr", "draw_lambda", "draw_profiles",
+__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_eos", "draw_gr", "draw_lambda",
+           "draw_profiles",
            "draw_stress", "draw_vcorr", "draw_vdf", "draw_waves", "output_path", "parse_kinds",
            "plot_files", "plot_profiles", "reference_height"]
 
@@ -65,8 +66,9 @@ def draw(kind: str, runs: Sequence[Run], *, scaled: bool = False,
         raise ValueError(f"unknown plot kind {kind!r} (allowed: {', '.join(KINDS)})")
     if kind == "profiles":
         return draw_profiles(runs, scaled=scaled)
-    if kind in ("stress", "lambda", "waves"):
-        return {"stress": draw_stress, "lambda": draw_lambda, "waves": draw_waves}[kind](runs)
+    if kind in ("stress", "eos", "lambda", "waves"):
+        return {"stress": draw_stress, "eos": draw_eos, "lambda": draw_lambda,
+                "waves": draw_waves}[kind](runs)
     fn: dict[str, Callable[..., Figure]] = {"vdf": draw_vdf, "angles": draw_angles,
                                             "gr": draw_gr, "vcorr": draw_vcorr}
     return fn[kind](runs, bins=bins)

@@ -23,6 +23,7 @@ from ..io.results import Results
 #: results-file groups holding each kind (first present wins)
 GROUPS = {
     "stress": ("statistics/stress", "stress"),
+    "eos": ("statistics/stress", "stress"),
     "vdf": ("statistics/vdf",),
     "angles": ("statistics/angles",),
     "gr": ("statistics/gr",),
@@ -31,12 +32,14 @@ GROUPS = {
     "waves": ("statistics/waves",),
 }
 #: a dataset that must be present for the kind to be drawable
-REQUIRED = {"stress": "total", "vdf": "X", "angles": "p_text", "gr": "g", "vcorr": "C",
-            "lambda": "lambda", "waves": "series_time"}
+REQUIRED = {"stress": "total", "eos": "total", "vdf": "X", "angles": "p_text", "gr": "g",
+            "vcorr": "C", "lambda": "lambda", "waves": "series_time"}
 #: how to obtain a missing kind ({file}: the results file's name)
 HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
        "stress": "add it with measure.statistics = [\"stress\"] or "
                  "`demstudy analyze {file} --what stress`",
+       "eos": "it needs /stress: measure.statistics = [\"stress\"] or "
+              "`demstudy analyze {file} --what stress`",
        "angles": "add it with `demstudy analyze {file} --what angles`, which needs an "
                  "event-driven run's /collisions log",
        "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only"}

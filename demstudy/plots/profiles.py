@@ -148,3 +148,45 @@ def draw_stress(runs: Sequence[Run]) -> Figure:
     per = "force per length (2D)" if dims == {2} else "force per area (3D)" if dims == {3} \
         else "force per length (2D) or area (3D)"
     return finish(fig, runs, f"stress profiles in {per}; markers: wall stresses at the walls")
+
+
+def draw_eos(runs: Sequence[Run]) -> Figure:
+    """Campbell's equation of state χ(ν) = P_yy / (ρ_p Σ_a ⟨v_a'²⟩) per bin (the total P_yy of
+    ``/stress`` and the profiles' velocity variances, :func:`demstudy.analysis.derived.
+    equation_of_state`) against the bin's ν, with the kinetic-theory curve
+    χ = ν Z(ν)/dim (Henderson's g0 for discs, Carnahan–Starling's for spheres, the scene's
+    restitution e) and the elastic one."""
+    from ..analysis.derived import equation_of_state
+    from ..theory import campbell_chi
+
+    fig, axes = new_figure(1, 1, width=5.5, height=4.5)
+    ax = axes[0, 0]
+    dims, nu_max = set(), 0.0
+    for r, run in enumerate(runs):
+        data, attrs = run.group("stress")
+        prof = run.results.profiles
+        dim = int(attrs.get("dim", 2))
+        dims.add(dim)
+        chi, err = equation_of_state(prof, np.asarray(data["total"], float)[:, 1, 1],
+                                     np.asarray(data["total_err"], float)[:, 1, 1])
+        nu = np.asarray(prof["solid_fraction"], float)
+        ok = np.isfinite(chi) & (nu > 0.02)
+        ax.errorbar(nu[ok], chi[ok], yerr=np.nan_to_num(err[ok]), ls="none",
+                    marker=MARKERS[r % len(MARKERS)], ms=4, capsize=2, color=f"C{r}",
+                    label=run.label, gid=f"{run.path.name}:chi")
+        nu_max = max(nu_max, float(nu[ok].max()) if ok.any() else 0.0)
+        e = float(run.scene.contact.restitution) if run.scene is not None else 1.0
+        grid = np.linspace(0.01, min(0.99 * (0.9069 if dim == 2 else 0.7405),
+                                     max(nu_max, 0.1) * 1.1), 200)
+        ax.plot(grid, campbell_chi(grid, dim, e), color=f"C{r}", lw=1.2,
+                label=f"kinetic theory, e = {e:g}", gid=f"{run.path.name}:chi_theory")
+    ax.plot(grid, campbell_chi(grid, min(dims), 1.0), color="0.5", ls=":", lw=1.0,
+            label="kinetic theory, e = 1")
+    ax.set_xlabel("solid fraction ν")
+    ax.set_ylabel("χ(ν) = P_yy / (ρ_p Σ⟨v'²⟩)")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    g0 = "Henderson g0 (discs)" if dims == {2} else "Carnahan–Starling g0 (spheres)" \
+        if dims == {3} else "Henderson / Carnahan–Starling g0"
+    return finish(fig, runs, f"equation of state χ(ν), Campbell (1982); theory: {g0}")
