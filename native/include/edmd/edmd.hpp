@@ -288,6 +288,8 @@ private:
     void process_collision(std::int32_t i, std::int32_t j);
     void process_wall(std::int32_t i, int side);
     void process_bump(std::int32_t i, std::int32_t b);
+    void body_contact(std::int32_t i, int side, const double n[3], const double u[3],
+                      bool tc_model, std::int32_t partner);
     void rebound_floor(const double n[3], const double u[3], double m, double v[3], double J[3]);
     void process_crossing(std::int32_t i, int axis);
     void process_reshuffle();

@@ -884,72 +884,20 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
 void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
     advance(i, time_);
     advance(b, time_);
-    const int side = fixed_[b] - 1;
-    const Rule& rule = p_.wall[side].rule;
     double dr[3], vs[3];
     separation(i, b, dr, vs);
     const double dist = std::sqrt(dot3(dr, dr));
     const double n[3] = {dr[0] / dist, dr[1] / dist, dr[2] / dist};
-    double* v = P_[i].v;
-    double* om = &w_[3 * i];
-    double ub[3], zero[3] = {0.0, 0.0, 0.0};
-    for (int a = 0; a < 3; ++a) ub[a] = P_[b].v[a] + vs[a];
-    const double r = P_[i].r, m = m_[i], K = p_.inertia_k;
-    double vrel[3], rw[3], rwxn[3], g[3];
+    double ub[3], vrel[3];
     for (int a = 0; a < 3; ++a) {
-        vrel[a] = v[a] - ub[a];
-        rw[a] = r * om[a];
+        ub[a] = P_[b].v[a] + vs[a];
+        vrel[a] = P_[i].v[a] - ub[a];
     }
-    cross3(rw, n, rwxn);
-    for (int a = 0; a < 3; ++a) g[a] = vrel[a] + rwxn[a];
-    const double gn = dot3(g, n);
-    if (dot3(vrel, n) <= 0.0) {
-        // not approaching (a re-check after a grazing search, or round-off): no impulse
-        ++invalid_;
-        predict(i);
-        heap_update(i);
-        predict(b);
-        heap_update(b);
-        return;
-    }
-    double gt2 = 0.0;
-    for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
-    double e, beta;
-    if (p_.tc > 0.0 && time_ - last_[i] < p_.tc) {
-        e = 1.0;
-        beta = -1.0;
-        ++tc_elastic_;
+    if (dot3(vrel, n) > 0.0) {
+        body_contact(i, fixed_[b] - 1, n, ub, true, b);
     } else {
-        e = rule.restitution(std::max(gn, 0.0));
-        beta = rule.beta_for(e, K, std::max(gn, 0.0), std::sqrt(gt2));
+        ++invalid_;  // not approaching (a re-check after a grazing search, or round-off)
     }
-    auto energy = [&]() {  // in the bump's frame
-        double u[3];
-        for (int a = 0; a < 3; ++a) u[a] = v[a] - ub[a];
-        return 0.5 * m * (dot3(u, u) + K * r * r * dot3(om, om));
-    };
-    const double before = energy();
-    double J[3], ubc[3] = {ub[0], ub[1], ub[2]};
-    collide(n, r, P_[b].r, 1.0 / m, 0.0, K, e, beta, v, ubc, om, zero, J);
-    rebound_floor(n, ub, m, v, J);  // resting on bumps under gravity, as on a wall
-    dissipated_ += before - energy();
-    wall_work_[side] += dot3(J, ub);
-    for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
-    {
-        const double branch[3] = {r * n[0], r * n[1], r * n[2]};  // to the contact point
-        add_stress(P_[i].x[1], P_[i].x[1] + branch[1], branch, J);
-    }
-    if (p_.log_every > 0) {
-        double point[3], branch[3];
-        for (int a = 0; a < 3; ++a) {
-            branch[a] = r * n[a];
-            point[a] = P_[i].x[a] + branch[a];
-        }
-        log_collision(side + 1, i, b, point, n, branch, J, vrel, g);
-    }
-    last_[i] = time_;
-    ++count_[i];  // not the bump's: its trajectory never changes
-    ++wall_collisions_;
     predict(i);
     heap_update(i);
     predict(b);
@@ -978,73 +926,78 @@ void EventDriven::rebound_floor(const double n[3], const double u[3], double m, 
     ++resting_;
 }
 
-// A wall is a body of infinite mass moving with (u_x, v_n, u_z). A particle pressed onto it by
-// gravity leaves with at least ½ t_r |g_n| (t_r = tc, or 1e-8 when the TC model is off), so
-// it hops with a period of at least t_r instead of colliding infinitely often.
+// A wall is a body of infinite mass moving with (u_x, v_n, u_z).
 void EventDriven::process_wall(std::int32_t i, int side) {
     advance(i, time_);
-    Wall& w = p_.wall[side];
+    const Wall& w = p_.wall[side];
     const double n[3] = {0.0, side == 0 ? -1.0 : 1.0, 0.0};  // particle -> wall
-    double uw[3] = {w.u[0], w.vn, p_.dim == 3 ? w.u[2] : 0.0};
+    const double uw[3] = {w.u[0], w.vn, p_.dim == 3 ? w.u[2] : 0.0};
+    body_contact(i, side, n, uw, false, -1);
+    predict(i);
+    heap_update(i);
+}
+
+// Particle i meets a body of infinite mass moving with u (wall `side`, or a bump of it:
+// `partner`, -1 for the wall; n from the particle to the body): the wall's rule with m* = m
+// (Campbell's no-slip rule: the centre takes the body's tangential velocity, the spin is
+// unchanged, the normal velocity is reversed with e_w), the TC model when `tc_model` (bumps;
+// walls have the minimum rebound instead), the minimum rebound under gravity; the impulse and
+// work count for the wall, the contact's stress goes to the bins along the branch r n (as the
+// LAMMPS contact stress, so the bins next to a wall carry its stress), energy is booked in
+// the body's frame. The caller re-predicts.
+void EventDriven::body_contact(std::int32_t i, int side, const double n[3], const double u[3],
+                               bool tc_model, std::int32_t partner) {
+    const Rule& rule = p_.wall[side].rule;
     double* v = P_[i].v;
     double* om = &w_[3 * i];
     const double r = P_[i].r, m = m_[i], K = p_.inertia_k;
     double vrel[3], rw[3], rwxn[3], g[3];
     for (int a = 0; a < 3; ++a) {
-        vrel[a] = v[a] - uw[a];
+        vrel[a] = v[a] - u[a];
         rw[a] = r * om[a];
     }
     cross3(rw, n, rwxn);
     for (int a = 0; a < 3; ++a) g[a] = vrel[a] + rwxn[a];
-    const double gn = dot3(g, n);
+    const double g_n = dot3(g, n);
+    const double gn = std::max(g_n, 0.0);
     double gt2 = 0.0;
-    for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
-    const Rule& rule = w.rule;
-    const double e = rule.restitution(std::max(gn, 0.0));
-    auto energy = [&]() {  // in the wall's frame
-        double u[3];
-        for (int a = 0; a < 3; ++a) u[a] = v[a] - uw[a];
-        return 0.5 * m * (dot3(u, u) + K * r * r * dot3(om, om));
+    for (int a = 0; a < 3; ++a) gt2 += (g[a] - g_n * n[a]) * (g[a] - g_n * n[a]);
+    const bool elastic = tc_model && p_.tc > 0.0 && time_ - last_[i] < p_.tc;
+    if (elastic) ++tc_elastic_;
+    const double e = elastic ? 1.0 : rule.restitution(gn);
+    auto energy = [&]() {  // in the body's frame
+        double du[3];
+        for (int a = 0; a < 3; ++a) du[a] = v[a] - u[a];
+        return 0.5 * m * (dot3(du, du) + K * r * r * dot3(om, om));
     };
     const double before = energy();
     double J[3] = {0.0, 0.0, 0.0};
-    if (rule.tangential == Rule::kNoSlip) {
-        // Campbell's no-slip wall: the centre takes the wall's tangential velocity, the spin
-        // is unchanged, the normal velocity is reversed with e_w
+    if (rule.tangential == Rule::kNoSlip) {  // walls only (bumps refuse it)
         const double vn = dot3(vrel, n);
         for (int a = 0; a < 3; ++a) {
-            const double new_v = a == 1 ? uw[1] - e * vn * n[1] : uw[a];
+            const double new_v = u[a] - e * vn * n[a];
             J[a] = m * (new_v - v[a]);
             v[a] = new_v;
         }
     } else {
-        const double beta = rule.beta_for(e, K, std::max(gn, 0.0), std::sqrt(gt2));
-        double dummy[3] = {0.0, 0.0, 0.0};
-        collide(n, r, 0.0, 1.0 / m, 0.0, K, e, beta, v, uw, om, dummy, J);
+        const double beta = elastic ? -1.0 : rule.beta_for(e, K, gn, std::sqrt(gt2));
+        double body[3] = {u[0], u[1], u[2]}, unused[3] = {0.0, 0.0, 0.0};
+        collide(n, r, 0.0, 1.0 / m, 0.0, K, e, beta, v, body, om, unused, J);
     }
-    rebound_floor(n, uw, m, v, J);
+    rebound_floor(n, u, m, v, J);
     dissipated_ += before - energy();
-    wall_work_[side] += dot3(J, uw);
-    for (int a = 0; a < 3; ++a) wall_impulse_[side][a] += J[a];
-    {
-        // the wall acts at the contact point: branch r n from the centre (as the LAMMPS
-        // contact stress), so the bins next to the wall carry its stress too
-        const double branch[3] = {r * n[0], r * n[1], r * n[2]};
-        add_stress(P_[i].x[1], P_[i].x[1] + branch[1], branch, J);
+    wall_work_[side] += dot3(J, u);
+    double branch[3], point[3];
+    for (int a = 0; a < 3; ++a) {
+        branch[a] = r * n[a];
+        point[a] = P_[i].x[a] + branch[a];
+        wall_impulse_[side][a] += J[a];
     }
-    if (p_.log_every > 0) {
-        double point[3], branch[3];
-        for (int a = 0; a < 3; ++a) {
-            branch[a] = r * n[a];
-            point[a] = P_[i].x[a] + branch[a];
-        }
-        log_collision(side + 1, i, -1, point, n, branch, J, vrel, g);
-    }
+    add_stress(P_[i].x[1], point[1], branch, J);
+    if (p_.log_every > 0) log_collision(side + 1, i, partner, point, n, branch, J, vrel, g);
     last_[i] = time_;
-    ++count_[i];
+    ++count_[i];  // never the bump's: its trajectory does not change
     ++wall_collisions_;
-    predict(i);
-    heap_update(i);
 }
 
 void EventDriven::process_crossing(std::int32_t i, int code) {
