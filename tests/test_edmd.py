@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 import pytest
+from edmd_helpers import energy, make_scene, scene_with, system
 from scipy.spatial import cKDTree
 
 from demstudy.analysis.suite import profile_analysis
@@ -28,57 +29,18 @@ from demstudy.engines.base import EngineError, RunOptions, get_engine
 from demstudy.engines.edmd import (
     EdmdEngine,
     EventDriven,
-    check_supported,
     collide_pair,
     from_initial_state,
 )
 from demstudy.io.results import read_results
-from demstudy.scene import parse_scene_text, validate_scene
 from demstudy.scene.initial import build_initial_state
 from demstudy.theory import kinetic as theory
-
-
-def make_scene(dim: int, phi: float, n: int, seed: int = 1, e: float = 1.0,
-               extra: str = "", spread: float = 0.0, tangential: str = "smooth",
-               production: float = 1.0, sample: float = 1.0):
-    unit = math.pi / 6 if dim == 3 else math.pi / 4
-    length = (n * unit * (1 + spread**2 / 4) / phi) ** (1 / dim)
-    size = [round(length, 9)] * dim
-    tang = ('{ model = "smooth" }' if tangential == "smooth"
-            else f'{{ model = "beta", beta = {tangential} }}')
-    return validate_scene(parse_scene_text(f"""
-dimension = {dim}
-[box]
-size = {size}
-[particles]
-count = {n}
-diameter_spread = {spread}
-[contact]
-restitution = {e}
-tangential = {tang}
-[initial.velocity]
-temperature = 1.0
-[run]
-equilibration = 0.0
-production = {production}
-sample_interval = {sample}
-seed = {seed}
-{extra}
-"""))
-
-
-def system(scene, tc: float = 0.0, **kw) -> EventDriven:
-    params = check_supported(scene)
-    params.update(kw)
-    return from_initial_state(build_initial_state(scene), scene.box.size, tc=tc, **params)
 
 
 def fraction(scene) -> float:
     return scene.solid_fraction
 
 
-def energy(s: EventDriven) -> float:
-    return s.kinetic_energy + s.rotational_energy
 
 
 # ---- collision rules ----------------------------------------------------------------------
@@ -438,14 +400,7 @@ bin_width = 2.0
 
 
 def engine_scene(overrides: dict | None = None):
-    data = parse_scene_text(ENGINE_SCENE)
-    for key, value in (overrides or {}).items():
-        target = data
-        *path, last = key.split(".")
-        for part in path:
-            target = target.setdefault(part, {})
-        target[last] = value
-    return validate_scene(data)
+    return scene_with(ENGINE_SCENE, overrides)
 
 
 def test_engine_writes_the_common_results_file(tmp_path):

@@ -31,11 +31,11 @@ import sys
 
 import numpy as np
 import pytest
+from edmd_helpers import energy, make_scene, scene_with, system
 from scipy.spatial import cKDTree
 
 from demstudy.engines.base import EngineError, RunOptions
-from demstudy.engines.edmd import EdmdEngine, EventDriven, check_supported, from_initial_state
-from demstudy.engines.edmd.core import y_range
+from demstudy.engines.edmd import EdmdEngine, EventDriven
 from demstudy.io.results import read_results
 from demstudy.scene import load_scene, parse_scene_text, validate_scene
 from demstudy.scene.initial import build_initial_state
@@ -78,40 +78,10 @@ def contact_velocity(v, w, u, r, n):
     return v - u + np.cross(r * w, n)
 
 
-def energy(s: EventDriven) -> float:
-    return s.kinetic_energy + s.rotational_energy
 
 
-def make_scene(dim: int, phi: float, n: int, seed: int = 1, e: float = 1.0, extra: str = "",
-               profile: str = "none"):
-    unit = math.pi / 6 if dim == 3 else math.pi / 4
-    size = [round((n * unit / phi) ** (1 / dim), 9)] * dim
-    return validate_scene(parse_scene_text(f"""
-dimension = {dim}
-[box]
-size = {size}
-[particles]
-count = {n}
-[contact]
-restitution = {e}
-[initial.velocity]
-temperature = 1.0
-profile = "{profile}"
-[run]
-equilibration = 0.0
-production = 1.0
-seed = {seed}
-{extra}
-"""))
 
 
-def system(scene, tc: float = 0.0, **kw) -> EventDriven:
-    params = check_supported(scene)
-    initial = build_initial_state(scene)
-    if not scene.y_periodic:
-        params["y_range"] = y_range(scene, initial.position)
-    params.update(kw)
-    return from_initial_state(initial, scene.box.size, tc=tc, **params)
 
 
 def pair_gaps(positions, box):
@@ -726,14 +696,7 @@ bin_width = 2.0
 
 
 def engine_scene(overrides: dict | None = None):
-    data = parse_scene_text(ENGINE_SCENE)
-    for key, value in (overrides or {}).items():
-        target = data
-        *path, last = key.split(".")
-        for part in path:
-            target = target.setdefault(part, {})
-        target[last] = value
-    return validate_scene(data)
+    return scene_with(ENGINE_SCENE, overrides)
 
 
 @pytest.mark.parametrize("walls", [False, True])

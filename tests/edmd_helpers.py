@@ -1,0 +1,70 @@
+"""Helpers shared by the event-driven engine's tests (test_edmd.py, test_edmd_walls.py).
+
+Dimensionless particle units: d = 1, m = 1 (g = 1 with gravity).
+"""
+
+from __future__ import annotations
+
+import math
+
+from demstudy.engines.edmd import EventDriven, check_supported, from_initial_state
+from demstudy.engines.edmd.core import y_range
+from demstudy.scene import parse_scene_text, validate_scene
+from demstudy.scene.initial import build_initial_state
+
+
+def make_scene(dim: int, phi: float, n: int, seed: int = 1, e: float = 1.0,
+               extra: str = "", spread: float = 0.0, tangential: str = "smooth",
+               production: float = 1.0, sample: float = 1.0, profile: str = "none"):
+    """n particles at solid fraction phi in a periodic cube (square), T = 1."""
+    unit = math.pi / 6 if dim == 3 else math.pi / 4
+    length = (n * unit * (1 + spread**2 / 4) / phi) ** (1 / dim)
+    size = [round(length, 9)] * dim
+    tang = ('{ model = "smooth" }' if tangential == "smooth"
+            else f'{{ model = "beta", beta = {tangential} }}')
+    return validate_scene(parse_scene_text(f"""
+dimension = {dim}
+[box]
+size = {size}
+[particles]
+count = {n}
+diameter_spread = {spread}
+[contact]
+restitution = {e}
+tangential = {tang}
+[initial.velocity]
+temperature = 1.0
+profile = "{profile}"
+[run]
+equilibration = 0.0
+production = {production}
+sample_interval = {sample}
+seed = {seed}
+{extra}
+"""))
+
+
+def scene_with(text: str, overrides: dict | None = None):
+    """The scene of TOML ``text`` with dotted-key ``overrides`` set to Python values."""
+    data = parse_scene_text(text)
+    for key, value in (overrides or {}).items():
+        target = data
+        *path, last = key.split(".")
+        for part in path:
+            target = target.setdefault(part, {})
+        target[last] = value
+    return validate_scene(data)
+
+
+def system(scene, tc: float = 0.0, **kw) -> EventDriven:
+    """The core for a scene (with its cell range along a bounded y)."""
+    params = check_supported(scene)
+    initial = build_initial_state(scene)
+    if not scene.y_periodic:
+        params["y_range"] = y_range(scene, initial.position)
+    params.update(kw)
+    return from_initial_state(initial, scene.box.size, tc=tc, **params)
+
+
+def energy(s: EventDriven) -> float:
+    return s.kinetic_energy + s.rotational_energy
