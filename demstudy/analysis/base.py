@@ -18,7 +18,7 @@ import numpy as np
 
 from demstudy.io.frames import Frame
 
-__all__ = ["AnalysisBase"]
+__all__ = ["AnalysisBase", "default_y_edges", "z_slab"]
 
 
 class AnalysisBase:
@@ -85,3 +85,19 @@ class AnalysisBase:
             if self.verbose and self.n_frames % 100 == 0:
                 print(f"{type(self).__name__}: {self.n_frames} frames")
         return self.finish()
+
+
+def default_y_edges(frame: Frame, period: float, n_bins: int) -> np.ndarray:
+    """``n_bins`` equal bins along y over the frame's box (from its lower edge over one period
+    when y is periodic)."""
+    lo = float(np.asarray(frame.box_lo, float)[1])
+    hi = lo + period if period else float(np.asarray(frame.box_hi, float)[1])
+    return np.linspace(lo, hi, n_bins + 1)
+
+
+def z_slab(frame: Frame, z: np.ndarray, n: int) -> np.ndarray:
+    """Index of the slab (of ``n`` equal slabs of the periodic z length) holding each z:
+    Malik's cells are y-bins split into such slabs."""
+    lo = float(np.asarray(frame.box_lo, float)[2])
+    length = float(np.asarray(frame.box_hi, float)[2]) - lo
+    return np.minimum((np.mod(z - lo, length) / length * n).astype(np.intp), n - 1)

@@ -65,7 +65,7 @@ from numpy.typing import ArrayLike
 from scipy.special import erf, gammainc, gammaln
 
 from demstudy import UNITS_NOTE
-from demstudy.analysis.base import AnalysisBase
+from demstudy.analysis.base import AnalysisBase, default_y_edges, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
 from demstudy.io.frames import Frame
 
@@ -183,15 +183,10 @@ class VelocityDistribution(AnalysisBase):
         if frame.dim != self.dim:
             raise ValueError(f"frame is {frame.dim}D, analysis is {self.dim}D")
         if self._edges is None:
-            lo = float(np.asarray(frame.box_lo, float)[1])
-            hi = lo + self.period if self.period else float(np.asarray(frame.box_hi, float)[1])
-            self._edges = np.linspace(lo, hi, self._n_bins + 1)
+            self._edges = default_y_edges(frame, self.period, self._n_bins)
         self.edges = self._edges
         self.n_bins = self.edges.size - 1
         self.n_cells = self.n_bins * self.z_cells
-        if self.dim == 3:
-            self._z_lo = float(np.asarray(frame.box_lo, float)[2])
-            self._z_len = float(np.asarray(frame.box_hi, float)[2]) - self._z_lo
         if self.reference is not None:
             ref_edges = self.reference["edges"]
             if ref_edges.shape != self.edges.shape or not np.allclose(
@@ -231,10 +226,8 @@ class VelocityDistribution(AnalysisBase):
                 vel[:, 0] -= turns * self.image_velocity_shift
         bins = np.searchsorted(self.edges, y, side="right") - 1
         keep = (bins >= 0) & (bins < self.n_bins)
-        if self.z_cells > 1:  # z is periodic: wrap, then slab index
-            z = np.mod(pos[:, 2] - self._z_lo, self._z_len)
-            zc = np.minimum((z / self._z_len * self.z_cells).astype(np.intp), self.z_cells - 1)
-            bins = bins * self.z_cells + zc
+        if self.z_cells > 1:  # Malik's cells: y-bin × z-slab
+            bins = bins * self.z_cells + z_slab(frame, pos[:, 2], self.z_cells)
         sqrt_j = np.sqrt(self.inertia_factor) * radius
         comps = np.concatenate([vel, omega, sqrt_j[:, None] * omega], axis=1)
         return bins[keep], comps[keep]

@@ -66,7 +66,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from demstudy import UNITS_NOTE
-from demstudy.analysis.base import AnalysisBase
+from demstudy.analysis.base import AnalysisBase, default_y_edges, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
 from demstudy.io.frames import Frame
 
@@ -123,9 +123,7 @@ class _Binned(AnalysisBase):
         if frame.dim != self.dim:
             raise ValueError(f"frame is {frame.dim}D, analysis is {self.dim}D")
         if self._edges is None:
-            lo = float(np.asarray(frame.box_lo, float)[1])
-            hi = lo + self.period if self.period else float(np.asarray(frame.box_hi, float)[1])
-            self._edges = np.linspace(lo, hi, self._n_bins + 1)
+            self._edges = default_y_edges(frame, self.period, self._n_bins)
         self.edges = self._edges
         self.n_bins = self.edges.size - 1
 
@@ -146,12 +144,9 @@ class _Binned(AnalysisBase):
         bins = np.searchsorted(self.edges, pos[:, 1], side="right") - 1
         bins[(bins < 0) | (bins >= self.n_bins)] = -1
         cells = bins
-        if self.z_cells > 1:  # Malik's cells: y-bin × z-slab (z periodic)
-            lo, hi = float(np.asarray(frame.box_lo, float)[2]), float(np.asarray(frame.box_hi,
-                                                                                  float)[2])
-            z = np.mod(pos[:, 2] - lo, hi - lo)
-            zc = np.minimum((z / (hi - lo) * self.z_cells).astype(np.intp), self.z_cells - 1)
-            cells = np.where(bins >= 0, bins * self.z_cells + zc, -1)
+        if self.z_cells > 1:  # Malik's cells: y-bin × z-slab
+            cells = np.where(bins >= 0, bins * self.z_cells + z_slab(frame, pos[:, 2],
+                                                                     self.z_cells), -1)
         return {"pos": pos, "vel": vel, "omega": omega, "bins": bins, "cells": cells}
 
     def _bin_mean(self, bins: np.ndarray, values: np.ndarray,
