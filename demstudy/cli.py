@@ -110,7 +110,8 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         def frames():
             return reader(source, scene.dimension, dt=dt, start_time=args.start)
 
-    for name, (data, attrs) in run_statistics(scene, frames, what, results).items():
+    for name, (data, attrs) in run_statistics(scene, frames, what, results,
+                                              args.z_cells).items():
         if name == "profiles":
             results.profiles, results.profile_attrs = data, attrs
         else:
@@ -172,8 +173,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--out", help="figure file (one kind), or OUT-<kind>.png for each of "
                                        "several kinds (default: <kind>.png)")
     p.add_argument("--kind", action="append", metavar="KIND",
-                   help="profiles (default), stress, vdf, angles, gr, vcorr, lambda, waves or "
-                        "all; comma-separated or repeated")
+                   help="profiles (default), stress, eos, vdf, angles, gr, vcorr, lambda, "
+                        "waves, cooling or all; comma-separated or repeated")
     p.add_argument("--scaled", action="store_true",
                    help="profiles against (y - y0)/H: H the wall gap, or the flow depth with "
                         "an open top")
@@ -189,6 +190,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--what", default="profiles",
                    help="comma-separated: profiles, vdf, gr, angles, stress, vcorr, lambda, "
                         "waves, cgprofiles (default: profiles)")
+    p.add_argument("--z-cells", type=int, default=1, metavar="N",
+                   help="3D: Malik's cells, fluctuations about the means of N z-slabs of each "
+                        "y-bin for profiles (added cell_temperature*), vdf, vcorr, lambda "
+                        "(default 1: the y-bin means, Campbell's strips)")
     p.add_argument("--dt", type=float, help="dump time step (default: the scene's LAMMPS one)")
     p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")
     p.add_argument("--out", help="results file (default: RUN.h5 itself, or DUMP.h5)")

@@ -156,3 +156,57 @@ def test_stop_refusal_and_failure_have_distinct_exit_codes(tmp_path, capsys):
     assert main([*args, "--dump", str(tmp_path / "x.dump")]) == 2
     err = capsys.readouterr().err
     assert "unsupported by edmd" in err and "Traceback" not in err
+
+
+def _synthetic_run(path: Path, scene_path: Path, frames: dict | None, *overrides: str) -> None:
+    """A results file holding ``scene_path``'s scene (with ``--set`` overrides) and frames."""
+    from demstudy.io.results import Results, write_results
+    from demstudy.scene import load_scene, scene_to_toml
+
+    scene = load_scene(scene_path, list(overrides))
+    write_results(path, Results({"engine": "synthetic", "scene_toml": scene_to_toml(scene),
+                                 "scene_name": scene.meta.name}, frames=frames))
+
+
+def test_analyze_z_cells_gives_malik_cell_temperatures(tmp_path, capsys):
+    """`analyze --z-cells 4` on a 3D gas whose mean velocity varies along z, u_x = a z + a
+    Maxwellian of temperature T (22³ periodic box, 4 y-bins): the strip temperature holds
+    a²L_z²/12 of the mean flow, the cell temperature only a²(L_z/4)²/12, and vdf, vcorr and
+    lambda are taken about the cell means too; a 2D run is refused."""
+    from demstudy.io.results import read_results
+
+    rng = np.random.default_rng(41)
+    nf, n, L, a, t0 = 30, 1500, 22.0, 0.2, 0.5
+    pos = rng.uniform(0, L, (nf, n, 3))
+    vel = np.sqrt(t0) * rng.normal(size=(nf, n, 3))
+    vel[..., 0] += a * pos[..., 2]
+    frames = {"time": np.arange(nf, dtype=float), "position": pos, "velocity": vel,
+              "angular_velocity": rng.normal(size=(nf, n, 3)), "radius": np.full((nf, n), 0.5),
+              "box_lo": np.zeros((nf, 3)), "box_hi": np.full((nf, 3), L)}
+    run = tmp_path / "gas.h5"
+    hcs = ROOT / "inputs" / "cooling" / "hcs-3d.toml"
+    _synthetic_run(run, hcs, frames, "measure.bin_width=5.5")
+    assert main(["analyze", str(run), "--what", "profiles,vdf,vcorr,lambda", "--z-cells", "4"]) == 0
+    res = read_results(run)
+    prof = res.profiles
+    strip, cells = t0 + a**2 * L**2 / 12, t0 + a**2 * (L / 4) ** 2 / 12
+    z_strip = ((prof["temperature_components"][:, 0] - strip)
+               / prof["temperature_components_err"][:, 0])
+    z_cells = ((prof["cell_temperature_components"][:, 0] - cells)
+               / prof["cell_temperature_components_err"][:, 0])
+    assert np.all(np.abs(z_strip) < 4) and np.all(np.abs(z_cells) < 4), (z_strip, z_cells)
+    assert strip - cells > 20 * prof["cell_temperature_components_err"].max()  # resolved
+    assert res.profile_attrs["z_cells"] == 4
+    vdf = res.groups["statistics/vdf"]
+    assert np.all(np.abs(vdf["variance"][:, 0] - cells) < 4 * vdf["variance_err"][:, 0])
+    for name in ("vdf", "vcorr", "lambda"):
+        assert res.group_attrs[f"statistics/{name}"]["z_cells"] == 4, name
+
+    flat = tmp_path / "chute.h5"
+    _synthetic_run(flat, CHUTE, None)
+    capsys.readouterr()
+    assert main(["analyze", str(flat), "--what", "profiles", "--z-cells", "2"]) == 1
+    err = capsys.readouterr().err
+    assert "--z-cells 2" in err and "3D" in err and "2D" in err
+    assert main(["analyze", str(run), "--what", "profiles", "--z-cells", "0"]) == 1
+    assert ">= 1" in capsys.readouterr().err

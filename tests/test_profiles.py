@@ -215,3 +215,117 @@ def test_empty_frames_count_as_samples_with_zero_solid_fraction():
     res = ProfileAnalysis(dim=2).run([full, empty] * 4).results
     np.testing.assert_allclose(res["solid_fraction"], np.pi / 8, rtol=1e-13)
     np.testing.assert_allclose(res["velocity"], 1.0, rtol=1e-13)
+
+
+def spanwise_shear_frames(rng, a, t0, n_frames, n=1500, box=(8.0, 12.0, 8.0)):
+    """3D unit spheres, uniform centres, u_x = a z + a Maxwellian of temperature t0 (m = 1),
+    spins of rotational temperature t0 (I = 0.1) with a mean omega_y = a z as well."""
+    box = np.asarray(box, float)
+    for t in range(n_frames):
+        pos, r = gas(rng, n, box)
+        vel = np.sqrt(t0) * rng.normal(size=(n, 3))
+        vel[:, 0] += a * pos[:, 2]
+        omega = np.sqrt(t0 / 0.1) * rng.normal(size=(n, 3))
+        omega[:, 1] += a * pos[:, 2]
+        yield frame(pos, vel, omega, r, box, t)
+
+
+def test_malik_cells_remove_a_spanwise_gradient_and_converge_to_t():
+    """u_x = a z inside each y-bin (z uniform on [0, L_z)): about the strip mean <u'^2> =
+    T + a^2 L_z^2/12; about the run means of N z-slabs only the slab's own spread is left,
+    T + a^2 (L_z/N)^2/12 -> T as N grows. The spin's mean omega_y = a z leaks the same way into
+    the rotational temperature, j a^2 (L_z/N)^2/12 / 3 (j = I/m = 0.1). The other fields are
+    the strip ones, identical whatever N."""
+    a, t0, lz = 0.6, 0.5, 8.0
+    frames = list(spanwise_shear_frames(np.random.default_rng(31), a, t0, 80))
+    strip = ProfileAnalysis(dim=3, period=12.0).run(frames)
+    res = strip.results
+    nb = res["y"].size
+    expected = np.tile([t0 + a**2 * lz**2 / 12, t0, t0], (nb, 1))
+    assert_calibrated(zscores(res, "temperature_components", expected))
+    assert "cell_temperature" not in res and strip.attrs["z_cells"] == 1
+    previous = np.inf
+    for n_cells in (2, 4, 16):
+        cells = ProfileAnalysis(dim=3, period=12.0, z_cells=n_cells).run(frames)
+        out, leak = cells.results, a**2 * (lz / n_cells) ** 2 / 12
+        expected = np.tile([t0 + leak, t0, t0], (nb, 1))
+        assert_calibrated(zscores(out, "cell_temperature_components", expected))
+        assert_calibrated(zscores(out, "cell_temperature", t0 + leak / 3))
+        assert_calibrated(zscores(out, "cell_rotational_temperature", t0 + 0.1 * leak / 3))
+        assert out["cell_temperature"].mean() < previous  # approaches T from above
+        previous = out["cell_temperature"].mean()
+        for key in (
+            "solid_fraction",
+            "velocity",
+            "temperature",
+            "temperature_err",
+            "rotational_temperature",
+            "kinetic_shear",
+            "spin",
+        ):
+            np.testing.assert_allclose(out[key], res[key], rtol=1e-10, atol=1e-14, err_msg=key)
+        assert cells.attrs["z_cells"] == n_cells and "Malik" in cells.attrs["fluctuations"]
+    # with 16 cells the leak (0.0075) is below the resolution: the cell temperature is T
+    assert_calibrated(zscores(out, "cell_temperature_components", np.tile([t0] * 3, (nb, 1))))
+
+
+def test_malik_cells_agree_with_strips_for_a_uniform_polydisperse_gas():
+    """No mean-velocity variation: both conventions recover the equipartition temperatures
+    (m v_a'^2 = T_a, I w'^2 = T_r) within errors, and differ from each other by far less."""
+    rng = np.random.default_rng(32)
+    temps, t_rot, n, box = np.array([1.5, 0.5, 1.0]), 0.8, 400, [8.0, 12.0, 8.0]
+    pa = ProfileAnalysis(dim=3, period=12.0, bin_width=1.5, z_cells=4)
+    for t in range(120):
+        pos, r = gas(rng, n, box, radius=(0.35, 0.65))
+        m = mass(r, 3)[:, None]
+        vel = np.array([2.0, 0.0, -0.5]) + rng.normal(size=(n, 3)) * np.sqrt(temps / m)
+        omega = rng.normal(size=(n, 3)) * np.sqrt(t_rot / (0.4 * m * r[:, None] ** 2))
+        pa.feed(frame(pos, vel, omega, r, box, t))
+    res = pa.finish().results
+    nb = res["y"].size
+    for prefix in ("", "cell_"):
+        assert_calibrated(zscores(res, f"{prefix}temperature_components", np.tile(temps, (nb, 1))))
+        assert_calibrated(zscores(res, f"{prefix}rotational_temperature", t_rot))
+    diff = np.abs(res["cell_temperature"] - res["temperature"])
+    assert np.all(diff < res["temperature_err"])
+
+
+def test_malik_cells_in_a_rigid_rotation_and_under_lees_edwards():
+    """Rigid rotation about y, v = W x r about the box centre: u_x = W (z - z_c), w_z =
+    -W (x - x_c), every spin W e_y. Strips: <u'^2> = W^2 L_z^2/12, <w'^2> = W^2 L_x^2/12;
+    z-cells take out the z spread only: <u'^2> = W^2 (L_z/N)^2/12, <w'^2> unchanged; <v'^2>
+    and the rotational temperatures are 0 exactly. Plus a Lees-Edwards shear u += g y (image
+    x velocity +- g L_y): the images keep their slab and add g^2 (w^2/12 + r^2/5) in both."""
+    rng = np.random.default_rng(33)
+    w0, g, n_cells, n = 0.5, 0.3, 4, 1500
+    box = np.array([6.0, 10.0, 8.0])
+    pa = ProfileAnalysis(dim=3, period=10.0, z_cells=n_cells, image_velocity_shift=g * 10.0)
+    for t in range(60):
+        pos, r = gas(rng, n, box)
+        rel = pos - box / 2
+        vel = np.cross(np.array([0.0, w0, 0.0]), rel)
+        vel[:, 0] += g * pos[:, 1]
+        pa.feed(frame(pos, vel, np.tile([0.0, w0, 0.0], (n, 1)), r, box, t))
+    res = pa.finish().results
+    nb, shear = res["y"].size, g**2 * (1 / 12 + 0.25 / 5)
+    strip = np.tile([w0**2 * 64 / 12 + shear, 0.0, w0**2 * 36 / 12], (nb, 1))
+    cells = np.tile([w0**2 * (8 / n_cells) ** 2 / 12 + shear, 0.0, w0**2 * 36 / 12], (nb, 1))
+    for key, expected in (
+        ("temperature_components", strip),
+        ("cell_temperature_components", cells),
+    ):
+        assert_calibrated((res[key] - expected)[:, [0, 2]] / res[f"{key}_err"][:, [0, 2]])
+        assert np.max(np.abs(res[key][:, 1])) < 1e-12
+    for key in ("rotational_temperature", "cell_rotational_temperature"):
+        assert np.max(np.abs(res[key])) < 1e-12
+
+
+def test_z_cells_is_refused_where_it_has_no_meaning():
+    for kwargs, where in (
+        ({"dim": 2, "z_cells": 4}, "2D"),
+        ({"dim": 3, "z_cells": 0}, "3D"),
+        ({"dim": 3, "axis": "z", "z_cells": 2}, "axis z"),
+    ):
+        with pytest.raises(ValueError, match=rf"z_cells = {kwargs['z_cells']}.*{where}"):
+            ProfileAnalysis(**kwargs)
+    assert ProfileAnalysis(dim=2, z_cells=1).z_cells == 1  # the strip default exists in 2D

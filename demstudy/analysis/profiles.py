@@ -31,6 +31,25 @@ that feed one bin: for u = g y and uniform density the extra <u'^2> is g^2 (w^2/
 for discs and g^2 (w^2/12 + r^2/5) for spheres (bin width w; r^2/4 and r^2/5 are the
 variances of a particle's chord-length profile across a bin edge), 0.15 g^2 for w = d = 1
 discs: keep w and the gradient small where this matters.
+
+Malik's cell convention (``z_cells`` > 1, 3D, profile axis x or y; Malik 2008 §4.1: the
+fluctuating velocities of the temperatures are taken "cellwise", about the means of cells that
+split each bin into slabs along z; his number of z cells is not stated). Each particle's volume
+is split over the bins exactly as above and goes to the z-slab of its centre (:func:`z_slab`,
+the cells of :mod:`demstudy.analysis.vdf`), so summing the cells of a bin gives back the bin's
+sums and every field above is unchanged. The cell mean is, as in the vdf, the run mean of the
+cell (time-averaged, exact from the accumulated sums, one pass). Added fields, per bin, pooled
+over its cells with the volume (mass) weights (C = cell, <.>_C its run mean):
+
+* cell_temperature_components_a = sum_C sum_i V_iC (v_a - <v_a>_C)^2 / (V_1 N_b), i.e.
+  <m>_b <(v_a - <v_a>_C)^2>_b, cell_temperature = their sum / dim,
+* cell_rotational_temperature = sum_C sum_i V_iC j_i |w - <w>_C|^2 / (n_rot V_1 N_b),
+
+with N_b the bin's fractional particle count. A mean velocity varying along z inside a bin
+leaks into ``temperature`` (u = a z: + a^2 L_z^2 / 12 in T_xx) but into the cell temperature
+only through the cell's own width (+ a^2 (L_z / z_cells)^2 / 12). ``z_cells = 1`` (the
+default) is Campbell's strip convention and adds nothing. ``kinetic_shear`` stays a bin
+(strip) quantity.
 """
 
 from __future__ import annotations
@@ -39,7 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from demstudy import UNITS_NOTE
-from demstudy.analysis.base import AnalysisBase
+from demstudy.analysis.base import AnalysisBase, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
 from demstudy.analysis.volumes import bin_profile_sums, profile_nvalues
 from demstudy.io.frames import Frame
@@ -66,6 +85,8 @@ class ProfileAnalysis(AnalysisBase):
     image_velocity_shift: x velocity of the periodic image at ``+period`` relative to the
         particle (Lees-Edwards: shear rate * period); parts of a particle straddling the
         periodic boundary then enter the other end of the grid with that velocity offset.
+    z_cells: Malik's cells: > 1 adds the temperatures about the means of ``z_cells`` z-slabs
+        of each bin (3D, axis x or y); 1 is Campbell's strip convention.
     """
 
     def __init__(
@@ -80,6 +101,7 @@ class ProfileAnalysis(AnalysisBase):
         max_blocks: int = 64,
         edges: ArrayLike | None = None,
         image_velocity_shift: float = 0.0,
+        z_cells: int = 1,
         verbose: bool = False,
     ) -> None:
         super().__init__(verbose=verbose)
@@ -96,6 +118,16 @@ class ProfileAnalysis(AnalysisBase):
             raise ValueError("image_velocity_shift needs a periodic axis (period > 0)")
         if image_velocity_shift and self.axis == 0:
             raise ValueError("image_velocity_shift shifts x velocities: the axis cannot be x")
+        if not (isinstance(z_cells, int | np.integer) and z_cells >= 1) or (
+            z_cells > 1 and (dim != 3 or self.axis == 2)
+        ):
+            raise ValueError(
+                f"z_cells = {z_cells!r}: Malik's cells split each bin into z_cells slabs along "
+                "z, so z_cells must be an integer >= 1, and > 1 only in 3D with the profile "
+                f"axis x or y (this analysis: {dim}D, axis {'xyz'[self.axis]}); 1 is "
+                "Campbell's strip convention"
+            )
+        self.z_cells = int(z_cells)
         self.dim = dim
         self.inertia_factor = float(
             inertia_factor if inertia_factor is not None else (0.5 if dim == 2 else 0.4)
@@ -152,19 +184,51 @@ class ProfileAnalysis(AnalysisBase):
         self.lo, self.hi, self.n_bins = lo, hi, nbins
         self.bin_width = (hi - lo) / nbins
         self.edges = lo + self.bin_width * np.arange(nbins + 1)
-        self._acc = BlockAccumulator(nbins * (self.n_values + 2), self.max_blocks)
-        self._sample = np.zeros(nbins * (self.n_values + 2))
+        # sample layout: solid fraction | volume | sums, per cell = z-slab * nbins + bin (each
+        # slab's bins contiguous, so the kernel writes a slab's cells in place)
+        self.n_cells = nbins * self.z_cells
+        self._acc = BlockAccumulator(self.n_cells * (self.n_values + 2), self.max_blocks)
+        self._sample = np.zeros(self.n_cells * (self.n_values + 2))
 
     def _single_frame(self, frame: Frame) -> None:
         pos, vel, omega, radius = self._frame_arrays(frame)
-        coord, period = pos[:, self.axis], self.period
+        coord, period, zc = pos[:, self.axis], self.period, self.z_cells
+        extra = [omega] if zc == 1 else [omega, z_slab(frame, pos[:, 2], zc)]
         if self.image_velocity_shift:
-            coord, radius, vel, omega = self._lees_edwards_images(coord, radius, vel, omega)
+            coord, radius, vel, *extra = self._lees_edwards_images(coord, radius, vel, *extra)
             period = 0.0
-        nb = self.n_bins
+        nb, nc = self.n_bins, self.n_cells
         self._sample[:] = 0.0
-        vol = self._sample[nb : 2 * nb]
-        sums = self._sample[2 * nb :].reshape(nb, self.n_values)
+        vol = self._sample[nc : 2 * nc]
+        sums = self._sample[2 * nc :].reshape(nc, self.n_values)
+        if zc == 1:
+            self._kernel(coord, radius, vel, extra[0], period, vol, sums)
+        else:  # one kernel call per z-slab on the particles centred in it (sorted once)
+            slab = extra[1].astype(np.int16 if zc < 2**15 else np.intp)  # int16: radix sort
+            order = np.argsort(slab, kind="stable")
+            ends = np.cumsum(np.bincount(slab, minlength=zc))
+            coord, radius, vel, omega = (
+                np.take(a, order, 0) for a in (coord, radius, vel, extra[0])
+            )
+            for s in range(zc):
+                p, c = slice(ends[s - 1] if s else 0, ends[s]), slice(s * nb, (s + 1) * nb)
+                self._kernel(coord[p], radius[p], vel[p], omega[p], period, vol[c], sums[c])
+        section = float(np.prod(np.delete(frame.lengths, self.axis)))
+        if not section > 0:
+            raise ValueError(f"non-positive box cross-section {section} at t = {frame.time}")
+        np.multiply(vol, 1.0 / (self.bin_width * section), out=self._sample[:nc])
+        self._acc.add(self._sample)
+
+    def _kernel(
+        self,
+        coord: np.ndarray,
+        radius: np.ndarray,
+        vel: np.ndarray,
+        omega: np.ndarray,
+        period: float,
+        vol: np.ndarray,
+        sums: np.ndarray,
+    ) -> None:
         bin_profile_sums(
             coord,
             radius,
@@ -173,17 +237,12 @@ class ProfileAnalysis(AnalysisBase):
             self.inertia_factor,
             self.lo,
             self.bin_width,
-            nb,
+            self.n_bins,
             self.dim,
             period,
             out_volume=vol,
             out_sums=sums,
         )
-        section = float(np.prod(np.delete(frame.lengths, self.axis)))
-        if not section > 0:
-            raise ValueError(f"non-positive box cross-section {section} at t = {frame.time}")
-        np.multiply(vol, 1.0 / (self.bin_width * section), out=self._sample[:nb])
-        self._acc.add(self._sample)
 
     def _frame_arrays(self, frame: Frame) -> tuple[np.ndarray, ...]:
         pos = np.asarray(frame.position, dtype=np.float64)
@@ -203,9 +262,10 @@ class ProfileAnalysis(AnalysisBase):
         return pos, vel, omega, radius
 
     def _lees_edwards_images(
-        self, coord: np.ndarray, radius: np.ndarray, vel: np.ndarray, omega: np.ndarray
+        self, coord: np.ndarray, radius: np.ndarray, vel: np.ndarray, *rest: np.ndarray
     ) -> tuple[np.ndarray, ...]:
-        """Explicit periodic images of boundary straddlers, with shifted x velocities."""
+        """Explicit periodic images of boundary straddlers, with shifted x velocities (the
+        ``rest`` per-particle arrays, spin and z-slab, are copied unchanged)."""
         lo, p = self.lo, self.period
         c = lo + np.mod(coord - lo, p)
         below, above = c - radius < lo, c + radius > lo + p
@@ -216,10 +276,40 @@ class ProfileAnalysis(AnalysisBase):
             np.concatenate([c, c[below] + p, c[above] - p]),
             np.concatenate([radius, radius[below], radius[above]]),
             np.concatenate(img_v),
-            np.concatenate([omega, omega[below], omega[above]]),
+            *(np.concatenate([a, a[below], a[above]]) for a in rest),
         )
 
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
+        if self.z_cells == 1:
+            return self._bin_estimate(mean)
+        nb, nc, zc, nv = self.n_bins, self.n_cells, self.z_cells, self.n_values
+        vol = mean[nc : 2 * nc].reshape(zc, nb)
+        sums = mean[2 * nc :].reshape(zc, nb, nv)
+        # a bin's sums are the sums of its cells: the strip fields come out unchanged
+        strip = np.concatenate([mean[:nc].reshape(zc, nb).sum(0), vol.sum(0), sums.sum(0).ravel()])
+        out = self._bin_estimate(strip)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = np.where(vol > 0, 1.0 / vol, 0.0)  # empty cells hold no fluctuation
+            s_v, s_w = sums[..., self._c_v], sums[..., self._c_w]
+            diag = [self._c_vv.start + self._pairs.index((a, a)) for a in range(self.dim)]
+            dev2 = sums[..., diag] - s_v**2 * inv[..., None]  # sum V (v_a - <v_a>_C)^2
+            rot = (
+                sums[..., self._c_jww]
+                - 2.0 * (s_w * sums[..., self._c_jw]).sum(-1) * inv
+                + (s_w**2).sum(-1) * sums[..., self._c_j] * inv**2
+            )
+            norm = self._unit_volume * sums[..., self._c_inv].sum(0)  # V_1 N_b
+            comps = dev2.sum(0) / norm[:, None]
+            out.update(
+                {
+                    "cell_temperature": comps.sum(1) / self.dim,
+                    "cell_temperature_components": comps,
+                    "cell_rotational_temperature": rot.sum(0) / (self.n_rot * norm),
+                }
+            )
+        return out
+
+    def _bin_estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
         nb, dim = self.n_bins, self.dim
         vol = mean[nb : 2 * nb]
         q = mean[2 * nb :].reshape(nb, self.n_values) / vol[:, None]
@@ -252,6 +342,12 @@ class ProfileAnalysis(AnalysisBase):
             self.results[key] = est[key]
             self.results[f"{key}_err"] = err[key]
         axis_name = "xyz"[self.axis]
+        fluctuations = "temperature*: relative to the run mean of the bin (strip), Campbell"
+        if self.z_cells > 1:
+            fluctuations += (
+                f"; cell_temperature*: relative to the run means of {self.z_cells} z-cells "
+                "per bin, Malik's cell convention"
+            )
         self.attrs = {
             "axis": axis_name,
             "bin_width": self.bin_width,
@@ -263,6 +359,8 @@ class ProfileAnalysis(AnalysisBase):
             "period": self.period,
             "inertia_factor": self.inertia_factor,
             "image_velocity_shift": self.image_velocity_shift,
+            "z_cells": self.z_cells,
+            "fluctuations": fluctuations,
             "block_length": self._acc.block_length,
             "n_blocks": self._acc.n_blocks,
             "units": UNITS_NOTE,

@@ -26,6 +26,8 @@ from .waves import DensityWaves
 #: Statistics ``demstudy analyze --what`` can compute from frames.
 AVAILABLE = ("profiles", "vdf", "gr", "structure", "angles", "stress", "vcorr", "lambda",
              "waves", "cgprofiles")
+#: Those that take Malik's cells (``z_cells``: fluctuations about y-bin × z-slab means).
+Z_CELLS = ("profiles", "vdf", "vcorr", "lambda")
 
 
 def profile_bounds(scene: Scene) -> tuple[float, float, float]:
@@ -45,33 +47,44 @@ def image_shift(scene: Scene, period: float) -> float:
         else 0.0
 
 
-def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None) -> ProfileAnalysis:
-    """Profiles along the scene's axis (``walls``: current wall positions when walls move)."""
+def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None,
+                     z_cells: int = 1) -> ProfileAnalysis:
+    """Profiles along the scene's axis (``walls``: current wall positions when walls move;
+    ``z_cells`` > 1 adds the temperatures in Malik's cell convention)."""
     lo, hi, period = profile_bounds(scene)
     if walls is not None and scene.measure.axis == "y":
         lo, hi = walls
     return ProfileAnalysis(axis=scene.measure.axis, bin_width=scene.measure.bin_width, lo=lo,
                            hi=hi, dim=scene.dimension, inertia_factor=scene.inertia_k,
-                           period=period, image_velocity_shift=image_shift(scene, period))
+                           period=period, image_velocity_shift=image_shift(scene, period),
+                           z_cells=z_cells)
 
 
 def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
-                   what: Iterable[str], results: Any = None) -> dict[str, tuple[dict, dict]]:
+                   what: Iterable[str], results: Any = None,
+                   z_cells: int = 1) -> dict[str, tuple[dict, dict]]:
     """``{name: (results, attrs)}`` for each requested statistic; ``frames`` returns a fresh
     iterable each call (the velocity distributions read the frames twice). ``results``: the
     source results file's content (:class:`~demstudy.io.results.Results`), needed by
-    ``angles`` (its ``/collisions`` log) and ``stress`` (its profiles and wall forces)."""
+    ``angles`` (its ``/collisions`` log) and ``stress`` (its profiles and wall forces).
+    ``z_cells``: Malik's cells for the statistics in :data:`Z_CELLS` (3D only; 1 = bins)."""
+    if z_cells != 1 and scene.dimension != 3:
+        raise ValueError(f"--z-cells {z_cells}: Malik's cells split the y-bins along z, so "
+                         f"they need a 3D run (this one is {scene.dimension}D; use 1)")
+    if z_cells < 1:
+        raise ValueError(f"--z-cells {z_cells}: the number of z cells per y-bin must be >= 1")
     out: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
     lo, hi, period = profile_bounds(scene)
     for name in what:
         if name == "profiles":
-            ana = profile_analysis(scene).run(frames()).finish()
+            ana = profile_analysis(scene, z_cells=z_cells).run(frames()).finish()
         elif name == "vdf":
             n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
             edges = [lo + (hi - lo) * i / n_bins for i in range(n_bins + 1)]
             ana = velocity_distributions(frames, dim=scene.dimension, edges=edges,
                                          inertia_factor=scene.inertia_k, period=period,
-                                         image_velocity_shift=image_shift(scene, period))
+                                         image_velocity_shift=image_shift(scene, period),
+                                         z_cells=z_cells)
         elif name == "gr":
             periodic = [scene.box.size[i] for i, a in enumerate("xyz"[: scene.dimension])
                         if a in scene.periodic]
@@ -94,7 +107,8 @@ def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
             out[name] = (data, attrs)
             continue
         elif name in ("vcorr", "lambda", "waves", "cgprofiles"):
-            ana = correlation_analysis(scene, frames, name)
+            ana = correlation_analysis(scene, frames, name,
+                                       z_cells if name in Z_CELLS else 1)
         else:
             raise ValueError(f"--what {name!r}: unknown statistic (allowed: "
                              f"{', '.join(AVAILABLE)})")
@@ -144,10 +158,11 @@ def stress_from_results(scene: Scene, results: Any) -> tuple[dict, dict]:
                           contact=parts.get("contact"), collisional=parts.get("collisional"))
 
 
-def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], name: str) -> Any:
-    """vcorr / lambda (two passes: run-mean bin velocities first) and waves in bins of
-    ``measure.bin_width`` along y; cgprofiles along ``measure.axis`` with w = bin_width / 2
-    at points spaced bin_width / 2."""
+def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], name: str,
+                         z_cells: int = 1) -> Any:
+    """vcorr / lambda (two passes: run-mean bin (``z_cells`` > 1: cell) velocities first) and
+    waves in bins of ``measure.bin_width`` along y; cgprofiles along ``measure.axis`` with
+    w = bin_width / 2 at points spaced bin_width / 2."""
     lo, hi, period = profile_bounds(scene)
     dim, shift = scene.dimension, image_shift(scene, period)
     n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
@@ -166,9 +181,9 @@ def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], na
     if name == "vcorr":
         periodic = [scene.box.size[i] for i, a in enumerate("xyz"[:dim]) if a in scene.periodic]
         r_max = min(5.0, 0.5 * min(periodic) - 0.05) if periodic else 5.0
-        return velocity_correlations(frames, r_max=r_max, dr=0.1, **y_bins)
+        return velocity_correlations(frames, r_max=r_max, dr=0.1, z_cells=z_cells, **y_bins)
     if name == "lambda":
-        return orientational_correlation(frames, **y_bins)
+        return orientational_correlation(frames, z_cells=z_cells, **y_bins)
     if name == "waves":
         ranges: list[tuple[float, float] | None] = [None] * dim
         if not scene.y_periodic:  # where the centres can be: walls -/+ d/2
