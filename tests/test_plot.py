@@ -1,6 +1,7 @@
 """`demstudy plot`: one figure per kind from results files written by the real writers and
-analyses (synthetic frames through `demstudy analyze`); the plotted Line2D data must equal the
-stored datasets. Dimensionless particle units: d = 1, m = 1, g = 1 with gravity."""
+analyses (synthetic frames through `demstudy analyze`, and a short event-driven homogeneous
+cooling run); the plotted Line2D data must equal the stored datasets or the theory functions.
+Dimensionless particle units: d = 1, m = 1, g = 1 with gravity."""
 
 from __future__ import annotations
 
@@ -70,6 +71,22 @@ def chute(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
+def cooling(tmp_path_factory):
+    """A real homogeneous cooling run: 1000 smooth spheres, φ = 0.1, e = 0.8, T0 = 1 in a
+    periodic cube, `demstudy run --engine edmd` up to t = 30 ≈ 3 t0 (about 2 s)."""
+    from edmd_helpers import make_scene
+
+    folder = tmp_path_factory.mktemp("cooling")
+    scene = make_scene(3, 0.1, 1000, seed=4, e=0.8, production=30.0, sample=1.0,
+                       extra='[meta]\nname = "hcs-test"')
+    (folder / "hcs.toml").write_text(scene_to_toml(scene))
+    path = folder / "hcs.h5"
+    assert main(["run", str(folder / "hcs.toml"), "--engine", "edmd", "--out", str(path),
+                 "--quiet"]) == 0
+    return path
+
+
+@pytest.fixture(scope="module")
 def channel(tmp_path_factory):
     """A 3D channel (walls at y = 0, 15) with lambda and waves only."""
     path = tmp_path_factory.mktemp("channel") / "channel.h5"
@@ -101,14 +118,16 @@ def test_all_kinds_write_pngs_and_skip_the_absent_one(chute, tmp_path, capsys):
     out = tmp_path / "fig.png"
     assert main(["plot", str(chute), "--kind", "all", "-o", str(out)]) == 0
     cap = capsys.readouterr()
-    drawn = [k for k in KINDS if k != "lambda"]
+    drawn = [k for k in KINDS if k not in ("lambda", "cooling")]
     for kind in drawn:
         png = tmp_path / f"fig-{kind}.png"
         assert f"figure: {png}" in cap.out
         assert png.read_bytes()[:4] == b"\x89PNG" and png.stat().st_size > 20_000, kind
     assert not (tmp_path / "fig-lambda.png").exists()
+    assert not (tmp_path / "fig-cooling.png").exists()  # a chute is not a cooling run
     notices = [ln for ln in cap.err.splitlines() if ln]
-    assert len(notices) == 1 and "lambda skipped" in notices[0] and "--what lambda" in notices[0]
+    assert len(notices) == 2 and "lambda skipped" in notices[0] and "--what lambda" in notices[0]
+    assert "cooling skipped" in notices[1] and "homogeneous cooling" in notices[1]
     assert "Traceback" not in cap.err
 
 
@@ -174,6 +193,11 @@ def test_distributions_and_correlations_plot_the_stored_data(chute):
     for a in (0, 1):
         same(line(fig, f"{name}:C:{first}:{a}"), vc["r"], vc["C"][first, a])
         same(line(fig, f"{name}:C:{first + 3}:{a}"), vc["r"], vc["C"][first + 3, a])
+    assert vc["C_offdiag"].shape == (vc["C"].shape[0], 1, vc["r"].size)  # 2D: xy only
+    for b in (first, first + 3):
+        same(line(fig, f"{name}:C_offdiag:{b}:0"), vc["r"], vc["C_offdiag"][b, 0])
+    titles = [ax.get_title() for ax in fig.axes if ax.get_visible()]
+    assert titles == ["C_xx(r)", "C_yy(r)", "C_xy(r)"]
 
 
 def test_waves_plot_spectrum_field_and_series(chute, channel):
@@ -283,3 +307,54 @@ def test_equation_of_state_plots_chi_against_nu(chute):
     e = run.scene.contact.restitution
     np.testing.assert_allclose(theory.get_ydata(), campbell_chi(x, 2, e), rtol=1e-12)
     assert "Henderson" in fig._suptitle.get_text()
+
+
+def test_vcorr_plot_draws_the_three_off_diagonal_components_in_3d(channel, tmp_path):
+    """3D: C_xy, C_xz, C_yz below C_xx, C_yy, C_zz, each the stored C_offdiag row."""
+    assert main(["analyze", str(channel), "--what", "vcorr", "--out",
+                 str(tmp_path / "vc.h5")]) == 0
+    path = tmp_path / "vc.h5"
+    vc = read_results(path).groups["statistics/vcorr"]
+    fig = draw("vcorr", [Run.load(path)], bins=[2])
+    for p in range(3):
+        same(line(fig, f"vc.h5:C_offdiag:1:{p}"), vc["r"], vc["C_offdiag"][1, p])
+    titles = [ax.get_title() for ax in fig.axes]
+    assert titles[3:] == ["C_xy(r)", "C_xz(r)", "C_yz(r)"]
+
+
+def test_cooling_plot_overlays_haff_on_a_real_edmd_run(cooling, chute, tmp_path, capsys):
+    """T/T0 from the kinetic energy (centre-of-mass motion removed, dim (N − 1) degrees of
+    freedom) and Haff's T0/(1 + t/t0)² from demstudy.theory with the scene's ν and e, both
+    on log–log axes; the run follows Haff within 10 % up to 3 t0 (a t0 off by 2 would miss
+    by > 60 %). Other runs skip the kind with a notice."""
+    from demstudy.theory import haff_t0, haff_temperature
+
+    run = Run.load(cooling)
+    ts, scene = read_results(cooling).timeseries, run.scene
+    n = scene.n_particles
+    temp = (2 * ts["kinetic_energy"] - (ts["momentum"] ** 2).sum(1) / n) / (3 * (n - 1))
+    t = ts["time"] - ts["time"][0]
+    fig = draw("cooling", [run])
+    same(line(fig, "hcs.h5:temperature"), t[1:], temp[1:] / temp[0])
+    haff = line(fig, "hcs.h5:haff")
+    nu, e = scene.solid_fraction, scene.contact.restitution
+    assert (nu, e) == (pytest.approx(0.1), 0.8)
+    np.testing.assert_array_equal(haff.get_xdata(), t[1:])
+    np.testing.assert_allclose(haff.get_ydata(),
+                               haff_temperature(t[1:], nu, temp[0], 3, e) / temp[0], rtol=1e-12)
+    t0 = haff_t0(nu, temp[0], 3, e)
+    assert f"t0 = {t0:.3g}" in haff.get_label() and t[-1] > 3 * t0 * 0.95
+    assert fig.axes[0].get_xscale() == fig.axes[0].get_yscale() == "log"
+    ratio = temp[1:] / temp[0] / np.asarray(haff.get_ydata())
+    assert temp[-1] / temp[0] < 0.1 and np.all(np.abs(ratio - 1) < 0.1)
+    assert "initial temperature sets the time scale" in footer(fig)
+
+    out = tmp_path / "c.png"  # `all` includes cooling for a cooling run (the chute skips it)
+    assert main(["plot", str(cooling), "--kind", "all", "-o", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert f"figure: {tmp_path / 'c-cooling.png'}" in cap.out
+    assert (tmp_path / "c-cooling.png").stat().st_size > 20_000
+    assert "cooling skipped" not in cap.err and "Traceback" not in cap.err
+    assert main(["plot", str(chute), "--kind", "cooling", "-o", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert not out.exists() and "cooling skipped" in cap.err and "no figure" in cap.err

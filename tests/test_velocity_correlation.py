@@ -1,5 +1,5 @@
-"""Velocity correlations C_aa(r) and Malik's orientational correlation Lambda(y) against exact
-cases. Dimensionless particle units: d = 1, m = 1."""
+"""Velocity correlations C_aa(r), C_ab(r) and Malik's orientational correlation Lambda(y)
+against exact cases. Dimensionless particle units: d = 1, m = 1."""
 
 from __future__ import annotations
 
@@ -61,6 +61,10 @@ def test_cosine_field_gives_bessel_or_sinc_and_bin_means_are_removed(dim):
     np.testing.assert_allclose(res["temperature_components"][:, 1], 1.0, rtol=0.05)
     np.testing.assert_allclose(res["covariance"][:, 0] / res["temperature_components"][:, :1],
                                c[:, 0])
+    # u_x and u_y independent: C_xy = 0 (and xz, yz in 3D)
+    off, off_err = res["C_offdiag"], res["C_offdiag_err"]
+    assert off.shape == (4, dim * (dim - 1) // 2, res["r"].size)
+    assert np.all(np.abs(off[:, :, 1:]) < 5 * off_err[:, :, 1:] + 0.01)
     stepped_res = velocity_correlations(stepped, **opts).results
     np.testing.assert_allclose(stepped_res["C"], c, rtol=1e-9, atol=1e-12)
 
@@ -96,6 +100,89 @@ def test_checkerboard_lattice_in_bin_and_across_bins():
     # one frame: instantaneous bin means are the run means
     two_pass = velocity_correlations([frame], **opts).results
     np.testing.assert_allclose(two_pass["C"], across["C"], equal_nan=True)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_cross_correlation_of_a_shared_cosine_field(dim):
+    """u_x = cos(k x), u_y = a cos(k x) + noise (s.d. s), u_z independent: for pairs i != j
+    the noise drops out, so C_xy(r) = rho C_xx(r) with rho = a sqrt(T_x) / sqrt(a^2 T_x + s^2),
+    T_x = 1/2 (-0.816 for a = -1, s = 0.5), the J0 / sinc shell average; C_xz = C_yz = 0.
+    The antisymmetric part vanishes within errors (homogeneous statistics)."""
+    rng = np.random.default_rng(11)
+    L, n, r_max, a, s = (24.0, 2000, 6.0, -1.0, 0.5) if dim == 2 else (16.0, 2500, 4.0, -1.0,
+                                                                       0.5)
+    k = 2 * np.pi * 2 / L
+    frames = []
+    for t in range(8):
+        pos = rng.uniform(0, L, (n, dim))
+        vel = rng.normal(size=(n, dim))
+        vel[:, 0] = np.cos(k * pos[:, 0])
+        vel[:, 1] = a * vel[:, 0] + s * rng.normal(size=n)
+        frames.append(_frame(pos, vel, box=np.full(dim, L), t=t))
+    res = velocity_correlations(frames, dim=dim, n_bins=4, period=L, r_max=r_max,
+                                dr=0.5).results
+    profile = (lambda r: j0(k * r)) if dim == 2 else (lambda r: np.sinc(k * r / np.pi))
+    rho = a * np.sqrt(0.5) / np.sqrt(a**2 * 0.5 + s**2)
+    expected = rho * _shell_average(profile, res["r_edges"], dim)
+    off, err = res["C_offdiag"][:, :, 1:], res["C_offdiag_err"][:, :, 1:]
+    assert err.max() < 0.05
+    assert np.all(np.abs(off[:, 0] - expected[1:]) < 5 * err[:, 0] + 0.01)
+    assert np.all(np.abs(off[:, 1:]) < 5 * err[:, 1:] + 0.01)  # xz, yz (3D)
+    anti = res["C_offdiag_antisym"][:, :, 1:]
+    assert np.all(np.abs(anti) < 5 * res["C_offdiag_antisym_err"][:, :, 1:] + 0.01)
+    np.testing.assert_allclose(res["covariance_offdiag"][:, 0] / np.sqrt(
+        res["temperature_components"][:, :1] * res["temperature_components"][:, 1:2]),
+        res["C_offdiag"][:, 0])
+
+
+def _lattice(nx=10, ny=10):
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
+    return i.ravel(), j.ravel(), np.stack([i.ravel() + 0.5, j.ravel() + 0.5], axis=1)
+
+
+def test_cross_correlation_on_a_lattice_exact_and_under_swaps():
+    """Square lattice, one row j per bin (walls along y, x periodic).
+
+    * u_y = s u_x in every particle: C_xy = sign(s) C_xx exactly, shell by shell.
+    * u_x = (-1)^i, u_y = (-1)^i (j + 1)^2 (bin means 0): at r = 1 a particle of an interior
+      row has two row neighbours (u_x product -1) and two column neighbours (+1), so
+      S_xy = -2 c_j + c_(j+1) + c_(j-1) = 2 and S_yx = c_j (-2 + 2) = 0 with c_j = (j + 1)^2;
+      over 4 pairs and sqrt(T_x T_y) = c_j: C_xy = 1/(4 c_j) and the antisymmetric part
+      is the same. Swapping the velocity components keeps C_xy and flips the antisymmetric
+      part; flipping u_y flips both; the diagonal is untouched by the sign flip.
+    * one bin over a whole periodic box: the antisymmetric part is exactly 0."""
+    i, j, pos = _lattice()
+    opts = {"dim": 2, "edges": np.arange(11.0), "r_max": 2.0, "dr": 0.25}
+    shell_1 = 4
+    sign_x = (-1.0) ** i
+    base = np.stack([sign_x, sign_x * (-1.0) ** j], axis=1)  # the checkerboard above
+    for scale in (1.0, -2.0):
+        vel = np.stack([base[:, 0], scale * base[:, 0]], axis=1)
+        res = VelocityCorrelation(**opts).run([_frame(pos, vel, box=[10, 10])]).results
+        has = res["pairs_per_particle"] > 0
+        np.testing.assert_allclose(res["C_offdiag"][:, 0][has],
+                                   np.sign(scale) * res["C"][:, 0][has], atol=1e-12)
+        np.testing.assert_allclose(res["C_offdiag_antisym"][:, 0][has], 0.0, atol=1e-12)
+
+    vel = np.stack([sign_x, sign_x * (j + 1.0) ** 2], axis=1)
+    res = VelocityCorrelation(**opts).run([_frame(pos, vel, box=[10, 10])]).results
+    rows = np.arange(1, 9)
+    for key in ("C_offdiag", "C_offdiag_antisym"):
+        np.testing.assert_allclose(res[key][rows, 0, shell_1], 1 / (4 * (rows + 1) ** 2))
+    swapped = VelocityCorrelation(**opts).run([_frame(pos, vel[:, ::-1], box=[10, 10])])
+    flipped = VelocityCorrelation(**opts).run([_frame(pos, vel * [1, -1], box=[10, 10])])
+    swapped, flipped = swapped.results, flipped.results
+    for key, swap_sign, flip_sign in (("C_offdiag", 1, -1), ("C_offdiag_antisym", -1, -1)):
+        np.testing.assert_allclose(swapped[key], swap_sign * res[key], equal_nan=True)
+        np.testing.assert_allclose(flipped[key], flip_sign * res[key], equal_nan=True)
+    np.testing.assert_allclose(swapped["C"], res["C"][:, ::-1], equal_nan=True)
+    np.testing.assert_allclose(flipped["C"], res["C"], equal_nan=True)
+
+    whole = VelocityCorrelation(dim=2, n_bins=1, period=10.0, r_max=2.0, dr=0.25).run(
+        [_frame(pos, vel, box=[10, 10])]).results
+    has = whole["pairs_per_particle"][0] > 0  # empty shells are 0/0
+    assert np.abs(whole["C_offdiag"][0, 0, has]).max() > 0.5
+    np.testing.assert_allclose(whole["C_offdiag_antisym"][0, 0, has], 0.0, atol=1e-12)
 
 
 def test_lees_edwards_partner_through_the_boundary():

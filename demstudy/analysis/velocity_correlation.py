@@ -1,4 +1,4 @@
-"""Spatial velocity correlations C_aa(r) and Malik's orientational correlation Lambda(y).
+"""Spatial velocity correlations C_ab(r) and Malik's orientational correlation Lambda(y).
 
 Dimensionless particle units: d = 1, m = 1 (r in particle diameters). Axes: x flow (periodic),
 y wall-normal (the bin axis; periodic or bounded by walls), z spanwise (3D, periodic).
@@ -37,7 +37,24 @@ literal (4.1), sum_i sum_{j>i} u'_ia u'_ja delta(r - r_ij) / sum_i u'_ia^2 with 
 binned as 1/dr, i.e. <S_a> / (2 dr <Q_a>) (exactly Malik's for ``in_bin=True``; it mixes
 C with the pair density: C_malik = C * pairs_per_particle / (2 dr)). ``distance="planar"``
 (only with ``in_bin``) uses the separation in the periodic x(z) plane, Malik's reading for
-g(r). Only the diagonal components a = x, y(, z) are computed.
+g(r).
+
+Off-diagonal components C_ac (a != c: xy in 2D; xy, xz, yz in 3D), from the same pairs: with
+the ordered sums S_ac(b, k) = sum u'_ia u'_jc (i in bin b supplies component a, j component c),
+
+    covariance_offdiag_ac(r_k) = (<S_ac> + <S_ca>) / (2 <P>)   (symmetrised over the pair order),
+    C_offdiag_ac = covariance_offdiag_ac / sqrt(T_a T_c),      T = temperature_components (bin b),
+    C_offdiag_antisym_ac = (<S_ac> - <S_ca>) / (2 <P> sqrt(T_a T_c)).
+
+Normalising by sqrt(T_a T_c) makes C_ac a correlation coefficient that reduces to C_aa for
+a = c: u'_c = s u'_a in every particle gives C_ac = sign(s) C_aa exactly, independent
+components give 0. C_xy is the shear-stress-like one (the pair analogue of <u'v'>). When every
+ordered pair comes with its reverse in the same bin (one bin over a whole periodic box, or
+``in_bin=True``), S_ac = S_ca and the antisymmetric part is exactly 0; otherwise its
+expectation is 0 for statistically homogeneous fluctuations (<u'_a(x) u'_c(x + r)> =
+<u'_c(x) u'_a(x - r)> and each shell holds r and -r), and it is nonzero where the statistics
+vary across bins (e.g. a temperature gradient). Hence the symmetrised C_ac as the result, the
+antisymmetric part kept as a diagnostic.
 
 OrientationalCorrelation (Malik §4.8): per particle cos^2 Psi = (C.W)^2 / (|C|^2 |W|^2) of the
 translational fluctuation C and the spin fluctuation W (particles with C = 0 or W = 0 are
@@ -254,7 +271,8 @@ class BinMeans(_Binned):
 
 
 class VelocityCorrelation(_Binned):
-    """Spatial correlation C_aa(r) of velocity fluctuations per y-bin (see the module doc).
+    """Spatial correlations C_aa(r) and C_ab(r) (a != b, ``C_offdiag``) of velocity
+    fluctuations per y-bin (see the module doc).
 
     Parameters
     ----------
@@ -301,8 +319,11 @@ class VelocityCorrelation(_Binned):
         lengths = frame.lengths
         periodic = [0] + ([2] if self.dim == 3 else []) + ([1] if self.period else [])
         self.r_image_limit = 0.5 * float(min(lengths[periodic]))
-        # per bin: N | Q_a (dim) | P (n_r) | S_a (dim x n_r)
-        self._nv = 1 + self.dim + self.n_r * (1 + self.dim)
+        # ordered off-diagonal (a, b), a != b: the pair (a, b) then its reverse (b, a)
+        pairs = [(a, b) for a in range(self.dim) for b in range(a + 1, self.dim)]
+        self._off = [ab for a, b in pairs for ab in ((a, b), (b, a))]
+        # per bin: N | Q_a (dim) | P (n_r) | S_aa (dim x n_r) | S_ab (len(_off) x n_r)
+        self._nv = 1 + self.dim + self.n_r * (1 + self.dim + len(self._off))
         self._acc = BlockAccumulator(self.n_bins * self._nv, self.max_blocks)
 
     # -- pair search -------------------------------------------------------------------
@@ -385,10 +406,10 @@ class VelocityCorrelation(_Binned):
             idx = bins[i] * nr + k
             sample[:, 1 + dim : 1 + dim + nr] += np.bincount(
                 idx, minlength=nb * nr).reshape(nb, nr)
-            for c in range(dim):
+            for c, (a, b) in enumerate([(c, c) for c in range(dim)] + self._off):
                 col = 1 + dim + nr * (1 + c)
                 sample[:, col : col + nr] += np.bincount(
-                    idx, weights=u[i, c] * u[j, c], minlength=nb * nr).reshape(nb, nr)
+                    idx, weights=u[i, a] * u[j, b], minlength=nb * nr).reshape(nb, nr)
         self._acc.add(sample)
 
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
@@ -396,12 +417,20 @@ class VelocityCorrelation(_Binned):
         s = mean.reshape(nb, self._nv)
         n, q = s[:, 0], s[:, 1 : 1 + dim]
         p = s[:, 1 + dim : 1 + dim + nr]
-        sums = s[:, 1 + dim + nr :].reshape(nb, dim, nr)
+        sums = s[:, 1 + dim + nr : 1 + dim + nr * (1 + dim)].reshape(nb, dim, nr)
         cov = sums / p[:, None, :]
         temp = q / n[:, None]
+        # ordered off-diagonal covariances in pairs: [:, 0::2] is (a, b), [:, 1::2] is (b, a)
+        off = s[:, 1 + dim + nr * (1 + dim) :].reshape(nb, len(self._off), nr) / p[:, None, :]
+        sym, anti = 0.5 * (off[:, 0::2] + off[:, 1::2]), 0.5 * (off[:, 0::2] - off[:, 1::2])
+        norm = np.sqrt(np.stack([temp[:, a] * temp[:, b] for a, b in self._off[0::2]],
+                                axis=1))[:, :, None]
         return {
             "C": cov / temp[:, :, None],
             "covariance": cov,
+            "C_offdiag": sym / norm,
+            "C_offdiag_antisym": anti / norm,
+            "covariance_offdiag": sym,
             "temperature_components": temp,
             "C_malik": sums / (2 * self.dr * q[:, :, None]),
             "pairs_per_particle": p / n[:, None],
@@ -422,7 +451,9 @@ class VelocityCorrelation(_Binned):
         self.attrs = {
             **self._common_attrs(),
             "components": ",".join("xyz"[: self.dim]),
-            "shape": "C, covariance, C_malik: (n_bins, dim, n_r)",
+            "offdiag_components": ",".join("xyz"[a] + "xyz"[b] for a, b in self._off[0::2]),
+            "shape": "C, covariance, C_malik: (n_bins, dim, n_r); C_offdiag, "
+                     "C_offdiag_antisym, covariance_offdiag: (n_bins, dim (dim - 1) / 2, n_r)",
             "in_bin": self.in_bin,
             "distance": self.distance,
             "dr": self.dr,
@@ -430,7 +461,8 @@ class VelocityCorrelation(_Binned):
             "r_image_limit": self.r_image_limit,
             "mean": "instantaneous bin mean" if self._ref is None
             else "run-mean bin velocity (first pass)",
-            "normalisation": "C = <sum_pairs u'_i u'_j>/<pairs> / (<sum_i u'_i^2>/<N>)",
+            "normalisation": "C = <sum_pairs u'_i u'_j>/<pairs> / (<sum_i u'_i^2>/<N>); "
+                             "C_offdiag_ab = (<u'_ia u'_jb> + <u'_ib u'_ja>)/2 / sqrt(T_a T_b)",
         }
 
 
@@ -506,7 +538,7 @@ def _two_pass(cls: type, frames: Callable[[], Iterable[Frame]] | Iterable[Frame]
 
 def velocity_correlations(frames: Callable[[], Iterable[Frame]] | Iterable[Frame],
                           **options: Any) -> VelocityCorrelation:
-    """Two passes: run-mean bin velocities (:class:`BinMeans`), then C_aa(r) of the
+    """Two passes: run-mean bin velocities (:class:`BinMeans`), then C_aa(r), C_ab(r) of the
     fluctuations about them. ``frames``: a list or a callable returning fresh iterables."""
     return _two_pass(VelocityCorrelation, frames, options)
 

@@ -9,9 +9,10 @@ Kinds (``demstudy plot RUN.h5 … --kind``; see docs/plots.md):
 * ``vdf``: Campbell's P(X1…X5) with folded Maxwellians, Malik's P(C/σ) with the Gaussian;
 * ``angles``: P(θ) in both conventions with Savage–Jeffrey;
 * ``gr``: g(r) (whole box, in-bin when stored);
-* ``vcorr``: C_αα(r) per component;
+* ``vcorr``: C_αα(r) per component and the off-diagonal C_αβ(r);
 * ``lambda``: Λ(y) with 1/3;
-* ``waves``: power spectrum of the dominant plane, its density contour, mode amplitudes.
+* ``waves``: power spectrum of the dominant plane, its density contour, mode amplitudes;
+* ``cooling``: homogeneous cooling runs only, T(t)/T0 with Haff's law (log–log).
 
 Every ``draw_<kind>(runs, …)`` returns a :class:`matplotlib.figure.Figure` (Agg canvas, no
 pyplot); :func:`plot_files` loads files, skips kinds a file lacks with a one-line notice and
@@ -30,16 +31,16 @@ from matplotlib.figure import Figure
 from .common import Run, missing_notice, save
 from .correlations import draw_gr, draw_lambda, draw_vcorr
 from .distributions import draw_angles, draw_vdf
-from .profiles import draw_eos, draw_profiles, draw_stress, reference_height
+from .profiles import draw_cooling, draw_eos, draw_profiles, draw_stress, reference_height
 from .waves import draw_waves
 
 #: the kinds, in the order ``--kind all`` draws them
-KINDS = ("profiles", "stress", "eos", "vdf", "angles", "gr", "vcorr", "lambda", "waves")
+KINDS = ("profiles", "stress", "eos", "vdf", "angles", "gr", "vcorr", "lambda", "waves",
+         "cooling")
 
-__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_eos", "draw_gr", "draw_lambda",
-           "draw_profiles",
-           "draw_stress", "draw_vcorr", "draw_vdf", "draw_waves", "output_path", "parse_kinds",
-           "plot_files", "plot_profiles", "reference_height"]
+__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_cooling", "draw_eos", "draw_gr",
+           "draw_lambda", "draw_profiles", "draw_stress", "draw_vcorr", "draw_vdf", "draw_waves",
+           "output_path", "parse_kinds", "plot_files", "plot_profiles", "reference_height"]
 
 
 def parse_kinds(values: Sequence[str] | None) -> list[str]:
@@ -66,9 +67,9 @@ def draw(kind: str, runs: Sequence[Run], *, scaled: bool = False,
         raise ValueError(f"unknown plot kind {kind!r} (allowed: {', '.join(KINDS)})")
     if kind == "profiles":
         return draw_profiles(runs, scaled=scaled)
-    if kind in ("stress", "eos", "lambda", "waves"):
+    if kind in ("stress", "eos", "lambda", "waves", "cooling"):
         return {"stress": draw_stress, "eos": draw_eos, "lambda": draw_lambda,
-                "waves": draw_waves}[kind](runs)
+                "waves": draw_waves, "cooling": draw_cooling}[kind](runs)
     fn: dict[str, Callable[..., Figure]] = {"vdf": draw_vdf, "angles": draw_angles,
                                             "gr": draw_gr, "vcorr": draw_vcorr}
     return fn[kind](runs, bins=bins)

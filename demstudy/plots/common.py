@@ -42,10 +42,20 @@ HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
               "`demstudy analyze {file} --what stress`",
        "angles": "add it with `demstudy analyze {file} --what angles`, which needs an "
                  "event-driven run's /collisions log",
-       "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only"}
+       "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only",
+       "cooling": "Haff's law needs every axis periodic, no walls, gravity or shear, and a "
+                  "constant e < 1"}
 
 LINESTYLES = ("-", "--", ":", "-.")
 MARKERS = ("o", "s", "^", "v", "D", "P")
+
+
+def homogeneous_cooling(scene: Any) -> bool:
+    """A free-cooling scene, where Haff's law applies: every axis periodic, no walls, gravity
+    or shear, and a constant normal restitution e < 1."""
+    return (scene is not None and len(scene.periodic) == scene.dimension and not scene.walls
+            and scene.gravity is None and scene.shear is None
+            and scene.contact.law.model == "constant" and scene.contact.restitution < 1)
 
 
 def _decode(value: Any) -> Any:
@@ -128,6 +138,10 @@ class Run:
         if kind == "profiles":
             prof = self.results.profiles
             return (prof, self.results.profile_attrs) if prof and "y" in prof else None
+        if kind == "cooling":  # a property of the run (its scene), not of a stored group
+            ts = self.results.timeseries
+            ok = homogeneous_cooling(self.scene) and "kinetic_energy" in ts and "time" in ts
+            return (ts, {}) if ok else None
         for name in GROUPS[kind]:
             data = self.results.groups.get(name)
             if data and REQUIRED[kind] in data:
@@ -135,6 +149,8 @@ class Run:
         return None
 
     def where(self, kind: str) -> str:
+        if kind == "cooling":
+            return "homogeneous cooling scene with /timeseries/kinetic_energy"
         return "/profiles" if kind == "profiles" else " or ".join(f"/{g}" for g in GROUPS[kind])
 
 
@@ -148,6 +164,8 @@ def units_text(runs: Sequence[Run]) -> str:
     """The units statement of a figure, with whether gravity acts in these runs."""
     gravity = {run.gravity for run in runs}
     text = "units: d = 1, m = 1, g = 1 with gravity"
+    if all(homogeneous_cooling(run.scene) for run in runs):  # no wall speed, no shear rate
+        return text + " (no gravity here: the initial temperature sets the time scale)"
     if gravity == {True}:
         return text + " (gravity acts here)"
     if gravity == {False}:

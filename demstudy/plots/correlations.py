@@ -1,4 +1,4 @@
-"""Pair correlation g(r), velocity correlations C_αα(r) and Malik's Λ(y).
+"""Pair correlation g(r), velocity correlations C_αα(r), C_αβ(r) and Malik's Λ(y).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 with gravity (r in particle diameters).
 """
@@ -69,30 +69,43 @@ def draw_gr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
 
 def draw_vcorr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
     """Malik's C_αα(r) per component (x, y[, z]) in chosen y-bins: the normalised correlation
-    of the velocity fluctuations about the run-mean bin velocities (C → 1 as r → 0+)."""
+    of the velocity fluctuations about the run-mean bin velocities (C → 1 as r → 0+); below,
+    when stored, the off-diagonal C_αβ(r) (xy[, xz, yz]; symmetrised over the pair order,
+    normalised by √(⟨u'_α²⟩⟨u'_β²⟩)), which can be negative: C_xy carries the shear stress."""
     dim = max(int(run.group("vcorr")[0]["C"].shape[1]) for run in runs)
-    fig, axes = new_figure(1, dim, width=4.5, height=4.0, sharey=True)
+    off = any("C_offdiag" in run.group("vcorr")[0] for run in runs)
+    # off-diagonal values are usually much smaller than C_αα(0+) = 1: a y scale per row
+    fig, axes = new_figure(2 if off else 1, dim, width=4.5, height=4.0, sharey="row")
     for r, run in enumerate(runs):
-        data, _attrs = run.group("vcorr")
-        c, rr = np.asarray(data["C"], float), np.asarray(data["r"], float)
-        y = np.asarray(data["y"], float)
+        data, attrs = run.group("vcorr")
+        rr, y = np.asarray(data["r"], float), np.asarray(data["y"], float)
+        c = np.asarray(data["C"], float)
         chosen = pick_bins(np.asarray(data.get("count", np.ones(c.shape[0])), float) > 0, bins)
         prefix = f"{run.label}, " if len(runs) > 1 else ""
         ls = LINESTYLES[r % len(LINESTYLES)]
-        for a in range(c.shape[1]):
-            ax = axes[0, a]
+        panels = [(axes[0, a], "xyz"[a] * 2, c[:, a], f"C:{{b}}:{a}") for a in range(c.shape[1])]
+        if "C_offdiag" in data:
+            c_off = np.asarray(data["C_offdiag"], float)
+            names = str(attrs.get("offdiag_components", "xy,xz,yz")).split(",")
+            panels += [(axes[1, p], names[p], c_off[:, p], f"C_offdiag:{{b}}:{p}")
+                       for p in range(c_off.shape[1])]
+        for ax, comp, values, gid in panels:
             for i, b in enumerate(chosen):
-                ax.plot(rr, c[b, a], ls=ls, marker=".", ms=3, color=f"C{i}",
-                        label=f"{prefix}{bin_label(y, b)}", gid=f"{run.path.name}:C:{b}:{a}")
-            if r == 0:
+                ax.plot(rr, values[b], ls=ls, marker=".", ms=3, color=f"C{i}",
+                        label=f"{prefix}{bin_label(y, b)}",
+                        gid=f"{run.path.name}:{gid.format(b=b)}")
+            if not ax.get_title():  # first run drawn in this panel
                 _artefact(ax, np.asarray(data["r_edges"], float), data.get("image_artefact"))
-                comp = "xyz"[a]
-                ax.set_title(f"C_{comp}{comp}(r)", fontsize=9)
+                ax.set_title(f"C_{comp}(r)", fontsize=9)
                 ax.axhline(0.0, color="0.5", lw=0.8)
                 ax.set_xlabel("r (particle diameters)")
                 ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel("C_αα(r)")
     axes[0, 0].legend(fontsize=7, loc="upper right")
+    if off:
+        axes[1, 0].set_ylabel("C_αβ(r), symmetrised")
+        for ax in axes[1]:
+            ax.set_visible(bool(ax.get_title()))  # 2D: one off-diagonal panel of two
     return finish(fig, runs, "spatial velocity correlations (fluctuations about the "
                              "run-mean bin velocity)")
 

@@ -190,3 +190,50 @@ def draw_eos(runs: Sequence[Run]) -> Figure:
     g0 = "Henderson g0 (discs)" if dims == {2} else "Carnahan–Starling g0 (spheres)" \
         if dims == {3} else "Henderson / Carnahan–Starling g0"
     return finish(fig, runs, f"equation of state χ(ν), Campbell (1982); theory: {g0}")
+
+
+def cooling_temperature(run: Run) -> tuple[np.ndarray, np.ndarray]:
+    """(t − t_first, T) of a homogeneous cooling run from ``/timeseries``: T per translational
+    degree of freedom, T = (2 E_kin − |P|²/N) / (dim (N − 1)) (m = 1; the centre-of-mass
+    motion is not thermal and takes dim degrees of freedom; N from the scene)."""
+    ts, scene = run.results.timeseries, run.scene
+    n, dim = scene.n_particles, scene.dimension
+    energy = 2 * np.asarray(ts["kinetic_energy"], float)
+    if "momentum" in ts:
+        energy = energy - (np.asarray(ts["momentum"], float) ** 2).sum(axis=1) / n
+    t = np.asarray(ts["time"], float)
+    return t - t[0], energy / (dim * (n - 1))
+
+
+def draw_cooling(runs: Sequence[Run]) -> Figure:
+    """Homogeneous cooling: T(t)/T0 on log–log axes (T0 the first sample's T) with Haff's law
+    T/T0 = 1/(1 + t/t0)², t0 = 2 dim / ((1 − e²) ω_E(T0)), ω_E the Enskog collision
+    frequency at the scene's ν (:func:`demstudy.theory.haff_temperature`; smooth particles)."""
+    from ..theory import haff_t0, haff_temperature
+
+    fig, axes = new_figure(1, 1, width=6.5, height=4.5)
+    ax = axes[0, 0]
+    for r, run in enumerate(runs):
+        scene, name = run.scene, run.path.name
+        t, temp = cooling_temperature(run)
+        t0_temp = float(temp[0])
+        keep = (t > 0) & (temp > 0)  # log axes: the origin t = 0 (T = T0) cannot be shown
+        t, temp = t[keep], temp[keep]
+        ax.plot(t, temp / t0_temp, marker=MARKERS[r % len(MARKERS)], ms=3, ls="none",
+                color=f"C{r}", label=f"{run.label}: T/T0 (T0 = {t0_temp:.3g})",
+                gid=f"{name}:temperature")
+        nu, e, dim = scene.solid_fraction, scene.contact.restitution, scene.dimension
+        t0 = haff_t0(nu, t0_temp, dim, e)
+        label = f"Haff, ν = {nu:.3g}, e = {e:g}: t0 = {t0:.3g}"
+        if scene.rotation_matters:  # rough particles also cool through their spins
+            label += " (theory for smooth particles)"
+        ax.plot(t, haff_temperature(t, nu, t0_temp, dim, e) / t0_temp, color=f"C{r}", ls="--",
+                lw=1.2, label=label, gid=f"{name}:haff")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("t (particle units, from the first sample)")
+    ax.set_ylabel("T(t) / T0 (per translational degree of freedom)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, loc="lower left")
+    return finish(fig, runs, "homogeneous cooling and Haff's law T/T0 = 1/(1 + t/t0)²\n"
+                             "t0 = 2 dim/((1 − e²) ω(T0)), ω the Enskog collision frequency")
