@@ -8,6 +8,14 @@
 #include <string>
 #include <utility>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(DEMSTUDY_EDMD_NO_AVX2)
+#include <immintrin.h>
+#define DEMSTUDY_EDMD_AVX2 1
+#endif
+
 namespace demstudy::edmd {
 
 namespace {
@@ -40,12 +48,12 @@ inline std::uint64_t morton(const std::int32_t* c) {
 
 // v[k] <- v[perm[k]] for rows of `width` elements, in place (cycle following): no copy of
 // the array, so re-sorting does not raise the peak memory.
-template <typename T>
-void permute_rows(std::vector<T>& v, std::size_t width, const std::vector<std::int32_t>& perm,
+template <typename V>
+void permute_rows(V& v, std::size_t width, const std::vector<std::int32_t>& perm,
                   std::vector<char>& done) {
     const std::size_t n = perm.size();
     done.assign(n, 0);
-    std::vector<T> tmp(width);
+    std::vector<typename V::value_type> tmp(width);
     for (std::size_t start = 0; start < n; ++start) {
         if (done[start]) continue;
         for (std::size_t a = 0; a < width; ++a) tmp[a] = v[width * start + a];
@@ -113,6 +121,162 @@ double bump_contact_time(const double* d0, const double* dv, const double* a, do
     return t;  // grazing: re-check there
 }
 }  // namespace
+
+namespace {
+
+// Collision times of particle i (state xi, vi at time `now`, radius ri) with the candidates
+// js[0..n) of the same image (no shift): out[q] = time from now, 0 if touching or overlapping
+// and approaching, +inf if they do not meet. Pair times do not depend on gravity, but the
+// candidates' positions and velocities are extrapolated to `now` along their parabolas
+// (hg = g/2; G = false: no gravity, the same numbers without the g terms). The scalar and the
+// AVX2 versions do the same IEEE operations in the same order (no FMA), so they give identical
+// bits and the run does not depend on which one the CPU gets.
+template <bool G>
+void pair_times_scalar(const PairRecord* P, const std::int32_t* js, int n, const double* xi,
+                       const double* vi, double ri, double now, const double* g,
+                       const double* hg, double* out) {
+    for (int q = 0; q < n; ++q) {
+        const PairRecord& p = P[js[q]];
+        const double dt = now - p.t;
+        double dr[3], dv[3];
+        for (int a = 0; a < 3; ++a) {
+            if constexpr (G) {
+                dr[a] = p.x[a] + (p.v[a] + hg[a] * dt) * dt - xi[a];
+                dv[a] = p.v[a] + g[a] * dt - vi[a];
+            } else {
+                dr[a] = p.x[a] + p.v[a] * dt - xi[a];
+                dv[a] = p.v[a] - vi[a];
+            }
+        }
+        const double b = dot3(dr, dv);
+        double t = kInfinity;
+        if (b < 0.0) {
+            const double sigma = ri + p.r;
+            const double cc = dot3(dr, dr) - sigma * sigma;
+            if (cc <= 0.0) {
+                t = 0.0;  // touching or overlapping and approaching: collide now
+            } else {
+                const double disc = b * b - dot3(dv, dv) * cc;
+                if (disc > 0.0) t = cc / (std::sqrt(disc) - b);
+            }
+        }
+        out[q] = t;
+    }
+}
+
+#ifdef DEMSTUDY_EDMD_AVX2
+// Four candidates at a time: each 64-byte record is two 256-bit loads, transposed into
+// columns (x0, x1, x2, v0 | v1, v2, t, r).
+template <bool G>
+__attribute__((target("avx2"))) void pair_times_avx2(const PairRecord* P, const std::int32_t* js,
+                                                     int n, const double* xi, const double* vi,
+                                                     double ri, double now, const double* g,
+                                                     const double* hg, double* out) {
+    const __m256d vnow = _mm256_set1_pd(now), vri = _mm256_set1_pd(ri);
+    const __m256d zero = _mm256_setzero_pd(), inf = _mm256_set1_pd(kInfinity);
+    const __m256d x0i = _mm256_set1_pd(xi[0]), x1i = _mm256_set1_pd(xi[1]),
+                  x2i = _mm256_set1_pd(xi[2]);
+    const __m256d v0i = _mm256_set1_pd(vi[0]), v1i = _mm256_set1_pd(vi[1]),
+                  v2i = _mm256_set1_pd(vi[2]);
+    int q = 0;
+    for (; q + 4 <= n; q += 4) {
+        const double* p0 = P[js[q]].x;
+        const double* p1 = P[js[q + 1]].x;
+        const double* p2 = P[js[q + 2]].x;
+        const double* p3 = P[js[q + 3]].x;
+        const __m256d a0 = _mm256_load_pd(p0), a1 = _mm256_load_pd(p1);
+        const __m256d a2 = _mm256_load_pd(p2), a3 = _mm256_load_pd(p3);
+        const __m256d b0 = _mm256_load_pd(p0 + 4), b1 = _mm256_load_pd(p1 + 4);
+        const __m256d b2 = _mm256_load_pd(p2 + 4), b3 = _mm256_load_pd(p3 + 4);
+        const __m256d al01 = _mm256_unpacklo_pd(a0, a1), ah01 = _mm256_unpackhi_pd(a0, a1);
+        const __m256d al23 = _mm256_unpacklo_pd(a2, a3), ah23 = _mm256_unpackhi_pd(a2, a3);
+        const __m256d bl01 = _mm256_unpacklo_pd(b0, b1), bh01 = _mm256_unpackhi_pd(b0, b1);
+        const __m256d bl23 = _mm256_unpacklo_pd(b2, b3), bh23 = _mm256_unpackhi_pd(b2, b3);
+        const __m256d x0 = _mm256_permute2f128_pd(al01, al23, 0x20);
+        const __m256d x2 = _mm256_permute2f128_pd(al01, al23, 0x31);
+        const __m256d x1 = _mm256_permute2f128_pd(ah01, ah23, 0x20);
+        __m256d v0 = _mm256_permute2f128_pd(ah01, ah23, 0x31);
+        __m256d v1 = _mm256_permute2f128_pd(bl01, bl23, 0x20);
+        const __m256d tj = _mm256_permute2f128_pd(bl01, bl23, 0x31);
+        __m256d v2 = _mm256_permute2f128_pd(bh01, bh23, 0x20);
+        const __m256d rj = _mm256_permute2f128_pd(bh01, bh23, 0x31);
+        const __m256d dt = _mm256_sub_pd(vnow, tj);
+        __m256d dr0, dr1, dr2;
+        if constexpr (G) {
+            // x + (v + hg dt) dt − xi, then v + g dt
+            dr0 = _mm256_sub_pd(_mm256_add_pd(x0, _mm256_mul_pd(_mm256_add_pd(v0, _mm256_mul_pd(_mm256_set1_pd(hg[0]), dt)), dt)), x0i);
+            dr1 = _mm256_sub_pd(_mm256_add_pd(x1, _mm256_mul_pd(_mm256_add_pd(v1, _mm256_mul_pd(_mm256_set1_pd(hg[1]), dt)), dt)), x1i);
+            dr2 = _mm256_sub_pd(_mm256_add_pd(x2, _mm256_mul_pd(_mm256_add_pd(v2, _mm256_mul_pd(_mm256_set1_pd(hg[2]), dt)), dt)), x2i);
+            v0 = _mm256_add_pd(v0, _mm256_mul_pd(_mm256_set1_pd(g[0]), dt));
+            v1 = _mm256_add_pd(v1, _mm256_mul_pd(_mm256_set1_pd(g[1]), dt));
+            v2 = _mm256_add_pd(v2, _mm256_mul_pd(_mm256_set1_pd(g[2]), dt));
+        } else {
+            dr0 = _mm256_sub_pd(_mm256_add_pd(x0, _mm256_mul_pd(v0, dt)), x0i);
+            dr1 = _mm256_sub_pd(_mm256_add_pd(x1, _mm256_mul_pd(v1, dt)), x1i);
+            dr2 = _mm256_sub_pd(_mm256_add_pd(x2, _mm256_mul_pd(v2, dt)), x2i);
+        }
+        const __m256d dv0 = _mm256_sub_pd(v0, v0i), dv1 = _mm256_sub_pd(v1, v1i),
+                      dv2 = _mm256_sub_pd(v2, v2i);
+        const __m256d b = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dr0, dv0), _mm256_mul_pd(dr1, dv1)),
+                                        _mm256_mul_pd(dr2, dv2));
+        const __m256d sigma = _mm256_add_pd(vri, rj);
+        const __m256d cc = _mm256_sub_pd(
+            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dr0, dr0), _mm256_mul_pd(dr1, dr1)),
+                          _mm256_mul_pd(dr2, dr2)),
+            _mm256_mul_pd(sigma, sigma));
+        const __m256d aa = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dv0, dv0), _mm256_mul_pd(dv1, dv1)),
+                                         _mm256_mul_pd(dv2, dv2));
+        const __m256d disc = _mm256_sub_pd(_mm256_mul_pd(b, b), _mm256_mul_pd(aa, cc));
+        const __m256d root = _mm256_sqrt_pd(_mm256_max_pd(disc, zero));
+        __m256d t = _mm256_div_pd(cc, _mm256_sub_pd(root, b));
+        const __m256d touching = _mm256_cmp_pd(cc, zero, _CMP_LE_OQ);
+        t = _mm256_blendv_pd(t, zero, touching);
+        // a miss: receding (b >= 0), or apart with no real root (cc > 0, disc <= 0)
+        const __m256d miss = _mm256_or_pd(
+            _mm256_cmp_pd(b, zero, _CMP_GE_OQ),
+            _mm256_andnot_pd(touching, _mm256_cmp_pd(disc, zero, _CMP_LE_OQ)));
+        _mm256_storeu_pd(out + q, _mm256_blendv_pd(t, inf, miss));
+    }
+    if (q < n) pair_times_scalar<G>(P, js + q, n - q, xi, vi, ri, now, g, hg, out + q);
+}
+
+bool cpu_has_avx2() noexcept { return __builtin_cpu_supports("avx2"); }
+#endif
+
+}  // namespace
+
+void pair_times(bool gravity, const PairRecord* P, const std::int32_t* js, int n,
+                const double* xi, const double* vi, double ri, double now, const double* g,
+                double* out) {
+    const double hg[3] = {0.5 * g[0], 0.5 * g[1], 0.5 * g[2]};
+#ifdef DEMSTUDY_EDMD_AVX2
+    static const bool avx2 = cpu_has_avx2();
+    if (avx2) {
+        if (gravity)
+            pair_times_avx2<true>(P, js, n, xi, vi, ri, now, g, hg, out);
+        else
+            pair_times_avx2<false>(P, js, n, xi, vi, ri, now, g, hg, out);
+        return;
+    }
+#endif
+    if (gravity)
+        pair_times_scalar<true>(P, js, n, xi, vi, ri, now, g, hg, out);
+    else
+        pair_times_scalar<false>(P, js, n, xi, vi, ri, now, g, hg, out);
+}
+
+void advise_huge_pages(void* p, std::size_t bytes) noexcept {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    constexpr std::uintptr_t kHuge = std::uintptr_t{1} << 21;
+    if (bytes < 2 * kHuge) return;
+    const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+    const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
+    if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);  // advice only
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}
 
 double Rule::restitution(double gn) const {
     switch (law) {
@@ -286,10 +450,10 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     co_partner_.assign(N, -1);
     co_count_.assign(N, 0);
     ev_partner_.assign(N + 1, kNone);
-    heap_.resize(N + 1);
+    heap_.assign(N + 1 + kHeapPad, Node{kInf, -1});
     pos_in_heap_.resize(N + 1);
     for (std::int32_t k = 0; k <= static_cast<std::int32_t>(n_); ++k) {
-        heap_[k] = Node{kInf, k};
+        node_at(k) = Node{kInf, k};
         pos_in_heap_[k] = k;
     }
     predict_all();
@@ -327,16 +491,19 @@ void EventDriven::setup_grid() {
         cw_[2] = p_.box[2];
         org_[2] = 0.0;
     }
-    n_nb_ = 0;
+    for (int& count : n_nb_) count = 0;
     const int zr = p_.dim == 3 ? 1 : 0;
     for (int dz = -zr; dz <= zr; ++dz)
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
-                nb_off_[n_nb_] = (static_cast<std::int64_t>(dz) * ncell_[1] + dy) * ncell_[0] + dx;
-                nb_d_[n_nb_][0] = static_cast<std::int8_t>(dx);
-                nb_d_[n_nb_][1] = static_cast<std::int8_t>(dy);
-                nb_d_[n_nb_][2] = static_cast<std::int8_t>(dz);
-                ++n_nb_;
+                const std::int64_t off = (static_cast<std::int64_t>(dz) * ncell_[1] + dy) * ncell_[0] + dx;
+                const int d[3] = {dx, dy, dz};
+                nb_off_[0][n_nb_[0]++] = off;
+                for (int a = 0; a < 3; ++a)
+                    if (d[a] != 0) {
+                        const int list = 1 + 2 * a + (d[a] > 0);
+                        nb_off_[list][n_nb_[list]++] = off;
+                    }
             }
 }
 
@@ -434,9 +601,11 @@ void EventDriven::separation(std::int32_t i, std::int32_t j, double dr[3], doubl
 }
 
 // Visit the particles j of the neighbouring cells of i (only the layer at offset `dir` along
-// `only_axis` when only_axis >= 0) with the shift of j's image: visit(j, shift, vshift).
-// Across a Lees–Edwards boundary the image row slides: 6 x-cells cover every partner that can
-// come within reach until the next re-scan (the offset moves by one cell width between them).
+// `only_axis` when only_axis >= 0) with the shift of j's image: visit(j, shift, vshift), where
+// shift == nullptr means no shift (the common case, so the caller's arithmetic for it folds
+// away). Across a Lees–Edwards boundary the image row slides: 6 x-cells cover every partner
+// that can come within reach until the next re-scan (the offset moves by one cell width
+// between them).
 template <typename F>
 void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& visit) const {
     const std::int32_t* ci = &cell_[3 * i];
@@ -444,17 +613,54 @@ void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& vis
     bool interior = true;
     for (int a = 0; a < p_.dim; ++a) interior = interior && ci[a] >= 1 && ci[a] + 1 < ncell_[a];
     if (interior) {
-        static constexpr double zero[3] = {0.0, 0.0, 0.0};
         const std::int64_t base = cell_index(ci);
-        for (int k = 0; k < n_nb_; ++k) {
-            if (only_axis >= 0 && nb_d_[k][only_axis] != dir) continue;
-            for (std::int32_t j = head_[base + nb_off_[k]]; j >= 0; j = next_[j]) {
-                if (j == i) continue;
-                visit(j, zero, zero);
-            }
-        }
+        const int list = only_axis < 0 ? 0 : 1 + 2 * only_axis + (dir > 0);
+        const std::int64_t* off = nb_off_[list];
+        for (int k = 0, nk = n_nb_[list]; k < nk; ++k)
+            for (std::int32_t j = head_[base + off[k]]; j >= 0; j = next_[j])
+                if (j != i) visit(j, nullptr, nullptr);
         return;
     }
+    static constexpr double zero[3] = {0.0, 0.0, 0.0};
+    if (!le_row(i)) {
+        // a border cell: per axis the (up to) three neighbour coordinates, wrapped, and the
+        // shift of their images; rows beyond a non-periodic y are absent
+        std::int32_t cell[3][3];
+        double shift[3][3];
+        int count[3];
+        for (int a = 0; a < 3; ++a) {
+            count[a] = 0;
+            if (a >= p_.dim) {
+                cell[a][0] = ci[a];
+                shift[a][0] = 0.0;
+                count[a] = 1;
+                continue;
+            }
+            const bool periodic = a != 1 || p_.periodic_y;
+            for (int d = -1; d <= 1; ++d) {
+                if (only_axis == a && d != dir) continue;
+                std::int32_t c = ci[a] + d;
+                double s = 0.0;
+                if (c < 0 || c >= ncell_[a]) {
+                    if (!periodic) continue;
+                    s = c < 0 ? -p_.box[a] : p_.box[a];
+                    c += c < 0 ? ncell_[a] : -ncell_[a];
+                }
+                cell[a][count[a]] = c;
+                shift[a][count[a]++] = s;
+            }
+        }
+        for (int kz = 0; kz < count[2]; ++kz)
+            for (int ky = 0; ky < count[1]; ++ky)
+                for (int kx = 0; kx < count[0]; ++kx) {
+                    const std::int32_t c[3] = {cell[0][kx], cell[1][ky], cell[2][kz]};
+                    const double sh[3] = {shift[0][kx], shift[1][ky], shift[2][kz]};
+                    for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j])
+                        if (j != i) visit(j, sh, zero);
+                }
+        return;
+    }
+    // a row next to the Lees–Edwards boundary
     const int zr = p_.dim == 3 ? 1 : 0;
     for (int dz = -zr; dz <= zr; ++dz) {
         if (only_axis == 2 && dz != dir) continue;
@@ -464,7 +670,6 @@ void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& vis
             double shift[3] = {0.0, 0.0, 0.0}, vshift[3] = {0.0, 0.0, 0.0};
             int side = 0;
             if (c[1] < 0 || c[1] >= ncell_[1]) {
-                if (!p_.periodic_y) continue;
                 side = c[1] < 0 ? -1 : 1;
                 c[1] -= side * ncell_[1];
                 shift[1] = side * p_.box[1];
@@ -479,7 +684,7 @@ void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& vis
                 }
             }
             int x0 = ci[0] - 1, x1 = ci[0] + 1;
-            if (side != 0 && p_.shear_rate != 0.0) {
+            if (side != 0) {
                 shift[0] = side * le_delta(time_);
                 vshift[0] = side * p_.shear_rate * p_.box[1];
                 if (side > 0) {
@@ -505,10 +710,8 @@ void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& vis
                 }
                 const double s0 = shift[0] + wraps * p_.box[0];
                 const double sh[3] = {s0, shift[1], shift[2]};
-                for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j]) {
-                    if (j == i) continue;
-                    visit(j, sh, vshift);
-                }
+                for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j])
+                    if (j != i) visit(j, sh, vshift);
             }
         }
     }
@@ -545,7 +748,41 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             partner_count = count_[j];
         }
     };
-    if (gravity_) {
+    const std::int32_t* ci = &cell_[3 * i];
+    bool interior = !has_bumps_;
+    for (int a = 0; a < p_.dim; ++a) interior = interior && ci[a] >= 1 && ci[a] + 1 < ncell_[a];
+    if (interior) {
+        // the common case, batched: gather the candidates of the neighbouring cells (no image
+        // shifts), compute their collision times together (pair_times), keep the earliest
+        constexpr int kBatch = 64;
+        std::int32_t js[kBatch];
+        double ts[kBatch];
+        int nb = 0;
+        auto flush = [&]() {
+            if (nb == 0) return;
+            pair_times(gravity_, P_.data(), js, nb, xi, vi, ri, time_, p_.gravity, ts);
+            for (int q = 0; q < nb; ++q) {
+                const double t = ts[q];
+                const std::int32_t j = js[q];
+                if (t < best || (t == best && t < kInf && partner >= 0 && j < partner)) {
+                    best = t;
+                    partner = j;
+                    partner_count = count_[j];
+                }
+            }
+            nb = 0;
+        };
+        const std::int64_t base = cell_index(ci);
+        const int list = only_axis < 0 ? 0 : 1 + 2 * only_axis + (dir > 0);
+        const std::int64_t* off = nb_off_[list];
+        for (int k = 0, nk = n_nb_[list]; k < nk; ++k)
+            for (std::int32_t j = head_[base + off[k]]; j >= 0; j = next_[j]) {
+                if (j == i) continue;
+                js[nb++] = j;
+                if (nb == kBatch) flush();
+            }
+        flush();
+    } else if (gravity_) {
         const double* g = p_.gravity;
         std::int32_t kind = kNone;
         const double horizon = has_bumps_ ? next_boundary(i, kind) : kInf;
@@ -556,8 +793,8 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             double dr[3], dv[3];
             if (fixed_[j] != 0) {  // a static bump: the relative motion is a parabola
                 for (int a = 0; a < 3; ++a) {
-                    dr[a] = pj.x[a] + pj.v[a] * dtj + sh[a] - xi[a];
-                    dv[a] = pj.v[a] + vs[a] - vi[a];
+                    dr[a] = pj.x[a] + pj.v[a] * dtj + (sh ? sh[a] : 0.0) - xi[a];
+                    dv[a] = pj.v[a] + (sh ? vs[a] : 0.0) - vi[a];
                 }
                 const double t = bump_contact_time(dr, dv, minus_g, ri + pj.r,
                                                    std::min(horizon, best));
@@ -569,9 +806,14 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
                 return;
             }
             for (int a = 0; a < 3; ++a) {
-                dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj + sh[a] - xi[a];
-                dv[a] = pj.v[a] + g[a] * dtj + vs[a] - vi[a];
+                dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj - xi[a];
+                dv[a] = pj.v[a] + g[a] * dtj - vi[a];
             }
+            if (sh != nullptr)
+                for (int a = 0; a < 3; ++a) {
+                    dr[a] += sh[a];
+                    dv[a] += vs[a];
+                }
             consider(j, dr, dv);
         });
     } else {
@@ -580,9 +822,14 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             const double dtj = time_ - pj.t;
             double dr[3], dv[3];
             for (int a = 0; a < 3; ++a) {
-                dr[a] = pj.x[a] + pj.v[a] * dtj + sh[a] - xi[a];
-                dv[a] = pj.v[a] + vs[a] - vi[a];
+                dr[a] = pj.x[a] + pj.v[a] * dtj - xi[a];
+                dv[a] = pj.v[a] - vi[a];
             }
+            if (sh != nullptr)
+                for (int a = 0; a < 3; ++a) {
+                    dr[a] += sh[a];
+                    dv[a] += vs[a];
+                }
             consider(j, dr, dv);
         });
     }
@@ -607,10 +854,10 @@ void EventDriven::schedule(std::int32_t i) {
     const double best = next_boundary(i, kind);
     const double other = time_ + best;
     if (co_partner_[i] >= 0 && co_t_[i] <= other) {
-        heap_[pos_in_heap_[i]].t = co_t_[i];
+        node_at(pos_in_heap_[i]).t = co_t_[i];
         ev_partner_[i] = co_partner_[i];
     } else {
-        heap_[pos_in_heap_[i]].t = other;
+        node_at(pos_in_heap_[i]).t = other;
         ev_partner_[i] = kind;
     }
 }
@@ -710,36 +957,39 @@ void EventDriven::predict_rows() {
 
 void EventDriven::schedule_system() {
     ev_partner_[n_] = kReshuffle;
-    heap_[pos_in_heap_[n_]].t =
+    node_at(pos_in_heap_[n_]).t =
         p_.shear_rate != 0.0 ? le_t_ + cw_[0] / (p_.shear_rate * p_.box[1]) : kInf;
 }
 
 void EventDriven::heap_up(std::int64_t k) {
-    const Node node = heap_[k];
+    const Node node = node_at(k);
     while (k > 0) {
-        const std::int64_t parent = (k - 1) / 2;
-        if (!less(node, heap_[parent])) break;
-        heap_[k] = heap_[parent];
-        pos_in_heap_[heap_[k].i] = static_cast<std::int32_t>(k);
+        const std::int64_t parent = (k - 1) / kArity;
+        if (!less(node, node_at(parent))) break;
+        node_at(k) = node_at(parent);
+        pos_in_heap_[node_at(k).i] = static_cast<std::int32_t>(k);
         k = parent;
     }
-    heap_[k] = node;
+    node_at(k) = node;
     pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
 }
 
 void EventDriven::heap_down(std::int64_t k) {
-    const Node node = heap_[k];
+    const Node node = node_at(k);
     const std::int64_t n = n_ + 1;
     while (true) {
-        std::int64_t child = 2 * k + 1;
-        if (child >= n) break;
-        if (child + 1 < n && less(heap_[child + 1], heap_[child])) ++child;
-        if (!less(heap_[child], node)) break;
-        heap_[k] = heap_[child];
-        pos_in_heap_[heap_[k].i] = static_cast<std::int32_t>(k);
+        const std::int64_t first = kArity * k + 1;
+        if (first >= n) break;
+        const std::int64_t last = std::min(first + kArity, n);
+        std::int64_t child = first;
+        for (std::int64_t c = first + 1; c < last; ++c)
+            if (less(node_at(c), node_at(child))) child = c;
+        if (!less(node_at(child), node)) break;
+        node_at(k) = node_at(child);
+        pos_in_heap_[node_at(k).i] = static_cast<std::int32_t>(k);
         k = child;
     }
-    heap_[k] = node;
+    node_at(k) = node;
     pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
 }
 
@@ -752,7 +1002,7 @@ void EventDriven::heap_update(std::int32_t i) {
 
 // Re-establish the heap order of the node array (node times are current).
 void EventDriven::heap_build() {
-    for (std::int64_t k = (n_ + 1) / 2 - 1; k >= 0; --k) heap_down(k);
+    for (std::int64_t k = n_ > 0 ? (n_ - 1) / kArity : -1; k >= 0; --k) heap_down(k);
 }
 
 // Collisional stress per bin along y: r_ij ⊗ J_i shared among the bins the branch r_i → r_j
@@ -1052,8 +1302,8 @@ bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t sto
             reached = false;
             break;
         }
-        const std::int32_t i = heap_[0].i;
-        const double et = heap_[0].t;
+        const std::int32_t i = node_at(0).i;
+        const double et = node_at(0).t;
         if (!(et <= t)) break;
         if (events() - sorted_at_ >= kSortEvery * n_) {
             for (std::int32_t k = 0; k < static_cast<std::int32_t>(n_); ++k) advance(k, time_);
@@ -1130,9 +1380,11 @@ void EventDriven::reorder() {
         permute(ev_partner_, 1);
         ev_partner_.push_back(sys_p);
     }
-    for (auto& node : heap_)
+    for (std::int64_t k = 0; k <= n_; ++k) {
+        Node& node = node_at(k);
         if (node.i < static_cast<std::int32_t>(n_)) node.i = inv[static_cast<std::size_t>(node.i)];
-    for (std::size_t k = 0; k < heap_.size(); ++k) pos_in_heap_[heap_[k].i] = static_cast<std::int32_t>(k);
+        pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
+    }
     for (std::size_t k = 0; k < N; ++k) {
         if (co_partner_[k] >= 0) co_partner_[k] = inv[static_cast<std::size_t>(co_partner_[k])];
         if (ev_partner_[k] >= 0) ev_partner_[k] = inv[static_cast<std::size_t>(ev_partner_[k])];
@@ -1183,7 +1435,7 @@ double EventDriven::scale_width(double factor) {
             for_neighbours(i, -1, 0, [&](std::int32_t j, const double* sh, const double*) {
                 if (j <= i || (fixed_[i] != 0 && fixed_[j] != 0)) return;
                 double dr[3];
-                for (int a = 0; a < 3; ++a) dr[a] = P_[j].x[a] + sh[a] - P_[i].x[a];
+                for (int a = 0; a < 3; ++a) dr[a] = P_[j].x[a] + (sh ? sh[a] : 0.0) - P_[i].x[a];
                 const double sigma = P_[i].r + P_[j].r + 1e-9;
                 const double need = sigma * sigma - dr[1] * dr[1] - dr[2] * dr[2];
                 if (need > 0.0 && dr[0] != 0.0)
@@ -1277,20 +1529,20 @@ EventDriven::State EventDriven::get_state() const {
             s.vel[3 * i + a] = v[a];
         }
     }
-    s.omega = w_;
-    s.last = last_;
-    s.count = count_;
-    s.cell = cell_;
+    s.omega.assign(w_.begin(), w_.end());
+    s.last.assign(last_.begin(), last_.end());
+    s.count.assign(count_.begin(), count_.end());
+    s.cell.assign(cell_.begin(), cell_.end());
     s.ev_time.resize(N + 1);
     s.ev_count.assign(N + 1, 0);
     for (std::size_t i = 0; i <= N; ++i) {
-        s.ev_time[i] = heap_[pos_in_heap_[i]].t;
+        s.ev_time[i] = node_at(pos_in_heap_[i]).t;
         if (i < N && ev_partner_[i] >= 0) s.ev_count[i] = co_count_[i];
     }
-    s.ev_partner = ev_partner_;
-    s.co_time = co_t_;
-    s.co_partner = co_partner_;
-    s.co_count = co_count_;
+    s.ev_partner.assign(ev_partner_.begin(), ev_partner_.end());
+    s.co_time.assign(co_t_.begin(), co_t_.end());
+    s.co_partner.assign(co_partner_.begin(), co_partner_.end());
+    s.co_count.assign(co_count_.begin(), co_count_.end());
     s.stress = stress_;
     s.scalars = {time_, dissipated_, gravity_work_, p_.box[0], le_t_,
                  static_cast<double>(le_cell_)};
@@ -1354,10 +1606,10 @@ void EventDriven::set_state(const State& s) {
             P_[i].v[a] = s.vel[3 * i + a];
             P_[i].t = t;
         }
-    w_ = s.omega;
-    last_ = s.last;
-    count_ = s.count;
-    cell_ = s.cell;
+    w_.assign(s.omega.begin(), s.omega.end());
+    last_.assign(s.last.begin(), s.last.end());
+    count_.assign(s.count.begin(), s.count.end());
+    cell_.assign(s.cell.begin(), s.cell.end());
     stress_ = s.stress;
     time_ = t;
     dissipated_ = s.scalars[1];
@@ -1416,13 +1668,13 @@ void EventDriven::set_state(const State& s) {
     build_cells();
     if (events) {
         for (std::int32_t k = 0; k <= static_cast<std::int32_t>(n_); ++k) {
-            heap_[k] = Node{s.ev_time[k], k};
+            node_at(k) = Node{s.ev_time[k], k};
             pos_in_heap_[k] = k;
         }
-        ev_partner_ = s.ev_partner;
-        co_t_ = s.co_time;
-        co_partner_ = s.co_partner;
-        co_count_ = s.co_count;
+        ev_partner_.assign(s.ev_partner.begin(), s.ev_partner.end());
+        co_t_.assign(s.co_time.begin(), s.co_time.end());
+        co_partner_.assign(s.co_partner.begin(), s.co_partner.end());
+        co_count_.assign(s.co_count.begin(), s.co_count.end());
     } else {
         predict_all();
         schedule_system();
@@ -1450,7 +1702,7 @@ double EventDriven::min_gap() const {
             double xj[3], vj[3];
             state_at(j, time_, xj, vj);
             double dr[3];
-            for (int a = 0; a < 3; ++a) dr[a] = xj[a] + sh[a] - xi[a];
+            for (int a = 0; a < 3; ++a) dr[a] = xj[a] + (sh ? sh[a] : 0.0) - xi[a];
             best = std::min(best, std::sqrt(dot3(dr, dr)) - P_[i].r - P_[j].r);
         });
     }
