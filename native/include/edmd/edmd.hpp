@@ -124,6 +124,9 @@ struct alignas(64) PairRecord {
 void pair_times(bool gravity, const PairRecord* P, const std::int32_t* js, int n,
                 const double* xi, const double* vi, double ri, double now, const double* g,
                 double* out);
+// Use the AVX2 pair times when the CPU has them (the default); returns whether they are used.
+// For tests: both settings give the same bits.
+bool set_pair_simd(bool enabled) noexcept;
 
 // Post-collision velocities of one contact. n: unit normal from i to j; im_j = 0 for a wall
 // (then vj is the wall's velocity and wj is ignored). Returns the impulse J on i (j gets −J).

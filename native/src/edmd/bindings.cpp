@@ -238,6 +238,9 @@ nb::tuple collide_py(std::vector<double> n, double ri, double rj, double mi, dou
 }  // namespace
 
 void bind(nb::module_& m) {
+    m.def("edmd_set_simd", &set_pair_simd, "enabled"_a,
+          "Use the AVX2 pair-time kernel of the event-driven engine when the CPU has it "
+          "(default); returns whether it is used. Both give identical bits (for tests).");
     m.def("edmd_collide_pair", &collide_py, "n"_a, "ri"_a, "rj"_a, "mi"_a, "mj"_a, "inertia_k"_a,
           "e"_a, "beta"_a, "vi"_a, "vj"_a, "wi"_a, "wj"_a,
           "One hard-particle collision (n: unit normal from i to j, 3 components; spins as "

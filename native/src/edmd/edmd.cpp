@@ -241,17 +241,27 @@ __attribute__((target("avx2"))) void pair_times_avx2(const PairRecord* P, const 
 }
 
 bool cpu_has_avx2() noexcept { return __builtin_cpu_supports("avx2"); }
+bool g_pair_simd = cpu_has_avx2();
 #endif
 
 }  // namespace
+
+bool set_pair_simd(bool enabled) noexcept {
+#ifdef DEMSTUDY_EDMD_AVX2
+    g_pair_simd = enabled && cpu_has_avx2();
+    return g_pair_simd;
+#else
+    (void)enabled;
+    return false;
+#endif
+}
 
 void pair_times(bool gravity, const PairRecord* P, const std::int32_t* js, int n,
                 const double* xi, const double* vi, double ri, double now, const double* g,
                 double* out) {
     const double hg[3] = {0.5 * g[0], 0.5 * g[1], 0.5 * g[2]};
 #ifdef DEMSTUDY_EDMD_AVX2
-    static const bool avx2 = cpu_has_avx2();
-    if (avx2) {
+    if (g_pair_simd) {
         if (gravity)
             pair_times_avx2<true>(P, js, n, xi, vi, ri, now, g, hg, out);
         else
