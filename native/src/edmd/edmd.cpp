@@ -788,6 +788,8 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
         for (int k = 0, nk = n_nb_[list]; k < nk; ++k)
             for (std::int32_t j = head_[base + off[k]]; j >= 0; j = next_[j]) {
                 if (j == i) continue;
+                // issued while the lists are walked, the misses on the records overlap
+                __builtin_prefetch(&P_[j]);
                 js[nb++] = j;
                 if (nb == kBatch) flush();
             }
@@ -991,6 +993,11 @@ void EventDriven::heap_down(std::int64_t k) {
         const std::int64_t first = kArity * k + 1;
         if (first >= n) break;
         const std::int64_t last = std::min(first + kArity, n);
+        // the next level's candidate lines (the children of these children): their misses
+        // overlap with this level's comparisons
+        const std::int64_t next_first = kArity * first + 1;
+        for (std::int64_t c = 0; c < kArity && next_first + kArity * c < n; ++c)
+            __builtin_prefetch(&node_at(next_first + kArity * c));
         std::int64_t child = first;
         for (std::int64_t c = first + 1; c < last; ++c)
             if (less(node_at(c), node_at(child))) child = c;
