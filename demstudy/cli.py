@@ -188,8 +188,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("source", help="RUN.h5 (run with --keep-frames) or a LAMMPS dump")
     p.add_argument("--scene", help="the scene (needed for dumps; default for RUN.h5: its own)")
     p.add_argument("--what", default="profiles",
-                   help="comma-separated: profiles, vdf, gr, angles, stress, vcorr, lambda, "
-                        "waves, cgprofiles (default: profiles)")
+                   help="comma-separated: profiles, vdf, gr, angles, freepath, stress, vcorr, "
+                        "lambda, waves, cgprofiles (default: profiles)")
     p.add_argument("--z-cells", type=int, default=1, metavar="N",
                    help="3D: Malik's cells, fluctuations about the means of N z-slabs of each "
                         "y-bin for profiles (added cell_temperature*), vdf, vcorr, lambda "

@@ -1,4 +1,5 @@
-"""Collision-angle distribution P(theta) per y-bin from a collision log (Campbell 1982).
+"""Collision-angle distribution P(theta) (Campbell 1982) and free paths (Malik 2008) per y-bin
+from a collision log.
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 
@@ -33,12 +34,24 @@ length R, or with the mean spacing C = R sqrt(pi/nu) (text) / C/2 (listing).
 chunks* (mappings with the datasets above, one per time window) instead of frames; per-chunk
 histograms go to a block accumulator, so the errors are block-averaged over chunks (make
 chunks longer than the correlation time of the collision statistics).
+
+Free paths (:func:`free_flights`, :func:`flight_chunks`, :class:`FreePath`): the reading is
+*every particle's flights, path measured centre to centre*: each particle's consecutive
+logged collisions (pairs as i or j via the ``i``, ``j`` datasets, walls and bumps as i) bound
+a flight of exact duration tau; lambda is the distance its centre travels (the chord through
+the nearest periodic image, Lees–Edwards offset included; the parabola's arc length under
+gravity). The log must hold every collision (``log_every`` = 1). Censored flights (before a
+particle's first and after its last logged collision) are dropped, and only flights starting
+a horizon before the log's end count, longer ones weighted, so that the window's censoring
+does not favour short flights; flights longer than the window are never seen. Malik's
+Kn = <lambda>/W is stored per bin with W; with profiles, Enskog's references
+(:func:`demstudy.theory.mean_free_path`, 1/:func:`demstudy.theory.collision_frequency`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -50,13 +63,17 @@ from demstudy import UNITS_NOTE
 from demstudy.analysis import derived as dv
 from demstudy.analysis.base import AnalysisBase
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
-from demstudy.theory import corrected_s, savage_jeffrey
+from demstudy.theory import collision_frequency, corrected_s, mean_free_path, savage_jeffrey
 
 __all__ = [
     "CONVENTIONS",
     "CollisionAngles",
+    "FreePath",
     "collision_angles",
     "collision_chunks",
+    "flight_chunks",
+    "flight_length",
+    "free_flights",
     "savage_jeffrey_projected",
 ]
 
@@ -209,3 +226,277 @@ def collision_chunks(log: Mapping[str, Any], n_chunks: int = 64,
         sel = keep & (which == c)
         if np.any(sel):
             yield {k: np.asarray(v)[sel] for k, v in log.items()}
+
+
+# -- free paths ------------------------------------------------------------------------------
+
+def flight_length(delta: ArrayLike, tau: ArrayLike,
+                  gravity: ArrayLike | None = None) -> np.ndarray:
+    """Distance travelled along each flight (M,) from its end-to-end displacement ``delta``
+    (M, dim) and duration ``tau`` (M,): the chord |delta| without gravity; with gravity g the
+    exact arc length of the parabola, int_0^tau |v1 + g s| ds with v1 = delta/tau - g tau/2
+    (the only parabola through both ends in that time). With a = v1.g^, b = |v1 - a g^| the
+    speed is sqrt(b^2 + u^2), u = a + |g| s, whose integral is F(u) = (u sqrt(u^2 + b^2)
+    + b^2 asinh(u/b)) / 2 (F = u|u|/2 for b = 0: a vertical flight up and down)."""
+    d, t = np.asarray(delta, float), np.asarray(tau, float)
+    chord = np.linalg.norm(d, axis=1)
+    if gravity is None or not np.any(gravity):
+        return chord
+    g = np.asarray(gravity, float)[: d.shape[1]]
+    gm = float(np.linalg.norm(g))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v1 = d / t[:, None] - 0.5 * g * t[:, None]
+        a = v1 @ (g / gm)
+        b = np.linalg.norm(v1 - a[:, None] * (g / gm), axis=1)
+
+        def antiderivative(u: np.ndarray) -> np.ndarray:
+            tail = np.where(b > 0, b**2 * np.arcsinh(u / np.where(b > 0, b, 1.0)), 0.0)
+            return 0.5 * (u * np.hypot(u, b) + tail)
+
+        arc = (antiderivative(a + gm * t) - antiderivative(a)) / gm
+    return np.where(t > 0, arc, chord)  # tau = 0: no flight (simultaneous collisions)
+
+
+def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
+                 gravity: ArrayLike | None = None,
+                 shear_offset: Callable[[np.ndarray], np.ndarray] | None = None,
+                 x_period: Callable[[np.ndarray], np.ndarray] | None = None,
+                 start: float = 0.0) -> dict[str, Any]:
+    """Every particle's free flights between consecutive logged collisions.
+
+    ``log``: the ``/collisions`` datasets with ``i``, ``j`` (every collision: ``log_every`` =
+    1); ``radius`` (N,): radii of the mobile particles in input order; ``periods`` (dim,):
+    period of each axis, 0 when not periodic; ``shear_offset(t)``: Lees–Edwards x offset of
+    the image above at time t; ``x_period(t)``: the x period at t when it changes (servo);
+    records before ``start`` are ignored. A particle collides as i (pairs and walls, bumps
+    included) or as j (pairs); its centre is contact - r_i n (i) or that + branch (j, the
+    engine's own image vector). A flight runs from one collision of a particle to its next:
+    tau = t2 - t1 exactly, the displacement is the nearest periodic image of c2 - c1 (a y wrap
+    under Lees–Edwards also shifts x by the offset at t2; the image of a flight longer than
+    half a period along an axis is taken as the shorter one: keep the periods >> lambda) and
+    lambda = :func:`flight_length`. Censored flights (before a particle's first logged
+    collision, after its last) are dropped.
+
+    Returns ``t0``, ``t1`` (the logged window), ``collisions`` (particle collisions: 2 per
+    pair, 1 per wall), ``event_time``, ``event_y`` (every particle collision: time, centre y)
+    and per flight ``particle``, ``start_time``, ``tau``, ``length``, ``start`` (M, dim)
+    starting centre, ``y_wrapped`` (crossed the y period)."""
+    if "i" not in log or "j" not in log:
+        raise ValueError("the collision log has no particle indices i, j (an older results "
+                         "file): free paths need them")
+    t = np.asarray(log["time"], float)
+    keep = t >= start
+    if not np.any(keep):
+        raise ValueError("the collision log holds no collisions after the start time")
+    t = t[keep]
+    kind = np.asarray(log["kind"])[keep]
+    i = np.asarray(log["i"])[keep].astype(np.intp)
+    j = np.asarray(log["j"])[keep].astype(np.intp)
+    n = np.asarray(log["normal"], float)[keep]
+    r = np.asarray(radius, float)
+    c_i = np.asarray(log["position"], float)[keep] - r[i][:, None] * n
+    pair = kind == PAIR
+    c_j = c_i[pair] + np.asarray(log["branch"], float)[keep][pair]
+    who = np.concatenate([i, j[pair]])
+    when = np.concatenate([t, t[pair]])
+    where = np.concatenate([c_i, c_j])
+    order = np.lexsort((np.arange(who.size), when, who))  # by particle, then in time
+    who, when, where = who[order], when[order], where[order]
+    nxt = np.flatnonzero(who[1:] == who[:-1])  # flight from event k to event k + 1
+    tau = when[nxt + 1] - when[nxt]
+    delta = where[nxt + 1] - where[nxt]
+    per = np.asarray(periods, float)
+    wrapped = np.zeros(tau.size, bool)
+    if per[1] > 0:  # y first: a Lees–Edwards wrap moves the image along x
+        k = np.rint(-delta[:, 1] / per[1])
+        delta[:, 1] += k * per[1]
+        wrapped = k != 0
+        if shear_offset is not None:
+            delta[:, 0] += k * shear_offset(when[nxt + 1])
+    for a in (0, 2)[: delta.shape[1] - 1]:
+        if per[a] > 0:
+            length = x_period(when[nxt + 1]) if a == 0 and x_period is not None else per[a]
+            delta[:, a] -= length * np.rint(delta[:, a] / length)
+    y = where[:, 1] if per[1] == 0 else np.mod(where[:, 1], per[1])
+    return {"t0": float(t.min()), "t1": float(t.max()),
+            "collisions": int(2 * pair.sum() + (~pair).sum()),
+            "event_time": when, "event_y": y,
+            "particle": who[nxt], "start_time": when[nxt], "tau": tau,
+            "length": flight_length(delta, tau, gravity),
+            "start": np.column_stack([where[nxt, :1], y[nxt], where[nxt, 2:]]),
+            "y_wrapped": wrapped}
+
+
+def flight_chunks(flights: Mapping[str, Any], n_chunks: int = 64,
+                  horizon: float | None = None) -> Iterator[dict[str, Any]]:
+    """Split :func:`free_flights` into ``n_chunks`` equal windows of starting times over
+    [t0, t1 - h] (flights by start time, collisions by time; empty windows kept, so that
+    every chunk lasts ``duration``). A flight of duration tau is seen only if it ends by t1:
+    with starts up to t1 - h every flight with tau <= h is (so each chunk samples the same
+    distribution and the chunk-to-chunk scatter is statistical); a longer one only if it
+    starts in the first T - tau of the window, T = t1 - t0, and gets the weight
+    (T - h) / (T - tau) for the ones missed. ``horizon`` h: default 8 x the mean duration
+    of the complete flights, at most T/4."""
+    t0, t1 = float(flights["t0"]), float(flights["t1"])
+    span = t1 - t0
+    tau = np.asarray(flights["tau"], float)
+    if span <= 0 or tau.size == 0:
+        raise ValueError("the collision log spans no time or holds no complete flight")
+    h = min(8.0 * float(tau.mean()), 0.25 * span) if horizon is None else float(horizon)
+    if not 0 <= h < span:
+        raise ValueError(f"horizon {h} must be in [0, {span})")
+    bounds = np.linspace(t0, t1 - h, n_chunks + 1)
+
+    def which(t: np.ndarray) -> np.ndarray:  # -1 / n_chunks: outside the start window
+        k = np.searchsorted(bounds, t, side="right") - 1
+        return np.where(t == bounds[-1], n_chunks - 1, k)
+
+    weight = np.where(tau <= h, 1.0, (span - h) / np.maximum(span - tau, np.finfo(float).tiny))
+    f_chunk, e_chunk = which(np.asarray(flights["start_time"])), which(flights["event_time"])
+    y, ey = np.asarray(flights["start"], float)[:, 1], np.asarray(flights["event_y"], float)
+    for c in range(n_chunks):
+        sel, ev = f_chunk == c, e_chunk == c
+        yield {"y": y[sel], "length": np.asarray(flights["length"])[sel], "tau": tau[sel],
+               "weight": weight[sel], "event_y": ey[ev], "duration": (span - h) / n_chunks,
+               "horizon": h}
+
+
+class FreePath(AnalysisBase):
+    """Free-path and free-time distributions per y-bin, fed with :func:`flight_chunks`.
+
+    Reading: every particle's flights (each particle's consecutive collisions, pairs as i or
+    j and walls), path measured centre to centre (the arc length under gravity), binned by
+    the y of the flight's starting centre, starting up to a horizon before the log's end
+    (flights longer than it weighted against the window's censoring, :func:`flight_chunks`).
+    Per bin: P(lambda), P(tau) (normalised over
+    every flight of the bin, so flights beyond ``lambda_max`` / ``tau_max`` leave the area
+    short by their fraction), <lambda>, <tau>, the moment ratios <x^2>/<x>^2 (2 for an
+    exponential), Kn = <lambda>/``width`` and the collision rate (particle collisions whose
+    centre is in the bin, per unit time); errors by jackknife over blocks of chunks.
+
+    Parameters
+    ----------
+    edges: y-bin edges; lambda_max, tau_max: histogram ranges (n_hist bins from 0);
+    width: the length of Kn (wall gap, periodic height or flow depth); dim: 2 or 3.
+    """
+
+    _SUMS = ("weight", "weight_length", "weight_length2", "weight_tau", "weight_tau2",
+             "events", "flights")
+
+    def __init__(self, edges: ArrayLike, lambda_max: float, tau_max: float, width: float,
+                 n_hist: int = 50, dim: int = 3, max_blocks: int = 64,
+                 verbose: bool = False) -> None:
+        super().__init__(verbose=verbose)
+        self.edges = np.asarray(edges, float)
+        if self.edges.ndim != 1 or self.edges.size < 2 or np.any(np.diff(self.edges) <= 0):
+            raise ValueError("edges must be increasing with at least 2 entries")
+        if dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        if not (lambda_max > 0 and tau_max > 0 and width > 0):
+            raise ValueError("lambda_max, tau_max and width must be > 0")
+        self.n_bins, self.n_hist, self.dim = self.edges.size - 1, int(n_hist), dim
+        self.width = float(width)
+        self.lambda_edges = np.linspace(0.0, lambda_max, self.n_hist + 1)
+        self.tau_edges = np.linspace(0.0, tau_max, self.n_hist + 1)
+        self._size = self.n_bins * self.n_hist
+        self._acc = BlockAccumulator(2 * self._size + len(self._SUMS) * self.n_bins, max_blocks)
+        self.duration = self.horizon = float("nan")
+        self.n_flights = 0
+
+    def _hist(self, ybin: np.ndarray, x: np.ndarray, edges: np.ndarray,
+              w: np.ndarray) -> np.ndarray:
+        k = np.searchsorted(edges, x, side="right") - 1
+        ok = (k >= 0) & (k < self.n_hist)
+        return np.bincount(ybin[ok] * self.n_hist + k[ok], w[ok], minlength=self._size)
+
+    def _ybin(self, y: np.ndarray) -> np.ndarray:
+        return np.searchsorted(self.edges, y, side="right") - 1
+
+    def _single_frame(self, chunk: Mapping[str, Any]) -> None:  # type: ignore[override]
+        self.duration, self.horizon = float(chunk["duration"]), float(chunk["horizon"])
+        ybin = self._ybin(np.asarray(chunk["y"], float))
+        ok = (ybin >= 0) & (ybin < self.n_bins)
+        ybin = ybin[ok]
+        lam, tau = np.asarray(chunk["length"], float)[ok], np.asarray(chunk["tau"], float)[ok]
+        w = np.asarray(chunk["weight"], float)[ok]
+        ebin = self._ybin(np.asarray(chunk["event_y"], float))
+        ebin = ebin[(ebin >= 0) & (ebin < self.n_bins)]
+        nb = self.n_bins
+        sums = [np.bincount(ybin, v, minlength=nb) for v in (w, w * lam, w * lam**2, w * tau,
+                                                             w * tau**2)]
+        sums += [np.bincount(ebin, minlength=nb), np.bincount(ybin, minlength=nb)]
+        self._acc.add(np.concatenate([self._hist(ybin, lam, self.lambda_edges, w),
+                                      self._hist(ybin, tau, self.tau_edges, w), *sums]))
+        self.n_flights += int(ok.sum())
+
+    def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
+        nb, nh, size = self.n_bins, self.n_hist, self._size
+        s = dict(zip(self._SUMS, mean[2 * size:].reshape(len(self._SUMS), nb), strict=True))
+        w, wl, wl2, wt, wt2 = (s[k] for k in self._SUMS[:5])
+        tot = {k: v.sum() for k, v in s.items()}
+        return {
+            "p_lambda": mean[:size].reshape(nb, nh) / (w[:, None] * np.diff(self.lambda_edges)),
+            "p_tau": mean[size:2 * size].reshape(nb, nh) / (w[:, None] * np.diff(self.tau_edges)),
+            "mean_free_path": wl / w, "mean_free_time": wt / w,
+            "lambda_ratio": wl2 * w / wl**2, "tau_ratio": wt2 * w / wt**2,
+            "knudsen": wl / w / self.width,
+            "collision_rate": s["events"] / self.duration,
+            "all_mean_free_path": np.asarray(tot["weight_length"] / tot["weight"]),
+            "all_mean_free_time": np.asarray(tot["weight_tau"] / tot["weight"]),
+            "all_lambda_ratio": np.asarray(tot["weight_length2"] * tot["weight"]
+                                           / tot["weight_length"] ** 2),
+            "all_tau_ratio": np.asarray(tot["weight_tau2"] * tot["weight"]
+                                        / tot["weight_tau"] ** 2),
+        }
+
+    def _conclude(self) -> None:
+        est, err = jackknife(self._acc, self._estimate)
+        total = self._acc.total
+        nb, size = self.n_bins, self._size
+        counts = total[2 * size:].reshape(len(self._SUMS), nb)
+        self.results = {
+            "edges": self.edges, "y": 0.5 * (self.edges[1:] + self.edges[:-1]),
+            "lambda_edges": self.lambda_edges, "tau_edges": self.tau_edges,
+            "lambda": 0.5 * (self.lambda_edges[1:] + self.lambda_edges[:-1]),
+            "tau": 0.5 * (self.tau_edges[1:] + self.tau_edges[:-1]),
+            "flights": counts[self._SUMS.index("flights")],
+            "collisions": counts[self._SUMS.index("events")],
+        }
+        for key, value in est.items():
+            self.results[key], self.results[f"{key}_err"] = value, err[key]
+        self.attrs = {
+            "dim": self.dim, "n_hist": self.n_hist, "chunks": self.n_frames,
+            "chunk_duration": self.duration, "horizon": self.horizon,
+            "flights_total": self.n_flights,
+            "block_length": self._acc.block_length, "n_blocks": self._acc.n_blocks,
+            "knudsen_width": self.width,
+            "reading": "every particle's flights between consecutive collisions (pairs as i "
+                       "or j, walls and bumps), centre to centre (arc length under gravity), "
+                       "binned by the starting centre's y; starts up to t1 - horizon, flights "
+                       "longer than the horizon weighted (T - horizon)/(T - tau) for the "
+                       "window's censoring",
+            "units": "lambda in d, tau and 1/rate in particle time units; " + UNITS_NOTE,
+        }
+
+    def overlay(self, profiles: Mapping[str, Any], cross_section: float) -> None:
+        """Enskog references per bin from ``profiles`` (same y-bins): ``lambda_enskog``
+        (mean_free_path at the bin's solid fraction), ``tau_enskog`` (1/collision_frequency
+        at its solid fraction and temperature), ``knudsen_enskog``, and the measured
+        ``collision_frequency`` = collision_rate / (n V_bin), V_bin = bin width x
+        ``cross_section``."""
+        if not self._finished:
+            raise RuntimeError("call finish() before overlay()")
+        y = np.asarray(profiles["y"], float)
+        if y.shape != self.results["y"].shape or not np.allclose(y, self.results["y"]):
+            raise ValueError("the profiles must use the same y-bins as the free paths")
+        nu = np.asarray(profiles["solid_fraction"], float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.results["lambda_enskog"] = mean_free_path(nu, self.dim)
+            self.results["tau_enskog"] = 1.0 / collision_frequency(
+                nu, np.asarray(profiles["temperature"], float), self.dim)
+            self.results["knudsen_enskog"] = dv.knudsen_enskog(dict(profiles), self.width)
+            if "number_density" in profiles:
+                volume = np.diff(self.edges) * cross_section
+                n = np.asarray(profiles["number_density"], float) * volume
+                self.results["collision_frequency"] = self.results["collision_rate"] / n
+                self.results["collision_frequency_err"] = self.results["collision_rate_err"] / n

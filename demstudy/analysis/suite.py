@@ -8,13 +8,17 @@ engine and every frame source (in-memory capture, dumps, stored frames) are comp
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
 from typing import Any
+
+import numpy as np
 
 from ..io.frames import Frame
 from ..scene import Scene
 from .coarse_graining import CoarseGrainedProfiles
-from .collisions import CollisionAngles, collision_chunks
+from .collisions import CollisionAngles, FreePath, collision_chunks, flight_chunks, free_flights
+from .derived import campbell_depth
 from .pair_correlation import PairCorrelation
 from .profiles import ProfileAnalysis
 from .stress import stress_results
@@ -24,8 +28,8 @@ from .velocity_correlation import orientational_correlation, velocity_correlatio
 from .waves import DensityWaves
 
 #: Statistics ``demstudy analyze --what`` can compute from frames.
-AVAILABLE = ("profiles", "vdf", "gr", "structure", "angles", "stress", "vcorr", "lambda",
-             "waves", "cgprofiles")
+AVAILABLE = ("profiles", "vdf", "gr", "structure", "angles", "freepath", "stress", "vcorr",
+             "lambda", "waves", "cgprofiles")
 #: Those that take Malik's cells (``z_cells``: fluctuations about y-bin × z-slab means).
 Z_CELLS = ("profiles", "vdf", "vcorr", "lambda")
 
@@ -102,6 +106,8 @@ def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
                                          y_mid=y_mid).run(frames()).finish()
         elif name == "angles":
             ana = collision_angle_analysis(scene, results)
+        elif name == "freepath":
+            ana = free_path_analysis(scene, results)
         elif name == "stress":
             data, attrs = stress_from_results(scene, results)
             out[name] = (data, attrs)
@@ -140,6 +146,82 @@ def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> 
     ana.run(collision_chunks(log, n_chunks, start))
     if res.profiles and scene.measure.axis == "y":
         ana.overlay(res.profiles)
+    return ana
+
+
+def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> FreePath:
+    """Free paths and times per profile bin from the ``/collisions`` log (every collision
+    needed: ``log_every`` = 1), radii from the scene's initial state, Kn with the wall gap
+    (or the periodic height; an open top: Campbell's flow depth from the profiles), Enskog
+    references when the file's profiles use the same bins."""
+    from ..scene.initial import build_initial_state  # only this statistic needs the radii
+
+    res = _need_results(results, "freepath")
+    log = res.groups.get("collisions")
+    if not log:
+        raise ValueError("--what freepath: the results file has no /collisions log "
+                         "(event-driven runs write it when the scene measures angles)")
+    every = int(res.group_attrs.get("collisions", {}).get("log_every", 1))
+    if every != 1:
+        raise ValueError(f"--what freepath: the log keeps every {every}th collision; free "
+                         "paths need every collision (run with log_every = 1)")
+    dim = scene.dimension
+    radius = build_initial_state(scene).diameter / 2
+    periods = [scene.box.size[a] if "xyz"[a] in scene.periodic else 0.0 for a in range(dim)]
+    ts = res.timeseries
+    offset = x_period = None
+    if scene.shear is not None and scene.y_periodic:
+        shear, ly = scene.shear.rate, scene.box.size[1]
+        t_s = np.asarray(ts.get("time", [0.0]), float)
+        tilt = np.asarray(ts.get("tilt", np.zeros(t_s.size)), float)
+
+        def offset(t: np.ndarray) -> np.ndarray:  # exactly linear from the last sample
+            k = np.clip(np.searchsorted(t_s, t, side="right") - 1, 0, t_s.size - 1)
+            return tilt[k] + shear * ly * (t - t_s[k])
+    if "width" in ts:  # servo: the x period follows the gap
+        def x_period(t: np.ndarray) -> np.ndarray:
+            return np.interp(t, np.asarray(ts["time"], float), np.asarray(ts["width"], float))
+    start = float(res.attrs.get("equilibration_end", 0.0))
+    flights = free_flights(log, radius, periods, scene.gravity_vector, offset, x_period, start)
+    lo, hi, _period = profile_bounds(scene)
+    along_y = scene.measure.axis == "y"
+    if not along_y:  # flights are binned along y whatever the profile axis
+        lo, hi = 0.0, scene.box.size[1]
+    edges = res.profiles.get("edges") if along_y else None
+    if edges is None:
+        n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
+        edges = np.linspace(lo, hi, n_bins + 1)
+    width = hi - lo
+    if scene.has_open_top and res.profiles:
+        width = campbell_depth(res.profiles, scene.wall_position("lower"))
+    lam, tau = flights["length"], flights["tau"]
+    if lam.size == 0:
+        raise ValueError("--what freepath: no particle collides twice in the logged window")
+    ana = FreePath(edges, lambda_max=8 * float(lam.mean()), tau_max=8 * float(tau.mean()),
+                   width=width, dim=dim)
+    ana.run(flight_chunks(flights, n_chunks))
+    span = flights["t1"] - flights["t0"]
+    shortest = min(p for p in periods if p > 0)  # x is always periodic
+    omega = flights["collisions"] / (radius.size * span)
+    ana.attrs.update({
+        "window_start": flights["t0"], "window_end": flights["t1"],
+        "collisions_logged": flights["collisions"], "particles": radius.size,
+        "measured_collision_frequency": omega,
+        "mean_free_time_over_window": float(tau.mean()) / span,
+        "y_wrapped_flights": int(flights["y_wrapped"].sum()),
+        "gravity": "arc length of the parabola" if scene.gravity else "none: chord",
+        "knudsen_width_is": "flow depth (campbell_depth)" if scene.has_open_top and res.profiles
+                            else "wall gap" if not scene.y_periodic else "periodic height",
+        "shortest_period": shortest,
+        # nearest images: a flight longer than half a period along an axis is aliased; the
+        # share of an exponential P(lambda) beyond half the shortest period bounds it
+        "alias_fraction_bound": math.exp(-0.5 * shortest / float(lam.mean())),
+    })
+    if res.profiles and along_y:
+        section = math.prod(s for a, s in enumerate(scene.box.size[:dim]) if a != 1)
+        if x_period is not None:
+            section *= float(np.mean(ts["width"])) / scene.box.size[0]
+        ana.overlay(res.profiles, section)
     return ana
 
 
