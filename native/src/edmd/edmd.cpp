@@ -660,14 +660,30 @@ void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& vis
                 shift[a][count[a]++] = s;
             }
         }
+        // two passes, as in the batched scan: walk the lists prefetching the records, then
+        // visit (the misses overlap)
+        constexpr int kBatch = 64;
+        std::int32_t js[kBatch];
+        double shs[kBatch][3];
+        int nb = 0;
         for (int kz = 0; kz < count[2]; ++kz)
             for (int ky = 0; ky < count[1]; ++ky)
                 for (int kx = 0; kx < count[0]; ++kx) {
                     const std::int32_t c[3] = {cell[0][kx], cell[1][ky], cell[2][kz]};
-                    const double sh[3] = {shift[0][kx], shift[1][ky], shift[2][kz]};
-                    for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j])
-                        if (j != i) visit(j, sh, zero);
+                    for (std::int32_t j = head_[cell_index(c)]; j >= 0; j = next_[j]) {
+                        if (j == i) continue;
+                        __builtin_prefetch(&P_[j]);
+                        js[nb] = j;
+                        shs[nb][0] = shift[0][kx];
+                        shs[nb][1] = shift[1][ky];
+                        shs[nb][2] = shift[2][kz];
+                        if (++nb == kBatch) {
+                            for (int q = 0; q < nb; ++q) visit(js[q], shs[q], zero);
+                            nb = 0;
+                        }
+                    }
                 }
+        for (int q = 0; q < nb; ++q) visit(js[q], shs[q], zero);
         return;
     }
     // a row next to the Lees–Edwards boundary
@@ -768,6 +784,7 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
         std::int32_t js[kBatch];
         double ts[kBatch];
         int nb = 0;
+        const std::int32_t stored = partner;
         auto flush = [&]() {
             if (nb == 0) return;
             pair_times(gravity_, P_.data(), js, nb, xi, vi, ri, time_, p_.gravity, ts);
@@ -777,7 +794,6 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
                 if (t < best || (t == best && t < kInf && partner >= 0 && j < partner)) {
                     best = t;
                     partner = j;
-                    partner_count = count_[j];
                 }
             }
             nb = 0;
@@ -785,8 +801,13 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
         const std::int64_t base = cell_index(ci);
         const int list = only_axis < 0 ? 0 : 1 + 2 * only_axis + (dir > 0);
         const std::int64_t* off = nb_off_[list];
-        for (int k = 0, nk = n_nb_[list]; k < nk; ++k)
-            for (std::int32_t j = head_[base + off[k]]; j >= 0; j = next_[j]) {
+        const int nk = n_nb_[list];
+        // all cell heads first: independent loads that overlap, where walking cell by cell
+        // would wait for each (a mostly empty cell's test mispredicts on the loaded value)
+        std::int32_t heads[27];
+        for (int k = 0; k < nk; ++k) heads[k] = head_[base + off[k]];
+        for (int k = 0; k < nk; ++k)
+            for (std::int32_t j = heads[k]; j >= 0; j = next_[j]) {
                 if (j == i) continue;
                 // issued while the lists are walked, the misses on the records overlap
                 __builtin_prefetch(&P_[j]);
@@ -794,6 +815,8 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
                 if (nb == kBatch) flush();
             }
         flush();
+        // the partner's collision counter once, at the end (a miss per candidate otherwise)
+        if (partner >= 0 && partner != stored) partner_count = count_[partner];
     } else if (gravity_) {
         const double* g = p_.gravity;
         std::int32_t kind = kNone;
