@@ -46,7 +46,9 @@ __all__ = [
     "branch_sums",
     "collisional_stress",
     "kinetic_tensor",
+    "momentum_snapshot",
     "stress_results",
+    "unsteady_inertia_between",
     "wall_stress",
 ]
 
@@ -234,15 +236,50 @@ def wall_stress(timeseries: Mapping[str, Any], side: str, area: float | ArrayLik
     return np.asarray(est), np.asarray(err)
 
 
+def momentum_snapshot(time: float, y: ArrayLike, momentum: ArrayLike) -> dict[str, Any]:
+    """The particles' y and momenta (n, dim) at one time: an end of the averaging window of
+    :func:`unsteady_inertia_between`."""
+    return {"time": float(time), "y": np.array(y, float),
+            "momentum": np.array(momentum, float)}
+
+
+def unsteady_inertia_between(start: Mapping[str, Any], end: Mapping[str, Any],
+                             edges: ArrayLike, section: float) -> np.ndarray | None:
+    """Campbell's unsteady term rho nu a per bin (n_bins, dim): the momentum of the particles
+    centred in each bin at ``end`` minus that at ``start`` (his QT − QS, sums of m u over the
+    strip), over the duration and the bin volume (:func:`derived.unsteady_inertia`). None for
+    an empty window. A flow accelerating down a chute needs it: the steady balance then
+    overstates tau_xy by the bed's rho nu a above each plane."""
+    edges = np.asarray(edges, float)
+    duration = float(end["time"]) - float(start["time"])
+    if not duration > 0:
+        return None
+    n = edges.size - 1
+
+    def binned(snap: Mapping[str, Any]) -> np.ndarray:
+        p = np.asarray(snap["momentum"], float)
+        b = np.searchsorted(edges, np.asarray(snap["y"], float), side="right") - 1
+        inside = (b >= 0) & (b < n)
+        out = np.zeros((n, p.shape[1]))
+        np.add.at(out, b[inside], p[inside])
+        return out
+
+    return dv.unsteady_inertia(binned(end) - binned(start), duration,
+                               float(edges[1] - edges[0]), section)
+
+
 def stress_results(scene: Any, profiles: Mapping[str, Any], timeseries: Mapping[str, Any],
                    start: float = 0.0, contact: tuple[np.ndarray, np.ndarray] | None = None,
                    collisional: tuple[np.ndarray, np.ndarray] | None = None,
+                   momentum: tuple[Mapping[str, Any], Mapping[str, Any]] | None = None,
                    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     """The ``/stress`` group: ``edges``, ``y``, ``kinetic`` and optional ``contact`` /
     ``collisional`` (n_bins, dim, dim) with ``*_err``, ``total`` (their sum), the walls'
     ``wall_<side>`` columns P_ay, and with gravity the momentum balance ``balance_tau_xy``,
     ``balance_tau_yy`` (Campbell's signs, integrated down from a free surface or from the
-    upper wall's measured stress)."""
+    upper wall's measured stress). ``momentum``: snapshots (:func:`momentum_snapshot`) at the
+    start and the end of production; the balance then includes Campbell's unsteady term
+    (``balance_inertia``, rho nu a per bin), otherwise it assumes a steady flow."""
     dim = scene.dimension
     edges = np.asarray(profiles["edges"], float)
     section = float(np.prod([scene.box.size[i] for i in range(dim) if i != 1]))
@@ -266,10 +303,17 @@ def stress_results(scene: Any, profiles: Mapping[str, Any], timeseries: Mapping[
         top = (0.0, 0.0)
         if "upper" in walls:  # Campbell's tau(H) = (-P_xy, P_yy) at the upper wall
             top = (-float(walls["upper"][0][0]), float(walls["upper"][0][1]))
-        bal = dv.momentum_balance_stress(dict(profiles), scene, top_stress=top)
+        inertia = None if momentum is None else unsteady_inertia_between(*momentum, edges,
+                                                                         section)
+        bal = dv.momentum_balance_stress(dict(profiles), scene, top_stress=top, inertia=inertia)
         for key in ("tau_xy", "tau_yy", "tau_xy_err", "tau_yy_err"):
             out[f"balance_{key}"] = bal[key]
+        if inertia is not None:
+            out["balance_inertia"] = inertia
     attrs = {"units": STRESS_UNITS, "dim": dim, "axis": "y", "cross_section": section,
              "convention": "P = -sigma (compressive positive); Campbell tau_yy = P_yy, "
-                           "tau_xy = -P_xy; wall_<side> = column P_ay at that wall"}
+                           "tau_xy = -P_xy; wall_<side> = column P_ay at that wall",
+             "balance": ("unsteady: includes rho nu a from the momentum change of each bin "
+                         "over production (Campbell's QT - QS); its error is not included"
+                         if "balance_inertia" in out else "steady (no inertia term)")}
     return out, attrs

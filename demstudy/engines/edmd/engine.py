@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from ... import __version__
 from ...analysis.profiles import ProfileAnalysis
-from ...analysis.stress import collisional_stress, stress_results
+from ...analysis.stress import collisional_stress, momentum_snapshot, stress_results
 from ...analysis.suite import profile_analysis, profile_bounds
 from ...decks.base import UnsupportedByEngine
 from ...decks.servo import ServoController, has_servo
@@ -84,6 +84,10 @@ class EdmdRunState:
     log: dict[str, list] = field(default_factory=dict)
     logged: int = 0
     stress_edges: np.ndarray | None = None  # servo runs: bins fixed when production starts
+    # particle y and momenta where production starts and at its latest sample (the
+    # momentum balance's unsteady term)
+    momentum_start: dict | None = None
+    momentum_end: dict | None = None
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
@@ -310,6 +314,12 @@ class _Run:
                 state.log.setdefault(key, []).append(value[:keep])
             state.logged += keep
         state.last_time = t
+        if self.scene.gravity is not None and (production or state.samples == self.n_eq):
+            snap = momentum_snapshot(t, core.positions()[:n, 1], self.mass[:, None] * velocity)
+            if production:
+                state.momentum_end = snap
+            else:
+                state.momentum_start = snap
         if not production:
             return
         lo, hi = np.zeros(dim), np.asarray(core.box, float)
@@ -399,9 +409,12 @@ class _Run:
                                              np.asarray(state.stress_durations),
                                              self.stress_edges, section)
         if self.stress:
+            momentum = None
+            if state.momentum_start is not None and state.momentum_end is not None:
+                momentum = (state.momentum_start, state.momentum_end)
             stress, stress_attrs = stress_results(scene, analysis.results, timeseries,
                                                   start=equilibration_end,
-                                                  collisional=collisional)
+                                                  collisional=collisional, momentum=momentum)
             groups["stress"], group_attrs["stress"] = stress, stress_attrs
         if state.log:
             groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}

@@ -22,7 +22,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ...analysis.profiles import ProfileAnalysis
-from ...analysis.stress import ContactStress, branch_sums, stress_results
+from ...analysis.stress import ContactStress, branch_sums, momentum_snapshot, stress_results
 from ...analysis.suite import profile_analysis, profile_bounds
 from ...decks import Deck
 from ...decks.output import (
@@ -63,6 +63,10 @@ class RunState:
     # wall forces (on the particles) summed over segments since the last sample / servo update
     force_sums: dict[str, np.ndarray] = field(default_factory=dict)
     force_counts: dict[str, int] = field(default_factory=dict)
+    # particle y and momenta where production starts and at its latest sample (the
+    # momentum balance's unsteady term)
+    momentum_start: dict | None = None
+    momentum_end: dict | None = None
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
@@ -198,6 +202,12 @@ class Driver:
             for key, value in state.servo.state().items():
                 state.record(key, value)
             state.record("width", float(frame.lengths[0]))
+        if self.scene.gravity is not None and (production or state.step == self.n_eq):
+            snap = momentum_snapshot(t, frame.position[:, 1], mass[:, None] * frame.velocity)
+            if production:
+                state.momentum_end = snap
+            else:
+                state.momentum_start = snap
         if production and self.measure_stress:  # collective (sum over ranks)
             self._sample_stress(session, state, frame)
         if not production or session.rank != 0:
@@ -360,8 +370,12 @@ class Driver:
         results = Results(attrs, timeseries, analysis.results, analysis.attrs, frames)
         if self.measure_stress:
             contact = state.stress.finish() if state.stress is not None else None
+            momentum = None
+            if state.momentum_start is not None and state.momentum_end is not None:
+                momentum = (state.momentum_start, state.momentum_end)
             data, group_attrs = stress_results(self.scene, analysis.results, timeseries,
-                                               self.n_eq * self.dt, contact=contact)
+                                               self.n_eq * self.dt, contact=contact,
+                                               momentum=momentum)
             group_attrs["contact_samples"] = state.stress.samples if state.stress else 0
             results.groups["stress"], results.group_attrs["stress"] = data, group_attrs
         path = write_results(self.out, results)
