@@ -7,6 +7,7 @@ All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gra
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -37,13 +38,23 @@ def _cmd_deck(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from .decks.base import UnsupportedByEngine
     from .engines.base import RunOptions, get_engine
 
     scene = load_scene(args.scene, args.set)
+    extra = {}
+    if args.tc is not None:  # checked before any engine starts
+        if args.engine != "edmd":
+            raise UnsupportedByEngine(args.engine, "--tc", args.tc,
+                                      "the TC-model time is an event-driven option (--engine edmd)")
+        if not (math.isfinite(args.tc) and args.tc >= 0.0):
+            raise UnsupportedByEngine(args.engine, "--tc", args.tc,
+                                      "a finite time >= 0 is allowed (0 switches the model off)")
+        extra["tc"] = args.tc
     out = Path(args.out or Path("results") / f"{Path(args.scene).stem}-{args.engine}.h5")
     options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
                          progress=not args.quiet, keep_frames=args.keep_frames or None,
-                         isolate=True, wall_limit=args.wall_limit)
+                         isolate=True, wall_limit=args.wall_limit, extra=extra)
     path = get_engine(args.engine).run(scene, options)
     print(f"results: {path}")
     return 0
@@ -164,6 +175,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wall-limit", type=float, metavar="SECONDS",
                    help="checkpoint and stop after this much wall-clock time (then --resume)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--tc", type=float, metavar="TIME",
+                   help="edmd: TC-model time t_c (default 1e-5; 0 = off). A collision within t_c "
+                        "of a partner's previous one is elastic, and a particle resting on a "
+                        "wall hops with period t_c: a resting bed costs ~1/t_c events per "
+                        "particle and time unit (docs/edmd-engine.md)")
     p.set_defaults(func=_cmd_run)
 
     p = sub.add_parser("plot", help="figures of results files: profiles, stress, statistics",

@@ -139,6 +139,24 @@ def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path, capsys):
     assert "unsupported by edmd: walls[lower].kind" in capsys.readouterr().err
 
 
+def test_tc_option_reaches_the_event_driven_engine_and_is_checked_first(tmp_path, capsys):
+    """`--tc` sets the TC-model time of `--engine edmd` (stored in the results); another
+    engine or a negative time is refused with exit 2 before anything runs."""
+    from demstudy.io.results import read_results
+
+    scene = ROOT / "inputs" / "cooling" / "hcs-3d.toml"
+    out = tmp_path / "hcs.h5"
+    args = ["run", str(scene), "--out", str(out), "-q", "--set", "run.production=1"]
+    assert main([*args, "--engine", "edmd", "--tc", "2e-4"]) == 0
+    attrs = read_results(out).attrs
+    assert attrs["tc"] == 2e-4 and "t_c = 0.0002" in attrs["approximations"]
+    for engine, tc, why in (("lammps", "1e-4", "event-driven option"),
+                            ("edmd", "-1", "finite time >= 0")):
+        assert main([*args, "--engine", engine, "--tc", tc]) == 2
+        err = capsys.readouterr().err
+        assert f"unsupported by {engine}: --tc" in err and why in err and "Traceback" not in err
+
+
 def test_stop_refusal_and_failure_have_distinct_exit_codes(tmp_path, capsys):
     """Batch scripts can tell them apart: 3 = stopped after a checkpoint (resume it),
     2 = refused before anything ran, 1 = failed; each says so in one line, once."""
