@@ -189,14 +189,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--out", help="figure file (one kind), or OUT-<kind>.png for each of "
                                        "several kinds (default: <kind>.png)")
     p.add_argument("--kind", action="append", metavar="KIND",
-                   help="profiles (default), stress, eos, vdf, angles, gr, vcorr, lambda, "
-                        "waves, cooling or all; comma-separated or repeated")
+                   help="profiles (default), stress, eos, vdf, angles, freepath, gr, vcorr, "
+                        "lambda, waves, cooling or all; comma-separated or repeated")
     p.add_argument("--scaled", action="store_true",
                    help="profiles against (y - y0)/H: H the wall gap, or the flow depth with "
                         "an open top")
     p.add_argument("--bins", metavar="B1,B2,...",
-                   help="y-bins drawn by vdf, angles, gr, vcorr (1-based: bin 1 touches the "
-                        "lower wall; default: first occupied, fourth, middle)")
+                   help="y-bins drawn by vdf, angles, freepath, gr, vcorr (1-based: bin 1 "
+                        "touches the lower wall; default: first occupied, fourth, middle)")
     p.set_defaults(func=_cmd_plot)
 
     p = sub.add_parser("analyze", parents=[overrides],

@@ -98,6 +98,34 @@ def channel(tmp_path_factory):
     return path
 
 
+@pytest.fixture(scope="module")
+def freepath(tmp_path_factory):
+    """A results file with only ``/statistics/freepath``, from the real analysis
+    (FreePath fed with flight_chunks, Enskog references from a profile overlay) on synthetic
+    exponential flights (mean time 2, speed 1.5) of 3000 particles started in y ∈ [0, 4],
+    written by write_results."""
+    from demstudy.analysis.collisions import FreePath, flight_chunks
+
+    rng = np.random.default_rng(7)
+    ends = rng.random((3000, 1)) + np.cumsum(rng.exponential(2.0, (3000, 30)), axis=1)
+    starts, taus = ends[:, :-1], np.diff(ends, axis=1)
+    done = ends[:, 1:] <= 50.0
+    starts, taus = starts[done], taus[done]
+    y = rng.uniform(0.0, 4.0, taus.size)
+    flights = {"t0": 0.0, "t1": 50.0, "start_time": starts, "tau": taus, "length": 1.5 * taus,
+               "start": np.column_stack([np.zeros_like(y), y]), "event_time": starts,
+               "event_y": y}
+    edges = np.linspace(0.0, 4.0, 5)
+    ana = FreePath(edges, 24.0, 16.0, width=4.0).run(flight_chunks(flights, 16)).finish()
+    ana.overlay({"y": 0.5 * (edges[1:] + edges[:-1]), "solid_fraction": np.full(4, 0.1),
+                 "temperature": np.full(4, 1.0), "velocity": np.zeros((4, 3))},
+                cross_section=100.0)
+    ana.attrs["knudsen_width_is"] = "wall gap"
+    path = tmp_path_factory.mktemp("freepath") / "fp.h5"
+    return write_results(path, Results(attrs=dict(ATTRS), groups={
+        "statistics/freepath": ana.results}, group_attrs={"statistics/freepath": ana.attrs}))
+
+
 def line(fig, gid):
     """The data line (the first Line2D) carrying ``gid``."""
     found = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_gid() == gid]
@@ -118,16 +146,19 @@ def test_all_kinds_write_pngs_and_skip_the_absent_one(chute, tmp_path, capsys):
     out = tmp_path / "fig.png"
     assert main(["plot", str(chute), "--kind", "all", "-o", str(out)]) == 0
     cap = capsys.readouterr()
-    drawn = [k for k in KINDS if k not in ("lambda", "cooling")]
+    drawn = [k for k in KINDS if k not in ("freepath", "lambda", "cooling")]
     for kind in drawn:
         png = tmp_path / f"fig-{kind}.png"
         assert f"figure: {png}" in cap.out
         assert png.read_bytes()[:4] == b"\x89PNG" and png.stat().st_size > 20_000, kind
     assert not (tmp_path / "fig-lambda.png").exists()
     assert not (tmp_path / "fig-cooling.png").exists()  # a chute is not a cooling run
+    assert not (tmp_path / "fig-freepath.png").exists()  # its log has no particle indices
     notices = [ln for ln in cap.err.splitlines() if ln]
-    assert len(notices) == 2 and "lambda skipped" in notices[0] and "--what lambda" in notices[0]
-    assert "cooling skipped" in notices[1] and "homogeneous cooling" in notices[1]
+    assert len(notices) == 3 and "freepath skipped" in notices[0]
+    assert "--what freepath" in notices[0]
+    assert "lambda skipped" in notices[1] and "--what lambda" in notices[1]
+    assert "cooling skipped" in notices[2] and "homogeneous cooling" in notices[2]
     assert "Traceback" not in cap.err
 
 
@@ -358,3 +389,68 @@ def test_cooling_plot_overlays_haff_on_a_real_edmd_run(cooling, chute, tmp_path,
     assert main(["plot", str(chute), "--kind", "cooling", "-o", str(out)]) == 0
     cap = capsys.readouterr()
     assert not out.exists() and "cooling skipped" in cap.err and "no figure" in cap.err
+
+
+def test_freepath_plots_the_stored_pdfs_and_the_exponentials(freepath, chute, tmp_path, capsys):
+    """P(λ), P(τ) per chosen bin equal the stored rows; the dashed reference is
+    exp(−x/⟨x⟩)/⟨x⟩ with the bin's stored mean; the legend states ⟨λ⟩, Kn and Enskog's λ;
+    `all` draws the kind for a file that has it (and only it)."""
+    from demstudy.theory import mean_free_path
+
+    fp = read_results(freepath).groups["statistics/freepath"]
+    assert np.all(fp["flights"] > 0)
+    fig = draw("freepath", [Run.load(freepath)], bins=[1, 3])
+    for b in (0, 2):
+        for x, mean in (("lambda", "mean_free_path"), ("tau", "mean_free_time")):
+            same(line(fig, f"fp.h5:p_{x}:{b}"), fp[x], fp[f"p_{x}"][b])
+            ref = line(fig, f"fp.h5:exp_{x}:{b}")
+            np.testing.assert_array_equal(ref.get_xdata(), fp[x])
+            m = fp[mean][b]
+            np.testing.assert_allclose(ref.get_ydata(), np.exp(-fp[x] / m) / m, rtol=1e-12)
+            assert ref.get_linestyle() == "--"
+        assert fp["mean_free_path"][b] == pytest.approx(3.0, rel=0.05)  # 1.5 x ⟨τ⟩ = 2
+    assert all(ax.get_yscale() == "log" for ax in fig.axes)
+    assert not any(ln.get_gid() == "fp.h5:p_lambda:1" for ax in fig.axes for ln in ax.lines)
+    labels = " ".join(fig.axes[0].get_legend_handles_labels()[1])
+    assert f"⟨λ⟩ = {fp['mean_free_path'][2]:.3g}" in labels
+    assert f"Kn = {fp['knudsen'][2]:.3g}" in labels
+    assert f"λ_E = {mean_free_path(0.1, 3):.3g}" in labels
+    assert "W = 4 (wall gap)" in fig._suptitle.get_text()
+    default = draw("freepath", [Run.load(freepath)])  # first, fourth and middle bin
+    assert {ln.get_gid() for ln in default.axes[1].lines} >= {f"fp.h5:p_tau:{b}" for b in (0, 2, 3)}
+
+    out = tmp_path / "f.png"
+    assert main(["plot", str(freepath), str(chute), "--kind", "all", "-o", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert f"figure: {tmp_path / 'f-freepath.png'}" in cap.out
+    assert (tmp_path / "f-freepath.png").stat().st_size > 20_000
+    assert "fp.h5: no /profiles: profiles skipped" in cap.err
+    assert "chute.h5: no /statistics/freepath: freepath skipped" in cap.err
+    assert "Traceback" not in cap.err
+
+
+def test_profiles_draw_malik_cell_temperatures_dashed(channel, tmp_path):
+    """`analyze --what profiles --z-cells 3` adds cell_temperature and
+    cell_rotational_temperature: dashed next to the strip temperatures, in the strip's
+    colour, labelled with the number of z-cells; without z-cells nothing is added."""
+    path = tmp_path / "zc.h5"
+    assert main(["analyze", str(channel), "--what", "profiles", "--z-cells", "3",
+                 "--out", str(path)]) == 0
+    res = read_results(path)
+    prof = res.profiles
+    assert int(res.profile_attrs["z_cells"]) == 3
+    ok = prof["solid_fraction"] > 1e-3
+    fig = draw("profiles", [Run.load(path)])
+    for key in ("temperature", "rotational_temperature"):
+        strip, cell = line(fig, f"zc.h5:{key}"), line(fig, f"zc.h5:cell_{key}")
+        same(strip, prof[key][ok], prof["y"][ok])
+        same(cell, prof[f"cell_{key}"][ok], prof["y"][ok])
+        assert cell.get_linestyle() == "--" and cell.get_color() == strip.get_color()
+        ax = cell.axes
+        assert "3 z-cells (Malik)" in [t.get_text() for t in ax.get_legend().get_texts()]
+    assert not np.array_equal(prof["cell_temperature"], prof["temperature"])
+
+    strip_only = tmp_path / "strip.h5"
+    assert main(["analyze", str(channel), "--what", "profiles", "--out", str(strip_only)]) == 0
+    fig = draw("profiles", [Run.load(strip_only)])
+    assert not any("cell_" in str(ln.get_gid()) for ax in fig.axes for ln in ax.lines)

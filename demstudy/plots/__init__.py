@@ -8,6 +8,7 @@ Kinds (``demstudy plot RUN.h5 … --kind``; see docs/plots.md):
   momentum balance;
 * ``vdf``: Campbell's P(X1…X5) with folded Maxwellians, Malik's P(C/σ) with the Gaussian;
 * ``angles``: P(θ) in both conventions with Savage–Jeffrey;
+* ``freepath``: P(λ), P(τ) per y-bin with the exponential of the bin's mean;
 * ``gr``: g(r) (whole box, in-bin when stored);
 * ``vcorr``: C_αα(r) per component and the off-diagonal C_αβ(r);
 * ``lambda``: Λ(y) with 1/3;
@@ -30,15 +31,16 @@ from matplotlib.figure import Figure
 
 from .common import Run, missing_notice, save
 from .correlations import draw_gr, draw_lambda, draw_vcorr
-from .distributions import draw_angles, draw_vdf
+from .distributions import draw_angles, draw_freepath, draw_vdf
 from .profiles import draw_cooling, draw_eos, draw_profiles, draw_stress, reference_height
 from .waves import draw_waves
 
 #: the kinds, in the order ``--kind all`` draws them
-KINDS = ("profiles", "stress", "eos", "vdf", "angles", "gr", "vcorr", "lambda", "waves",
-         "cooling")
+KINDS = ("profiles", "stress", "eos", "vdf", "angles", "freepath", "gr", "vcorr", "lambda",
+         "waves", "cooling")
 
-__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_cooling", "draw_eos", "draw_gr",
+__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_cooling", "draw_eos", "draw_freepath",
+           "draw_gr",
            "draw_lambda", "draw_profiles", "draw_stress", "draw_vcorr", "draw_vdf", "draw_waves",
            "output_path", "parse_kinds", "plot_files", "plot_profiles", "reference_height"]
 
@@ -71,7 +73,8 @@ def draw(kind: str, runs: Sequence[Run], *, scaled: bool = False,
         return {"stress": draw_stress, "eos": draw_eos, "lambda": draw_lambda,
                 "waves": draw_waves, "cooling": draw_cooling}[kind](runs)
     fn: dict[str, Callable[..., Figure]] = {"vdf": draw_vdf, "angles": draw_angles,
-                                            "gr": draw_gr, "vcorr": draw_vcorr}
+                                            "freepath": draw_freepath, "gr": draw_gr,
+                                            "vcorr": draw_vcorr}
     return fn[kind](runs, bins=bins)
 
 

@@ -26,13 +26,15 @@ GROUPS = {
     "eos": ("statistics/stress", "stress"),
     "vdf": ("statistics/vdf",),
     "angles": ("statistics/angles",),
+    "freepath": ("statistics/freepath",),
     "gr": ("statistics/gr",),
     "vcorr": ("statistics/vcorr",),
     "lambda": ("statistics/lambda",),
     "waves": ("statistics/waves",),
 }
 #: a dataset that must be present for the kind to be drawable
-REQUIRED = {"stress": "total", "eos": "total", "vdf": "X", "angles": "p_text", "gr": "g",
+REQUIRED = {"stress": "total", "eos": "total", "vdf": "X", "angles": "p_text",
+            "freepath": "p_lambda", "gr": "g",
             "vcorr": "C", "lambda": "lambda", "waves": "series_time"}
 #: how to obtain a missing kind ({file}: the results file's name)
 HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
@@ -42,6 +44,8 @@ HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
               "`demstudy analyze {file} --what stress`",
        "angles": "add it with `demstudy analyze {file} --what angles`, which needs an "
                  "event-driven run's /collisions log",
+       "freepath": "add it with `demstudy analyze {file} --what freepath`, which needs an "
+                   "event-driven run's /collisions log of every collision (log_every = 1)",
        "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only",
        "cooling": "Haff's law needs every axis periodic, no walls, gravity or shear, and a "
                   "constant e < 1"}

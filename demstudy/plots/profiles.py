@@ -9,6 +9,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 
 from .common import MARKERS, Run, finish, new_figure
@@ -60,6 +62,8 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
     fig, axes = new_figure(1, len(PANELS), height=4.5, sharey=True)
     axes = axes[0]
     what: set[str] = set()
+    # (handle, label) of the strip and cell temperatures: their own legend in those panels
+    cells: dict[Axes, list[tuple[ErrorbarContainer, str]]] = {ax: [] for ax in axes}
     for run in runs:
         prof = run.results.profiles
         y = np.asarray(prof["y"], float)
@@ -73,6 +77,8 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
             trend = 100 * run.attrs["kinetic_energy_trend"]
             label += f"\nNOT STEADY: kinetic energy changed {trend:+.0f} % over production"
         occupied = prof["solid_fraction"] > 1e-3
+        n_cells = int(run.results.profile_attrs.get("z_cells", 1))
+        prefix = f"{run.label}: " if len(runs) > 1 else ""
         for ax, (key, title) in zip(axes, PANELS, strict=True):
             if key not in prof:
                 continue
@@ -80,8 +86,21 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
             if val.ndim == 2:  # vectors: the flow (x) component
                 val, err = val[:, 0], None if err is None else err[:, 0]
             mask = occupied if key != "solid_fraction" else np.ones_like(occupied)
-            ax.errorbar(val[mask], y[mask], xerr=None if err is None else err[mask],
-                        marker="o", ms=3, capsize=2, label=label, gid=f"{run.path.name}:{key}")
+            strip = ax.errorbar(val[mask], y[mask], xerr=None if err is None else err[mask],
+                                marker="o", ms=3, capsize=2, label=label,
+                                gid=f"{run.path.name}:{key}")
+            if f"cell_{key}" in prof and n_cells > 1:
+                # Malik's cells: fluctuations about each z-slab's mean, so a mean velocity
+                # varying along z leaks less into T than in the strip
+                cell_err = prof.get(f"cell_{key}_err")
+                cell = ax.errorbar(prof[f"cell_{key}"][mask], y[mask], ls="--", marker="s",
+                                   ms=2, capsize=2, mfc="none",
+                                   xerr=None if cell_err is None else cell_err[mask],
+                                   color=strip.lines[0].get_color(),
+                                   label=f"{prefix}{n_cells} z-cells (Malik)",
+                                   gid=f"{run.path.name}:cell_{key}")
+                cells[ax].extend([(strip, f"{prefix}strip (Campbell)"),
+                                  (cell, cell.get_label())])
             ax.set_xlabel(title)
             ax.grid(alpha=0.3)
     axis = runs[0].results.profile_attrs.get("axis", "y")
@@ -91,6 +110,9 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
     else:
         axes[0].set_ylabel(f"{axis} (particle diameters)")
     axes[0].legend(fontsize=8, loc="upper right")
+    for ax, pairs in cells.items():
+        if pairs:
+            ax.legend(*zip(*pairs, strict=True), fontsize=7, loc="upper right")
     return finish(fig, runs, "profiles: solid fraction, mean velocity, temperatures")
 
 
