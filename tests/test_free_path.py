@@ -130,6 +130,32 @@ def test_lees_edwards_wrap_slides_the_image():
     assert wrong["length"][0] != pytest.approx(1.5 * np.linalg.norm(v), rel=1e-3)
 
 
+def test_lees_edwards_collision_with_an_image_starts_from_the_real_particle():
+    """The engine's branch points to j's nearest image: particle 1, just above the bottom,
+    meets particle 0 at the top as j through its image at (x + offset(t1), y + L_y); its
+    next flight (no wrap) must start from its real position: λ = |v| τ."""
+    rate, lx, ly = 0.2, 10.0, 10.0
+
+    def offset(t):
+        return np.mod(0.3 + rate * ly * np.asarray(t), lx)
+
+    c0 = np.array([5.0, 9.5])
+    c1 = np.array([np.mod(5.6 - offset(1.0), lx), 0.3])  # its image touches 0: (0.6, 0.8)
+    image = c1 + [offset(1.0), ly]
+    branch = image - c0
+    branch[0] -= lx * round(branch[0] / lx)
+    n = branch / np.linalg.norm(branch)
+    assert np.linalg.norm(branch) == pytest.approx(1.0)
+    v = np.array([0.5, 2.0])
+    c1b = c1 + 1.5 * v
+    log = {"time": np.array([1.0, 2.5]), "kind": np.array([0, 0]), "i": np.array([0, 1]),
+           "j": np.array([1, 2]), "position": np.array([c0 + 0.5 * n, c1b + [0.5, 0.0]]),
+           "normal": np.array([n, [1.0, 0.0]]), "branch": np.array([branch, [1.0, 0.0]])}
+    fl = free_flights(log, np.full(3, 0.5), [lx, ly], shear_offset=offset)
+    assert fl["particle"].tolist() == [1] and fl["y_wrapped"].tolist() == [False]
+    assert fl["length"][0] == pytest.approx(1.5 * np.linalg.norm(v), rel=1e-12)
+
+
 def test_parabolic_flights_have_the_exact_arc_length():
     g = np.array([0.0, -1.0])
     # straight up and down: chord 0, path v0^2 / g

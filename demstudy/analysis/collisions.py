@@ -269,8 +269,9 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
     period of each axis, 0 when not periodic; ``shear_offset(t)``: Lees–Edwards x offset of
     the image above at time t; ``x_period(t)``: the x period at t when it changes (servo);
     records before ``start`` are ignored. A particle collides as i (pairs and walls, bumps
-    included) or as j (pairs); its centre is contact - r_i n (i) or that + branch (j, the
-    engine's own image vector). A flight runs from one collision of a particle to its next:
+    included) or as j (pairs); its centre is contact - r_i n (i) or that + branch (j: the
+    branch points to j's nearest image, which across the y boundary is mapped back to j with
+    the offset at t1). A flight runs from one collision of a particle to its next:
     tau = t2 - t1 exactly, the displacement is the nearest periodic image of c2 - c1 (a y wrap
     under Lees–Edwards also shifts x by the offset at t2; the image of a flight longer than
     half a period along an axis is taken as the shorter one: keep the periods >> lambda) and
@@ -297,6 +298,14 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
     c_i = np.asarray(log["position"], float)[keep] - r[i][:, None] * n
     pair = kind == PAIR
     c_j = c_i[pair] + np.asarray(log["branch"], float)[keep][pair]
+    per = np.asarray(periods, float)
+    if per[1] > 0:
+        # the branch points to j's nearest image (the engine's separation()): one across the
+        # y boundary sits at ± (offset(t), L_y) from j itself; map it back to j
+        k = np.floor(c_j[:, 1] / per[1])
+        c_j[:, 1] -= k * per[1]
+        if shear_offset is not None:
+            c_j[:, 0] -= k * shear_offset(t[pair])
     who = np.concatenate([i, j[pair]])
     when = np.concatenate([t, t[pair]])
     where = np.concatenate([c_i, c_j])
@@ -305,7 +314,6 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
     nxt = np.flatnonzero(who[1:] == who[:-1])  # flight from event k to event k + 1
     tau = when[nxt + 1] - when[nxt]
     delta = where[nxt + 1] - where[nxt]
-    per = np.asarray(periods, float)
     wrapped = np.zeros(tau.size, bool)
     if per[1] > 0:  # y first: a Lees–Edwards wrap moves the image along x
         k = np.rint(-delta[:, 1] / per[1])
@@ -337,6 +345,8 @@ def flight_chunks(flights: Mapping[str, Any], n_chunks: int = 64,
     starts in the first T - tau of the window, T = t1 - t0, and gets the weight
     (T - h) / (T - tau) for the ones missed. ``horizon`` h: default 8 x the mean duration
     of the complete flights, at most T/4."""
+    if not (isinstance(n_chunks, int | np.integer) and n_chunks >= 1):
+        raise ValueError(f"n_chunks = {n_chunks!r}: must be an integer >= 1")
     t0, t1 = float(flights["t0"]), float(flights["t1"])
     span = t1 - t0
     tau = np.asarray(flights["tau"], float)
@@ -394,6 +404,8 @@ class FreePath(AnalysisBase):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
         if not (lambda_max > 0 and tau_max > 0 and width > 0):
             raise ValueError("lambda_max, tau_max and width must be > 0")
+        if not (isinstance(n_hist, int | np.integer) and n_hist >= 1):
+            raise ValueError(f"n_hist = {n_hist!r}: must be an integer >= 1")
         self.n_bins, self.n_hist, self.dim = self.edges.size - 1, int(n_hist), dim
         self.width = float(width)
         self.lambda_edges = np.linspace(0.0, lambda_max, self.n_hist + 1)

@@ -173,7 +173,10 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> FreePa
     if scene.shear is not None and scene.y_periodic:
         shear, ly = scene.shear.rate, scene.box.size[1]
         t_s = np.asarray(ts.get("time", [0.0]), float)
-        tilt = np.asarray(ts.get("tilt", np.zeros(t_s.size)), float)
+        if "tilt" not in ts or len(ts["tilt"]) != t_s.size:
+            raise ValueError("--what freepath: a Lees–Edwards run needs /timeseries/tilt (the "
+                             "image offset, one per time sample); this file has none")
+        tilt = np.asarray(ts["tilt"], float)
 
         def offset(t: np.ndarray) -> np.ndarray:  # exactly linear from the last sample
             k = np.clip(np.searchsorted(t_s, t, side="right") - 1, 0, t_s.size - 1)

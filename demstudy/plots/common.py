@@ -47,8 +47,8 @@ HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
        "freepath": "add it with `demstudy analyze {file} --what freepath`, which needs an "
                    "event-driven run's /collisions log of every collision (log_every = 1)",
        "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only",
-       "cooling": "Haff's law needs every axis periodic, no walls, gravity or shear, and a "
-                  "constant e < 1"}
+       "cooling": "Haff's law needs every axis periodic, no walls, gravity or shear, equal "
+                  "particles and a constant e < 1"}
 
 LINESTYLES = ("-", "--", ":", "-.")
 MARKERS = ("o", "s", "^", "v", "D", "P")
@@ -56,9 +56,11 @@ MARKERS = ("o", "s", "^", "v", "D", "P")
 
 def homogeneous_cooling(scene: Any) -> bool:
     """A free-cooling scene, where Haff's law applies: every axis periodic, no walls, gravity
-    or shear, and a constant normal restitution e < 1."""
+    or shear, equal particles (the theory is for d = m = 1) and a constant normal restitution
+    e < 1."""
     return (scene is not None and len(scene.periodic) == scene.dimension and not scene.walls
             and scene.gravity is None and scene.shear is None
+            and scene.particles.diameter_spread == 0
             and scene.contact.law.model == "constant" and scene.contact.restitution < 1)
 
 

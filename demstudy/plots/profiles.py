@@ -216,15 +216,21 @@ def draw_eos(runs: Sequence[Run]) -> Figure:
 
 def cooling_temperature(run: Run) -> tuple[np.ndarray, np.ndarray]:
     """(t − t_first, T) of a homogeneous cooling run from ``/timeseries``: T per translational
-    degree of freedom, T = (2 E_kin − |P|²/N) / (dim (N − 1)) (m = 1; the centre-of-mass
-    motion is not thermal and takes dim degrees of freedom; N from the scene)."""
+    degree of freedom, T = (2 E_kin − |P|²/M) / (dim (N − 1)) with M the total mass (the
+    centre-of-mass motion is not thermal and takes dim degrees of freedom; without a momentum
+    record T = 2 E_kin / (dim N))."""
+    from ..scene.initial import build_initial_state
+
     ts, scene = run.results.timeseries, run.scene
     n, dim = scene.n_particles, scene.dimension
     energy = 2 * np.asarray(ts["kinetic_energy"], float)
+    dof = dim * n
     if "momentum" in ts:
-        energy = energy - (np.asarray(ts["momentum"], float) ** 2).sum(axis=1) / n
+        total_mass = float(build_initial_state(scene).mass.sum())
+        energy = energy - (np.asarray(ts["momentum"], float) ** 2).sum(axis=1) / total_mass
+        dof = dim * (n - 1)
     t = np.asarray(ts["time"], float)
-    return t - t[0], energy / (dim * (n - 1))
+    return t - t[0], energy / dof
 
 
 def draw_cooling(runs: Sequence[Run]) -> Figure:

@@ -178,8 +178,11 @@ class _Run:
             raise EngineError(f"--resume: no checkpoint in {self.workdir}")
         with open(path, "rb") as fh:
             saved = pickle.load(fh)
-        if saved["scene"] != scene_to_toml(self.scene) or saved["tc"] != self.tc:
+        if saved["scene"] != scene_to_toml(self.scene):
             raise EngineError("--resume: the checkpoint belongs to a different scene")
+        if saved["tc"] != self.tc:
+            raise EngineError(f"--resume: the checkpoint was run with --tc {saved['tc']:g}, "
+                              f"this call has {self.tc:g}: pass --tc {saved['tc']:g}")
         core.set_state(saved["core"])
         self.keep_frames = saved["run"].keep_frames  # frames for the whole run or not at all
         if saved["run"].stress_edges is not None:
