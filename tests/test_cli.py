@@ -139,7 +139,7 @@ def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path, capsys):
     assert "unsupported by edmd: walls[lower].kind" in capsys.readouterr().err
 
 
-def test_tc_option_reaches_the_event_driven_engine_and_is_checked_first(tmp_path, capsys):
+def test_tc_option_reaches_the_event_driven_engine_and_is_checked_first(tmp_path, capfd):
     """`--tc` sets the TC-model time of `--engine edmd` (stored in the results); another
     engine or a negative time is refused with exit 2 before anything runs."""
     from demstudy.io.results import read_results
@@ -150,10 +150,16 @@ def test_tc_option_reaches_the_event_driven_engine_and_is_checked_first(tmp_path
     assert main([*args, "--engine", "edmd", "--tc", "2e-4"]) == 0
     attrs = read_results(out).attrs
     assert attrs["tc"] == 2e-4 and "t_c = 0.0002" in attrs["approximations"]
+    # a stopped run resumes with its own t_c when --tc is not repeated; a different one is refused
+    assert main([*args, "--engine", "edmd", "--tc", "2e-4", "--wall-limit", "0"]) == 3
+    assert main([*args, "--engine", "edmd", "--resume", "--tc", "1e-5"]) == 1
+    assert "was run with --tc 0.0002" in capfd.readouterr().err
+    assert main([*args, "--engine", "edmd", "--resume"]) == 0
+    assert read_results(out).attrs["tc"] == 2e-4
     for engine, tc, why in (("lammps", "1e-4", "event-driven option"),
                             ("edmd", "-1", "finite time >= 0")):
         assert main([*args, "--engine", engine, "--tc", tc]) == 2
-        err = capsys.readouterr().err
+        err = capfd.readouterr().err
         assert f"unsupported by {engine}: --tc" in err and why in err and "Traceback" not in err
 
 

@@ -181,8 +181,11 @@ class _Run:
         if saved["scene"] != scene_to_toml(self.scene):
             raise EngineError("--resume: the checkpoint belongs to a different scene")
         if saved["tc"] != self.tc:
-            raise EngineError(f"--resume: the checkpoint was run with --tc {saved['tc']:g}, "
-                              f"this call has {self.tc:g}: pass --tc {saved['tc']:g}")
+            if "tc" in self.options.extra:  # asked for explicitly: refuse to change it
+                raise EngineError(f"--resume: the checkpoint was run with --tc "
+                                  f"{saved['tc']:g}, this call has {self.tc:g}")
+            self.tc = float(saved["tc"])  # not given: continue with the run's own t_c
+            core = from_initial_state(everything, self.scene.box.size, tc=self.tc, **options)
         core.set_state(saved["core"])
         self.keep_frames = saved["run"].keep_frames  # frames for the whole run or not at all
         if saved["run"].stress_edges is not None:
