@@ -237,6 +237,23 @@ def test_lammps_couette_shear_stress_is_uniform_and_equals_the_walls(tmp_path):
     assert np.all(st["contact"][inner, 0, 1] < 0) and np.all(st["kinetic"][inner, 0, 1] < 0)
 
 
+def test_unsteady_inertia_is_the_momentum_change_per_bin_volume_and_time():
+    """Two snapshots 2 apart: bin 0 holds particles gaining x momentum 3 in total, bin 1 one
+    that moves in from bin 2 (its momentum counts where it is centred at each end), bin 2 the
+    rest: rho nu a = dM / (T w A) exactly, and outside the bins nothing counts."""
+    from demstudy.analysis.stress import momentum_snapshot, unsteady_inertia_between
+
+    edges = np.array([0.0, 0.5, 1.0, 1.5])
+    start = momentum_snapshot(1.0, [0.1, 0.2, 1.2, 9.0], [[1.0, 0.0], [0.0, 1.0], [2.0, 0.0],
+                                                          [5.0, 5.0]])
+    end = momentum_snapshot(3.0, [0.1, 0.2, 0.7, 9.0], [[2.5, 0.0], [1.5, 1.0], [2.0, -1.0],
+                                                        [7.0, 5.0]])
+    got = unsteady_inertia_between(start, end, edges, section=4.0)
+    expected = np.array([[3.0, 0.0], [2.0, -1.0], [-2.0, 0.0]]) / (2.0 * 0.5 * 4.0)
+    np.testing.assert_allclose(got, expected, rtol=1e-15)
+    assert unsteady_inertia_between(end, end, edges, 4.0) is None  # no duration
+
+
 # ---- three routes in a chute (event-driven) ----------------------------------------------------
 
 def test_edmd_chute_three_stress_routes_agree(tmp_path):

@@ -18,7 +18,7 @@ import numpy as np
 
 from demstudy.io.frames import Frame
 
-__all__ = ["AnalysisBase", "default_y_edges", "z_slab"]
+__all__ = ["AnalysisBase", "bin_edges", "default_y_edges", "z_slab"]
 
 
 class AnalysisBase:
@@ -85,6 +85,13 @@ class AnalysisBase:
             if self.verbose and self.n_frames % 100 == 0:
                 print(f"{type(self).__name__}: {self.n_frames} frames")
         return self.finish()
+
+
+def bin_edges(lo: float, hi: float, bin_width: float) -> np.ndarray:
+    """Equal bins over [lo, hi] of about ``bin_width`` (at least one): the profile grid of a
+    scene's ``measure.bin_width`` between its walls or over its box."""
+    n_bins = max(1, round((hi - lo) / bin_width))
+    return lo + (hi - lo) / n_bins * np.arange(n_bins + 1)
 
 
 def default_y_edges(frame: Frame, period: float, n_bins: int) -> np.ndarray:

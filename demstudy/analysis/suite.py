@@ -16,6 +16,7 @@ import numpy as np
 
 from ..io.frames import Frame
 from ..scene import Scene
+from .base import bin_edges
 from .coarse_graining import CoarseGrainedProfiles
 from .collisions import CollisionAngles, FreePath, collision_chunks, flight_chunks, free_flights
 from .derived import campbell_depth
@@ -83,8 +84,7 @@ def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
         if name == "profiles":
             ana = profile_analysis(scene, z_cells=z_cells).run(frames()).finish()
         elif name == "vdf":
-            n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
-            edges = [lo + (hi - lo) * i / n_bins for i in range(n_bins + 1)]
+            edges = bin_edges(lo, hi, scene.measure.bin_width)
             ana = velocity_distributions(frames, dim=scene.dimension, edges=edges,
                                          inertia_factor=scene.inertia_k, period=period,
                                          image_velocity_shift=image_shift(scene, period),
@@ -139,8 +139,7 @@ def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> 
     lo, hi, _period = profile_bounds(scene)
     edges = res.profiles.get("edges")
     if edges is None:
-        n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
-        edges = [lo + (hi - lo) * i / n_bins for i in range(n_bins + 1)]
+        edges = bin_edges(lo, hi, scene.measure.bin_width)
     start = float(res.attrs.get("equilibration_end", 0.0))
     ana = CollisionAngles(edges, dim=scene.dimension)
     ana.run(collision_chunks(log, n_chunks, start))
@@ -192,8 +191,7 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> FreePa
         lo, hi = 0.0, scene.box.size[1]
     edges = res.profiles.get("edges") if along_y else None
     if edges is None:
-        n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
-        edges = np.linspace(lo, hi, n_bins + 1)
+        edges = bin_edges(lo, hi, scene.measure.bin_width)
     width = hi - lo
     if scene.has_open_top and res.profiles:
         width = campbell_depth(res.profiles, scene.wall_position("lower"))
@@ -250,17 +248,16 @@ def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], na
     w = bin_width / 2 at points spaced bin_width / 2."""
     lo, hi, period = profile_bounds(scene)
     dim, shift = scene.dimension, image_shift(scene, period)
-    n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
     if name == "cgprofiles":  # along measure.axis, like the profiles
+        n_bins = len(bin_edges(lo, hi, scene.measure.bin_width)) - 1
         return CoarseGrainedProfiles(width=0.5 * scene.measure.bin_width,
                                      axis=scene.measure.axis, lo=lo, hi=hi, dim=dim,
                                      period=period, image_velocity_shift=shift,
                                      n_points=2 * n_bins).run(frames()).finish()
     if scene.measure.axis != "y":  # the other statistics bin along y
         lo, hi = 0.0, scene.box.size[1]
-        n_bins = max(1, round((hi - lo) / scene.measure.bin_width))
     y_period = scene.box.size[1] if scene.y_periodic else 0.0
-    edges = [lo + (hi - lo) * i / n_bins for i in range(n_bins + 1)]
+    edges = bin_edges(lo, hi, scene.measure.bin_width)
     y_bins = {"dim": dim, "edges": edges, "period": y_period,
               "image_velocity_shift": scene.shear.rate * y_period if scene.shear else 0.0}
     if name == "vcorr":

@@ -25,6 +25,7 @@ import numpy as np
 from tqdm import tqdm
 
 from ... import __version__
+from ...analysis.base import bin_edges
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.stress import collisional_stress, momentum_snapshot, stress_results
 from ...analysis.suite import profile_analysis, profile_bounds
@@ -144,8 +145,8 @@ class _Run:
             options["y_range"] = y_range(self.scene, initial.position)
         if self.stress:
             lo, hi, _period = profile_bounds(self.scene)
-            n_bins = max(1, round((hi - lo) / self.scene.measure.bin_width))
-            self.stress_edges = lo + (hi - lo) / n_bins * np.arange(n_bins + 1)
+            self.stress_edges = bin_edges(lo, hi, self.scene.measure.bin_width)
+            n_bins = len(self.stress_edges) - 1
             options["stress_bins"] = (lo, (hi - lo) / n_bins, n_bins)
         if self.log_every > 0:
             options.update(log_every=self.log_every, log_capacity=LOG_CAPACITY)
@@ -338,10 +339,9 @@ class _Run:
         if state.profiles is None:  # servo: bins between the walls where production starts
             state.profiles = profile_analysis(self.scene, (float(lo[1]), float(hi[1])))
             if self.stress:  # the collisional stress in the same bins, from now on
-                n_bins = max(1, round((hi[1] - lo[1]) / self.scene.measure.bin_width))
-                width = (hi[1] - lo[1]) / n_bins
-                self.stress_edges = lo[1] + width * np.arange(n_bins + 1)
-                core.set_stress_bins(float(lo[1]), float(width), n_bins)
+                self.stress_edges = bin_edges(lo[1], hi[1], self.scene.measure.bin_width)
+                n_bins = len(self.stress_edges) - 1
+                core.set_stress_bins(float(lo[1]), float((hi[1] - lo[1]) / n_bins), n_bins)
                 state.stress_edges = self.stress_edges
                 state.stress_chunks, state.stress_durations = [], []
                 state.last_stress = core.stress_sums[:, :dim, :dim].transpose(0, 2, 1)

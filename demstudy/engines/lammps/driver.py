@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ...analysis.base import bin_edges
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.stress import ContactStress, branch_sums, momentum_snapshot, stress_results
 from ...analysis.suite import profile_analysis, profile_bounds
@@ -227,9 +228,8 @@ class Driver:
             lo, hi, _ = profile_bounds(self.scene)
             if state.servo is not None:
                 lo, hi = state.servo.walls["lower"].y, state.servo.walls["upper"].y
-            n_bins = max(1, round((hi - lo) / self.scene.measure.bin_width))
             period = self.scene.box.size[1] if self.scene.y_periodic else 0.0
-            state.stress = ContactStress(lo + (hi - lo) / n_bins * np.arange(n_bins + 1),
+            state.stress = ContactStress(bin_edges(lo, hi, self.scene.measure.bin_width),
                                          self.scene.dimension, period)
         sums = session.sum_ranks(self._contact_sums(session, state.stress))
         if session.rank == 0:
