@@ -234,3 +234,5 @@ def test_analyze_z_cells_gives_malik_cell_temperatures(tmp_path, capsys):
     assert "--z-cells 2" in err and "3D" in err and "2D" in err
     assert main(["analyze", str(run), "--what", "profiles", "--z-cells", "0"]) == 1
     assert ">= 1" in capsys.readouterr().err
+    assert main(["analyze", str(run), "--what", "gr", "--z-cells", "4"]) == 1
+    assert "none of them is requested" in capsys.readouterr().err

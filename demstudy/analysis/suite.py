@@ -78,6 +78,10 @@ def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
                          f"they need a 3D run (this one is {scene.dimension}D; use 1)")
     if z_cells < 1:
         raise ValueError(f"--z-cells {z_cells}: the number of z cells per y-bin must be >= 1")
+    what = list(what)
+    if z_cells != 1 and not set(what) & set(Z_CELLS):
+        raise ValueError(f"--z-cells {z_cells}: applies to {', '.join(Z_CELLS)}; none of them "
+                         f"is requested (--what {','.join(what)})")
     out: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
     lo, hi, period = profile_bounds(scene)
     for name in what:
