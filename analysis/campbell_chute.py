@@ -71,6 +71,13 @@ def summarise(scene, h5: Path) -> None:
     print(f"  base: shear/normal force {abs(force[0] / force[1]):.3f} "
           f"(steady flow needs tan α = {np.tan(np.radians(alpha)):.3f}); normal force "
           f"{abs(force[1]):.2f} vs weight·cos α = {n * np.cos(np.radians(alpha)):.2f}")
+    # the bed's x-momentum balance: M g sin α − base shear force = dP_x/dt (m = 1 per disc)
+    t, px = ts["time"][production], ts["momentum"][production, 0]
+    accel = (px[-1] - px[0]) / (t[-1] - t[0])
+    drive = n * np.sin(np.radians(alpha))
+    trend = "accelerates" if accel > 0 else "decelerates"
+    print(f"  x momentum: M g sin α − base shear force = {drive - abs(force[0]):.2f} vs "
+          f"dP_x/dt = {accel:.2f} (m g): the bed {trend}")
     verdict = "steady" if res.attrs["steady"] else "NOT steady"
     print(f"  convergence (Campbell: KE within ~20 % with no trend): {verdict}, "
           f"KE trend {100 * res.attrs['kinetic_energy_trend']:+.0f} % over production")
