@@ -75,30 +75,37 @@ def write_results(path: str | os.PathLike, results: Results) -> Path:
     return path
 
 
-def read_results(path: str | os.PathLike) -> Results:
-    """Read a results file written by any engine."""
+def read_results(path: str | os.PathLike, skip: tuple[str, ...] = ()) -> Results:
+    """Read a results file written by any engine; ``skip``: top-level groups not to read
+    (e.g. ``("frames", "collisions")``, the large ones, when only the figures are wanted)."""
+    def decode(value: Any) -> Any:
+        return value.decode() if isinstance(value, bytes) else value
+
     with h5py.File(path, "r") as f:
         def load(name: str) -> dict[str, np.ndarray]:
-            return {k: v[()] for k, v in f[name].items()} if name in f else {}
+            if name not in f or name in skip:
+                return {}
+            return {k: v[()] for k, v in f[name].items() if isinstance(v, h5py.Dataset)}
 
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-        res = Results(attrs=attrs, timeseries=load("timeseries"), profiles=load("profiles"),
+        res = Results(attrs={k: decode(v) for k, v in f.attrs.items()},
+                      timeseries=load("timeseries"), profiles=load("profiles"),
                       frames=load("frames") or None)
         if "profiles" in f:
-            res.profile_attrs = dict(f["profiles"].attrs)
+            res.profile_attrs = {k: decode(v) for k, v in f["profiles"].attrs.items()}
 
         def collect(group: h5py.Group) -> None:
             datasets = {k: v[()] for k, v in group.items() if isinstance(v, h5py.Dataset)}
             if datasets:
                 key = group.name.lstrip("/")
                 res.groups[key] = datasets
-                res.group_attrs[key] = dict(group.attrs)
+                res.group_attrs[key] = {k: decode(v) for k, v in group.attrs.items()}
             for item in group.values():
                 if isinstance(item, h5py.Group):
                     collect(item)
 
         for name, item in f.items():
-            if name not in ("timeseries", "profiles", "frames") and isinstance(item, h5py.Group):
+            if (name not in ("timeseries", "profiles", "frames", *skip)
+                    and isinstance(item, h5py.Group)):
                 collect(item)
     return res
 

@@ -13,12 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import h5py
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..io.results import Results
+from ..io.results import Results, read_results
 
 #: results-file groups holding each kind (first present wins)
 GROUPS = {
@@ -64,38 +63,10 @@ def homogeneous_cooling(scene: Any) -> bool:
             and scene.contact.law.model == "constant" and scene.contact.restitution < 1)
 
 
-def _decode(value: Any) -> Any:
-    return value.decode() if isinstance(value, bytes) else value
-
-
 def load_results(path: str | Path) -> Results:
     """A results file without its (possibly huge) ``/frames`` and ``/collisions``: what the
-    figures need (same layout as :func:`demstudy.io.results.read_results`)."""
-    skip = ("timeseries", "profiles", "frames", "collisions")
-    with h5py.File(path, "r") as f:
-        def load(name: str) -> dict[str, np.ndarray]:
-            return {k: v[()] for k, v in f[name].items()
-                    if isinstance(v, h5py.Dataset)} if name in f else {}
-
-        res = Results(attrs={k: _decode(v) for k, v in f.attrs.items()},
-                      timeseries=load("timeseries"), profiles=load("profiles"))
-        if "profiles" in f:
-            res.profile_attrs = {k: _decode(v) for k, v in f["profiles"].attrs.items()}
-
-        def collect(group: h5py.Group) -> None:
-            data = {k: v[()] for k, v in group.items() if isinstance(v, h5py.Dataset)}
-            if data:
-                key = group.name.lstrip("/")
-                res.groups[key] = data
-                res.group_attrs[key] = {k: _decode(v) for k, v in group.attrs.items()}
-            for item in group.values():
-                if isinstance(item, h5py.Group):
-                    collect(item)
-
-        for name, item in f.items():
-            if name not in skip and isinstance(item, h5py.Group):
-                collect(item)
-    return res
+    figures need."""
+    return read_results(path, skip=("frames", "collisions"))
 
 
 @dataclass
