@@ -18,7 +18,7 @@ import numpy as np
 
 from demstudy.io.frames import Frame
 
-__all__ = ["AnalysisBase", "bin_edges", "default_y_edges", "z_slab"]
+__all__ = ["AnalysisBase", "bin_edges", "bin_index", "default_y_edges", "z_slab"]
 
 
 class AnalysisBase:
@@ -92,6 +92,12 @@ def bin_edges(lo: float, hi: float, bin_width: float) -> np.ndarray:
     scene's ``measure.bin_width`` between its walls or over its box."""
     n_bins = max(1, round((hi - lo) / bin_width))
     return lo + (hi - lo) / n_bins * np.arange(n_bins + 1)
+
+
+def bin_index(edges: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Index of the bin [e_k, e_k+1) holding each x: −1 below the first edge, n_bins at or
+    above the last (callers mask those)."""
+    return np.searchsorted(edges, x, side="right") - 1
 
 
 def default_y_edges(frame: Frame, period: float, n_bins: int) -> np.ndarray:

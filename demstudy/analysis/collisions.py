@@ -61,7 +61,7 @@ from scipy.special import erfc
 
 from demstudy import UNITS_NOTE
 from demstudy.analysis import derived as dv
-from demstudy.analysis.base import AnalysisBase
+from demstudy.analysis.base import AnalysisBase, bin_index
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
 from demstudy.theory import collision_frequency, corrected_s, mean_free_path, savage_jeffrey
 
@@ -106,6 +106,16 @@ def savage_jeffrey_projected(theta: ArrayLike, s: float) -> np.ndarray:
     return out
 
 
+def _y_edges(edges: ArrayLike, dim: int) -> np.ndarray:
+    """Checked y-bin edges (increasing, at least one bin) of a 2D or 3D log analysis."""
+    out = np.asarray(edges, float)
+    if out.ndim != 1 or out.size < 2 or np.any(np.diff(out) <= 0):
+        raise ValueError("edges must be increasing with at least 2 entries")
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    return out
+
+
 class CollisionAngles(AnalysisBase):
     """Histograms of theta (both conventions) per y-bin, fed with collision-log chunks.
 
@@ -120,11 +130,7 @@ class CollisionAngles(AnalysisBase):
     def __init__(self, edges: ArrayLike, n_theta: int = 50, dim: int = 2,
                  max_blocks: int = 64, verbose: bool = False) -> None:
         super().__init__(verbose=verbose)
-        self.edges = np.asarray(edges, float)
-        if self.edges.ndim != 1 or self.edges.size < 2 or np.any(np.diff(self.edges) <= 0):
-            raise ValueError("edges must be increasing with at least 2 entries")
-        if dim not in (2, 3):
-            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        self.edges = _y_edges(edges, dim)
         self.n_bins, self.n_theta, self.dim = self.edges.size - 1, int(n_theta), dim
         self.theta_edges = np.linspace(0.0, np.pi, self.n_theta + 1)
         self.max_blocks = max_blocks
@@ -136,7 +142,7 @@ class CollisionAngles(AnalysisBase):
     def _single_frame(self, chunk: Mapping[str, Any]) -> None:  # type: ignore[override]
         kind = np.asarray(chunk["kind"])
         y = np.asarray(chunk["position"], float)[:, 1]
-        ybin = np.searchsorted(self.edges, y, side="right") - 1
+        ybin = bin_index(self.edges, y)
         inside = (ybin >= 0) & (ybin < self.n_bins)
         pair = inside & (kind == PAIR)
         normal = np.asarray(chunk["normal"], float)[pair]
@@ -397,11 +403,7 @@ class FreePath(AnalysisBase):
                  n_hist: int = 50, dim: int = 3, max_blocks: int = 64,
                  verbose: bool = False) -> None:
         super().__init__(verbose=verbose)
-        self.edges = np.asarray(edges, float)
-        if self.edges.ndim != 1 or self.edges.size < 2 or np.any(np.diff(self.edges) <= 0):
-            raise ValueError("edges must be increasing with at least 2 entries")
-        if dim not in (2, 3):
-            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        self.edges = _y_edges(edges, dim)
         if not (lambda_max > 0 and tau_max > 0 and width > 0):
             raise ValueError("lambda_max, tau_max and width must be > 0")
         if not (isinstance(n_hist, int | np.integer) and n_hist >= 1):
@@ -421,17 +423,15 @@ class FreePath(AnalysisBase):
         ok = (k >= 0) & (k < self.n_hist)
         return np.bincount(ybin[ok] * self.n_hist + k[ok], w[ok], minlength=self._size)
 
-    def _ybin(self, y: np.ndarray) -> np.ndarray:
-        return np.searchsorted(self.edges, y, side="right") - 1
 
     def _single_frame(self, chunk: Mapping[str, Any]) -> None:  # type: ignore[override]
         self.duration, self.horizon = float(chunk["duration"]), float(chunk["horizon"])
-        ybin = self._ybin(np.asarray(chunk["y"], float))
+        ybin = bin_index(self.edges, np.asarray(chunk["y"], float))
         ok = (ybin >= 0) & (ybin < self.n_bins)
         ybin = ybin[ok]
         lam, tau = np.asarray(chunk["length"], float)[ok], np.asarray(chunk["tau"], float)[ok]
         w = np.asarray(chunk["weight"], float)[ok]
-        ebin = self._ybin(np.asarray(chunk["event_y"], float))
+        ebin = bin_index(self.edges, np.asarray(chunk["event_y"], float))
         ebin = ebin[(ebin >= 0) & (ebin < self.n_bins)]
         nb = self.n_bins
         sums = [np.bincount(ybin, v, minlength=nb) for v in (w, w * lam, w * lam**2, w * tau,

@@ -38,6 +38,7 @@ from numpy.typing import ArrayLike
 
 from demstudy import UNITS_NOTE
 from demstudy.analysis import derived as dv
+from demstudy.analysis.base import bin_index
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
 
 __all__ = [
@@ -258,7 +259,7 @@ def unsteady_inertia_between(start: Mapping[str, Any], end: Mapping[str, Any],
 
     def binned(snap: Mapping[str, Any]) -> np.ndarray:
         p = np.asarray(snap["momentum"], float)
-        b = np.searchsorted(edges, np.asarray(snap["y"], float), side="right") - 1
+        b = bin_index(edges, np.asarray(snap["y"], float))
         inside = (b >= 0) & (b < n)
         out = np.zeros((n, p.shape[1]))
         np.add.at(out, b[inside], p[inside])

@@ -132,14 +132,20 @@ def _need_results(results: Any, name: str) -> Any:
     return results
 
 
+def _collision_log(results: Any, name: str) -> tuple[Any, dict]:
+    """The results file and its ``/collisions`` log, or a clear error."""
+    res = _need_results(results, name)
+    log = res.groups.get("collisions")
+    if not log:
+        raise ValueError(f"--what {name}: the results file has no /collisions log "
+                         "(event-driven runs write it when the scene measures angles)")
+    return res, log
+
+
 def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> CollisionAngles:
     """P(theta) per profile bin from the ``/collisions`` log of a results file (production
     only), with the Savage–Jeffrey overlay when the file's profiles use the same bins."""
-    res = _need_results(results, "angles")
-    log = res.groups.get("collisions")
-    if not log:
-        raise ValueError("--what angles: the results file has no /collisions log "
-                         "(event-driven runs write it)")
+    res, log = _collision_log(results, "angles")
     lo, hi, _period = profile_bounds(scene)
     edges = res.profiles.get("edges")
     if edges is None:
@@ -159,11 +165,7 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> FreePa
     references when the file's profiles use the same bins."""
     from ..scene.initial import build_initial_state  # only this statistic needs the radii
 
-    res = _need_results(results, "freepath")
-    log = res.groups.get("collisions")
-    if not log:
-        raise ValueError("--what freepath: the results file has no /collisions log "
-                         "(event-driven runs write it when the scene measures angles)")
+    res, log = _collision_log(results, "freepath")
     every = int(res.group_attrs.get("collisions", {}).get("log_every", 1))
     if every != 1:
         raise ValueError(f"--what freepath: the log keeps every {every}th collision; free "
