@@ -275,6 +275,14 @@ struct Grid {
           end(lo_ + static_cast<double>(nbins_) * width_), period(period_),
           inv_period(period_ > 0.0 ? 1.0 / period_ : 0.0), nbins(nbins_),
           one_period(end <= lo_ + period_ * (1.0 + 1e-9)) {}
+
+    // c wrapped into [lo, lo + period) (period > 0)
+    double wrap(double c) const noexcept {
+        if (c >= lo && c < lo + period) return c;
+        double c0 = c - period * std::floor((c - lo) * inv_period);
+        if (c0 >= lo + period) c0 -= period;
+        return c0 < lo ? lo : c0;
+    }
 };
 
 // Calls image(c') for the particle itself (period == 0) or for each of its periodic images
@@ -287,12 +295,7 @@ inline void for_each_image(double c, double r, const Grid& g, Image&& image) {
         return;
     }
     const double p = g.period;
-    double c0 = c;  // wrapped into [lo, lo + P)
-    if (c0 < g.lo || c0 >= g.lo + p) {
-        c0 = c - p * std::floor((c - g.lo) * g.inv_period);
-        if (c0 >= g.lo + p) c0 -= p;
-        if (c0 < g.lo) c0 = g.lo;
-    }
+    const double c0 = g.wrap(c);
     image(c0);
     if (2.0 * r <= p && g.one_period) {  // at most one other image reaches the bins
         if (c0 - r < g.lo)
@@ -319,12 +322,7 @@ inline void deposit_particle(double c, double r, const double* __restrict vals, 
         return;
     }
     const double p = g.period;
-    double c0 = c;  // wrapped into [lo, lo + P)
-    if (c0 < g.lo || c0 >= g.lo + p) {
-        c0 = c - p * std::floor((c - g.lo) * g.inv_period);
-        if (c0 >= g.lo + p) c0 -= p;
-        if (c0 < g.lo) c0 = g.lo;
-    }
+    const double c0 = g.wrap(c);
     deposit<Dim, NV>(c0, r, vals, nv, g.lo, g.width, g.inv_width, g.nbins, vol, sums);
     if (2.0 * r <= p && g.one_period) {  // at most one other image reaches the bins
         if (c0 - r < g.lo)

@@ -817,16 +817,19 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
         flush();
         // the partner's collision counter once, at the end (a miss per candidate otherwise)
         if (partner >= 0 && partner != stored) partner_count = count_[partner];
-    } else if (gravity_) {
+    } else {
+        // bumps, or a row next to a Lees–Edwards boundary: one pair at a time. The candidates
+        // are extrapolated along their flights as in pair_times (g = 0 without gravity gives
+        // the same numbers as straight lines).
         const double* g = p_.gravity;
         std::int32_t kind = kNone;
-        const double horizon = has_bumps_ ? next_boundary(i, kind) : kInf;
+        const double horizon = gravity_ && has_bumps_ ? next_boundary(i, kind) : kInf;
         const double minus_g[3] = {-g[0], -g[1], -g[2]};
         for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
             const Particle& pj = P_[j];
             const double dtj = time_ - pj.t;
             double dr[3], dv[3];
-            if (fixed_[j] != 0) {  // a static bump: the relative motion is a parabola
+            if (gravity_ && fixed_[j] != 0) {  // a static bump: the relative motion is a parabola
                 for (int a = 0; a < 3; ++a) {
                     dr[a] = pj.x[a] + pj.v[a] * dtj + (sh ? sh[a] : 0.0) - xi[a];
                     dv[a] = pj.v[a] + (sh ? vs[a] : 0.0) - vi[a];
@@ -843,22 +846,6 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             for (int a = 0; a < 3; ++a) {
                 dr[a] = pj.x[a] + (pj.v[a] + 0.5 * g[a] * dtj) * dtj - xi[a];
                 dv[a] = pj.v[a] + g[a] * dtj - vi[a];
-            }
-            if (sh != nullptr)
-                for (int a = 0; a < 3; ++a) {
-                    dr[a] += sh[a];
-                    dv[a] += vs[a];
-                }
-            consider(j, dr, dv);
-        });
-    } else {
-        for_neighbours(i, only_axis, dir, [&](std::int32_t j, const double* sh, const double* vs) {
-            const Particle& pj = P_[j];
-            const double dtj = time_ - pj.t;
-            double dr[3], dv[3];
-            for (int a = 0; a < 3; ++a) {
-                dr[a] = pj.x[a] + pj.v[a] * dtj - xi[a];
-                dv[a] = pj.v[a] - vi[a];
             }
             if (sh != nullptr)
                 for (int a = 0; a < 3; ++a) {
