@@ -68,3 +68,33 @@ def system(scene, tc: float = 0.0, **kw) -> EventDriven:
 
 def energy(s: EventDriven) -> float:
     return s.kinetic_energy + s.rotational_energy
+
+
+#: A small engine scene: 2D discs at ν = 0.3, e = 0.95, β = 0.4, periodic (override for
+#: walls, shear, …).
+ENGINE_SCENE = """
+dimension = 2
+[meta]
+name = "edmd-small"
+[box]
+size = [20.0, 20.0]
+[particles]
+solid_fraction = 0.3
+[contact]
+restitution = 0.95
+tangential = { model = "beta", beta = 0.4 }
+[initial.velocity]
+temperature = 1.0
+[run]
+equilibration = 2.0
+production = 4.0
+sample_interval = 0.5
+seed = 3
+[measure]
+bin_width = 2.0
+"""
+
+
+def engine_scene(overrides: dict | None = None):
+    """ENGINE_SCENE with dotted-key ``overrides``."""
+    return scene_with(ENGINE_SCENE, overrides)

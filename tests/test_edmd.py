@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from edmd_helpers import energy, make_scene, scene_with, system
+from edmd_helpers import ENGINE_SCENE, energy, engine_scene, make_scene, system
 from scipy.spatial import cKDTree
 
 from demstudy.analysis.suite import profile_analysis
@@ -410,31 +410,6 @@ def test_rejects_bad_input():
 
 # ---- the engine ------------------------------------------------------------------------------
 
-ENGINE_SCENE = """
-dimension = 2
-[meta]
-name = "edmd-small"
-[box]
-size = [20.0, 20.0]
-[particles]
-solid_fraction = 0.3
-[contact]
-restitution = 0.95
-tangential = { model = "beta", beta = 0.4 }
-[initial.velocity]
-temperature = 1.0
-[run]
-equilibration = 2.0
-production = 4.0
-sample_interval = 0.5
-seed = 3
-[measure]
-bin_width = 2.0
-"""
-
-
-def engine_scene(overrides: dict | None = None):
-    return scene_with(ENGINE_SCENE, overrides)
 
 
 def test_engine_writes_the_common_results_file(tmp_path):

@@ -31,7 +31,8 @@ import sys
 
 import numpy as np
 import pytest
-from edmd_helpers import energy, make_scene, scene_with, system
+from edmd_helpers import energy, make_scene, system
+from edmd_helpers import engine_scene as base_engine_scene
 from scipy.spatial import cKDTree
 
 from demstudy.engines.base import EngineError, RunOptions
@@ -446,6 +447,16 @@ def test_campbell_chute_40_runs_to_the_requested_time(tmp_path):
 SERVO_SIGMA = 10 * CAMPBELL_SIGMA_N
 
 
+def wall_stress_ratios(ts, production, sigma):
+    """Per wall: the mean normal wall stress over production / σ_n and its standard error
+    (20 block means)."""
+    width = ts["width"][production]
+    for side, sign in (("lower", -1.0), ("upper", 1.0)):
+        stress = sign * ts[f"wall_force_{side}"][production, 1] / width / sigma
+        blocks = stress[: len(stress) // 20 * 20].reshape(20, -1).mean(axis=1)
+        yield side, stress.mean(), blocks.std(ddof=1) / math.sqrt(20)
+
+
 @pytest.fixture(scope="module")
 def servo_run(tmp_path_factory):
     """couette-rough.toml (2D, 40 rough discs, servo on both walls, width following the gap)
@@ -527,12 +538,8 @@ def test_servo_at_high_stress_converges_to_sigma_n_within_2_percent(tmp_path):
     res = read_results(out)
     ts = res.timeseries
     production = ts["time"] > 10000.0
-    width = ts["width"][production]
-    for side, sign in (("lower", -1.0), ("upper", 1.0)):
-        stress = sign * ts[f"wall_force_{side}"][production, 1] / width / SERVO_SIGMA
-        blocks = stress[: len(stress) // 20 * 20].reshape(20, -1).mean(axis=1)
-        err = blocks.std(ddof=1) / math.sqrt(20)
-        assert abs(stress.mean() - 1.0) < 0.02, side
+    for side, mean, err in wall_stress_ratios(ts, production, SERVO_SIGMA):
+        assert abs(mean - 1.0) < 0.02, side
         assert err < 0.03, side
     y = res.frames["position"][..., 1]
     lower = ts["wall_position_lower"][production]
@@ -555,13 +562,9 @@ def test_time_interval_servo_without_clamp_holds_the_time_mean_stress(tmp_path):
     EdmdEngine().run(scene, RunOptions(out=out, progress=False))
     ts = read_results(out).timeseries
     production = ts["time"] > 10000.0
-    width = ts["width"][production]
-    for side, sign in (("lower", -1.0), ("upper", 1.0)):
-        stress = sign * ts[f"wall_force_{side}"][production, 1] / width / CAMPBELL_SIGMA_N
-        blocks = stress[: len(stress) // 20 * 20].reshape(20, -1).mean(axis=1)
-        err = blocks.std(ddof=1) / math.sqrt(20)
-        assert abs(stress.mean() - 1.0) < max(3 * err, 0.02), side
-        assert abs(stress.mean() - 1.0) < 0.08, side
+    for side, mean, err in wall_stress_ratios(ts, production, CAMPBELL_SIGMA_N):
+        assert abs(mean - 1.0) < max(3 * err, 0.02), side
+        assert abs(mean - 1.0) < 0.08, side
 
 
 def test_width_scaling_that_changes_every_cell_axis_keeps_running():
@@ -672,31 +675,10 @@ def test_couette_stress_three_routes_agree(tmp_path):
 
 # ---- 7. run.unit = "collisions" ---------------------------------------------------------------
 
-ENGINE_SCENE = """
-dimension = 2
-[meta]
-name = "edmd-walls-small"
-[box]
-size = [20.0, 20.0]
-[particles]
-solid_fraction = 0.3
-[contact]
-restitution = 0.95
-tangential = { model = "beta", beta = 0.4 }
-[initial.velocity]
-temperature = 1.0
-[run]
-equilibration = 1.0
-production = 3.0
-sample_interval = 0.5
-seed = 3
-[measure]
-bin_width = 2.0
-"""
-
-
 def engine_scene(overrides: dict | None = None):
-    return scene_with(ENGINE_SCENE, overrides)
+    """The shared small engine scene, shorter (equilibration 1, production 3)."""
+    return base_engine_scene({"meta.name": "edmd-walls-small", "run.equilibration": 1.0,
+                              "run.production": 3.0, **(overrides or {})})
 
 
 @pytest.mark.parametrize("walls", [False, True])
