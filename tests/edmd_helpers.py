@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from demstudy.engines.edmd import EventDriven, check_supported, from_initial_state
 from demstudy.engines.edmd.core import y_range
 from demstudy.scene import parse_scene_text, validate_scene
@@ -64,6 +66,22 @@ def system(scene, tc: float = 0.0, **kw) -> EventDriven:
         params["y_range"] = y_range(scene, initial.position)
     params.update(kw)
     return from_initial_state(initial, scene.box.size, tc=tc, **params)
+
+
+def resumed(scene, saved, start: float, until: float, tc: float = 1e-5) -> EventDriven:
+    """A fresh system for ``scene`` restored from ``saved`` (taken at ``start``), continued to
+    ``until``."""
+    b = system(scene, tc=tc)
+    b.set_state(saved)
+    assert b.time == start
+    b.advance_to(until)
+    return b
+
+
+def assert_same_particles(a: EventDriven, b: EventDriven) -> None:
+    """Bit-identical positions, velocities and spins."""
+    for get in ("positions", "velocities", "angular_velocities"):
+        assert np.array_equal(getattr(a, get)(), getattr(b, get)()), get
 
 
 def energy(s: EventDriven) -> float:
