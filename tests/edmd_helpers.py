@@ -78,6 +78,24 @@ def resumed(scene, saved, start: float, until: float, tc: float = 1e-5) -> Event
     return b
 
 
+def whole_and_resumed(scene, tmp_path):
+    """The results of ``scene`` run in one go and run in two parts (stopped at once by a
+    zero wall limit, which checkpoints, then resumed)."""
+    import pytest
+
+    from demstudy.engines.base import EngineError, RunOptions
+    from demstudy.engines.edmd import EdmdEngine
+    from demstudy.io.results import read_results
+
+    whole = EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5", progress=False))
+    out = tmp_path / "parts.h5"
+    with pytest.raises(EngineError, match="--resume"):
+        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
+    assert (tmp_path / "parts.edmd" / "checkpoint.pkl").exists()
+    EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True))
+    return read_results(whole), read_results(out)
+
+
 def assert_same_particles(a: EventDriven, b: EventDriven) -> None:
     """Bit-identical positions, velocities and spins."""
     for get in ("positions", "velocities", "angular_velocities"):

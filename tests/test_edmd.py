@@ -30,12 +30,13 @@ from edmd_helpers import (
     make_scene,
     resumed,
     system,
+    whole_and_resumed,
 )
 from scipy.spatial import cKDTree
 
 from demstudy.analysis.suite import profile_analysis
 from demstudy.decks.base import UnsupportedByEngine
-from demstudy.engines.base import EngineError, RunOptions, get_engine
+from demstudy.engines.base import RunOptions, get_engine
 from demstudy.engines.edmd import (
     EdmdEngine,
     EventDriven,
@@ -446,13 +447,7 @@ def test_engine_writes_the_common_results_file(tmp_path):
 
 def test_engine_resume_is_bit_identical(tmp_path):
     scene = engine_scene()
-    whole = EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5", progress=False))
-    out = tmp_path / "parts.h5"
-    with pytest.raises(EngineError, match="--resume"):
-        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
-    assert (tmp_path / "parts.edmd" / "checkpoint.pkl").exists()
-    EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True))
-    a, b = read_results(whole), read_results(out)
+    a, b = whole_and_resumed(scene, tmp_path)
     for key, value in a.timeseries.items():
         assert np.array_equal(value, b.timeseries[key], equal_nan=True), key
     for key, value in a.profiles.items():

@@ -31,11 +31,18 @@ import sys
 
 import numpy as np
 import pytest
-from edmd_helpers import assert_same_particles, energy, make_scene, resumed, system
+from edmd_helpers import (
+    assert_same_particles,
+    energy,
+    make_scene,
+    resumed,
+    system,
+    whole_and_resumed,
+)
 from edmd_helpers import engine_scene as base_engine_scene
 from scipy.spatial import cKDTree
 
-from demstudy.engines.base import EngineError, RunOptions
+from demstudy.engines.base import RunOptions
 from demstudy.engines.edmd import EdmdEngine, EventDriven
 from demstudy.io.results import read_results
 from demstudy.scene import load_scene, parse_scene_text, validate_scene
@@ -733,13 +740,7 @@ def test_state_round_trip_with_walls_gravity_and_moved_walls():
 
 def test_engine_resume_with_walls_gravity_and_servo_is_bit_identical(tmp_path):
     scene = load_scene(COUETTE, SERVO_GRAVITY)
-    whole = EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5", progress=False))
-    out = tmp_path / "parts.h5"
-    with pytest.raises(EngineError, match="--resume"):
-        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
-    assert (tmp_path / "parts.edmd" / "checkpoint.pkl").exists()
-    EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True))
-    a, b = read_results(whole), read_results(out)
+    a, b = whole_and_resumed(scene, tmp_path)
     for key in ("gap", "gravity_work", "wall_force_lower", "wall_force_upper", "width"):
         assert key in a.timeseries, key
     for key, value in a.timeseries.items():

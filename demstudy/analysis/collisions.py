@@ -116,6 +116,16 @@ def _y_edges(edges: ArrayLike, dim: int) -> np.ndarray:
     return out
 
 
+def _check_overlay(analysis: AnalysisBase, profiles: Mapping[str, Any], name: str) -> None:
+    """An overlay needs the finished analysis and profiles on the same y-bins."""
+    if not analysis._finished:
+        raise RuntimeError("call finish() before overlay()")
+    y = np.asarray(profiles["y"], float)
+    mine = analysis.results["y"]
+    if y.shape != mine.shape or not np.allclose(y, mine):
+        raise ValueError(f"the profiles must use the same y-bins as the {name}")
+
+
 class CollisionAngles(AnalysisBase):
     """Histograms of theta (both conventions) per y-bin, fed with collision-log chunks.
 
@@ -196,11 +206,7 @@ class CollisionAngles(AnalysisBase):
         (``s_text``, ``s_listing`` with ``_err``) and, for the bin-centre angles,
         ``sj_text_R``, ``sj_text_C``, ``sj_listing_R``, ``sj_listing_C`` (n_bins, n_theta);
         3D uses :func:`savage_jeffrey_projected` with the same effective S."""
-        if not self._finished:
-            raise RuntimeError("call finish() before overlay()")
-        y = np.asarray(profiles["y"], float)
-        if y.shape != self.results["y"].shape or not np.allclose(y, self.results["y"]):
-            raise ValueError("the profiles must use the same y-bins as the collision angles")
+        _check_overlay(self, profiles, "collision angles")
         nu = np.asarray(profiles["solid_fraction"], float)
         theta = self.results["theta"]
         for variant, c_length in (("text", "C"), ("listing", "C/2")):
@@ -496,11 +502,7 @@ class FreePath(AnalysisBase):
         at its solid fraction and temperature), ``knudsen_enskog``, and the measured
         ``collision_frequency`` = collision_rate / (n V_bin), V_bin = bin width x
         ``cross_section``."""
-        if not self._finished:
-            raise RuntimeError("call finish() before overlay()")
-        y = np.asarray(profiles["y"], float)
-        if y.shape != self.results["y"].shape or not np.allclose(y, self.results["y"]):
-            raise ValueError("the profiles must use the same y-bins as the free paths")
+        _check_overlay(self, profiles, "free paths")
         nu = np.asarray(profiles["solid_fraction"], float)
         with np.errstate(divide="ignore", invalid="ignore"):
             self.results["lambda_enskog"] = mean_free_path(nu, self.dim)
