@@ -85,8 +85,8 @@ class EdmdRunState:
     log: dict[str, list] = field(default_factory=dict)
     logged: int = 0
     stress_edges: np.ndarray | None = None  # servo runs: bins fixed when production starts
-    # particle y and momenta where production starts and at its latest sample (the
-    # momentum balance's unsteady term)
+    # particle y and momenta where production starts and ends (the momentum balance's
+    # unsteady term)
     momentum_start: dict | None = None
     momentum_end: dict | None = None
 
@@ -321,19 +321,23 @@ class _Run:
                 state.log.setdefault(key, []).append(value[:keep])
             state.logged += keep
         state.last_time = t
-        if self.scene.gravity is not None and (production or state.samples == self.n_eq):
-            snap = momentum_snapshot(t, core.positions()[:n, 1], self.mass[:, None] * velocity)
-            if production:
-                state.momentum_end = snap
-            else:
+        snapshot = self.scene.gravity is not None and state.samples in (self.n_eq, self.n_total)
+        if not (production or snapshot):
+            return
+        position = core.positions()[:n]
+        if snapshot:
+            snap = momentum_snapshot(t, position[:, 1], self.mass[:, None] * velocity)
+            if state.samples == self.n_eq:
                 state.momentum_start = snap
+            else:
+                state.momentum_end = snap
         if not production:
             return
         lo, hi = np.zeros(dim), np.asarray(core.box, float)
         if not self.scene.y_periodic:
             lo[1] = core.wall_position(0) if self.scene.wall("lower") else 0.0
             hi[1] = core.wall_position(1) if self.scene.wall("upper") else hi[1]
-        frame = Frame(time=t, box_lo=lo, box_hi=hi, position=core.positions()[:n],
+        frame = Frame(time=t, box_lo=lo, box_hi=hi, position=position,
                       velocity=velocity, angular_velocity=core.angular_velocities()[:n],
                       radius=self.radius, tilt=core.shear_offset)
         if state.profiles is None:  # servo: bins between the walls where production starts

@@ -64,8 +64,8 @@ class RunState:
     # wall forces (on the particles) summed over segments since the last sample / servo update
     force_sums: dict[str, np.ndarray] = field(default_factory=dict)
     force_counts: dict[str, int] = field(default_factory=dict)
-    # particle y and momenta where production starts and at its latest sample (the
-    # momentum balance's unsteady term)
+    # particle y and momenta where production starts and ends (the momentum balance's
+    # unsteady term)
     momentum_start: dict | None = None
     momentum_end: dict | None = None
 
@@ -203,12 +203,12 @@ class Driver:
             for key, value in state.servo.state().items():
                 state.record(key, value)
             state.record("width", float(frame.lengths[0]))
-        if self.scene.gravity is not None and (production or state.step == self.n_eq):
+        if self.scene.gravity is not None and state.step in (self.n_eq, self.n_total):
             snap = momentum_snapshot(t, frame.position[:, 1], mass[:, None] * frame.velocity)
-            if production:
-                state.momentum_end = snap
-            else:
+            if state.step == self.n_eq:
                 state.momentum_start = snap
+            else:
+                state.momentum_end = snap
         if production and self.measure_stress:  # collective (sum over ranks)
             self._sample_stress(session, state, frame)
         if not production or session.rank != 0:
