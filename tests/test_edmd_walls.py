@@ -793,3 +793,40 @@ def test_falling_gas_on_static_bumps_balances_energy():
     assert abs(e1 - e0 - s.gravity_work - s.wall_work(0) + s.dissipated) < 1e-12 * e0
     assert s.min_gap() > -1e-9
     assert np.array_equal(s.positions()[n:], bumps)  # bumps never move
+
+
+def caged_disc(e: float = 1.0) -> EventDriven:
+    """A disc between two fixed bumps of the lower wall, touching both (zero gaps), moving
+    towards one: without time passing it bounces from bump to bump for ever."""
+    pos = np.array([[4.0, 2.0], [3.0, 2.0], [5.0, 2.0]])
+    vel = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]])
+    return EventDriven(pos, vel, np.zeros((3, 1)), np.ones(3), np.ones(3), [10.0, 10.0], 2,
+                       e=e, periodic_y=False, y_range=(0.0, 10.0),
+                       fixed=np.array([0, 1, 1], np.int8),
+                       walls=[{"side": "lower", "position": 0.0, "e": e}])
+
+
+def test_zero_time_collision_loop_stops_with_a_clear_error(monkeypatch):
+    """Hard-particle runs can stall: a cluster of exactly touching particles may collide in a
+    loop that takes no time (here a disc caged at zero gaps between two bumps). The engine's
+    watched advance turns that hang into an EngineError naming the time and the cause, while
+    an ordinary run with the same watch reaches its end."""
+    from demstudy.engines.base import EngineError
+    from demstudy.engines.edmd import core
+
+    stuck = caged_disc()
+    assert not stuck.advance_to(1.0, max_events=20_000)  # the loop is real: time stays at 0
+    assert stuck.time == 0.0 and stuck.wall_collisions == stuck.events == 20_000
+    monkeypatch.setattr(core, "STALL_CHUNK", 5_000)
+    with pytest.raises(EngineError, match=r"stalled at t = 0\b.*zero gaps"):
+        core.advance_watched(caged_disc(), 1.0, tc=0.0)
+    # the same watch on a disc with room to move: it rattles between the bumps and arrives
+    pos = np.array([[4.0, 2.0], [2.9, 2.0], [5.1, 2.0]])
+    roomy = EventDriven(pos, np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]]), np.zeros((3, 1)),
+                        np.ones(3), np.ones(3), [10.0, 10.0], 2, e=1.0, periodic_y=False,
+                        y_range=(0.0, 10.0), fixed=np.array([0, 1, 1], np.int8),
+                        walls=[{"side": "lower", "position": 0.0, "e": 1.0}])
+    assert core.advance_watched(roomy, 100.0, tc=0.0)
+    assert roomy.time == 100.0 and roomy.wall_collisions == 500  # one bounce per 0.2 time units
+    # a run that stops at its event budget is not a stall
+    assert not core.advance_watched(caged_disc(), 1.0, tc=0.0, max_events=3_000)

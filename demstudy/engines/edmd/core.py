@@ -12,7 +12,7 @@ the scheduled events); ``set_state(state)`` on a system built from the same part
 continues bit-identically (events are processed in the total order (time, index)).
 Accessors: ``positions()`` (wrapped into [0, L)), ``velocities()``, ``angular_velocities()``,
 ``kinetic_energy``, ``rotational_energy``, ``time``; counters ``collisions``,
-``cell_crossings``, ``events`` (= collisions + crossings), ``invalid_events`` (stale
+``cell_crossings``, ``events`` (= pair + wall collisions + crossings), ``invalid_events`` (stale
 predictions discarded), ``elastic_tc_collisions``; ``virial`` = Σ r_ij·J_i over all collisions
 (r_ij = r_i − r_j, J_i the impulse on i) and ``virial_tensor`` Σ r_ij ⊗ J_i, so the collisional
 pressure over an interval Δt is ΔW / (dim V Δt); ``dissipated`` = energy lost in collisions
@@ -41,11 +41,14 @@ from ...decks.base import UnsupportedByEngine
 from ...decks.bumps import bump_rows
 from ...scene import Scene
 from ...scene.initial import InitialState
+from ..base import EngineError
 
 DEFAULT_TC = 1e-5
+# events between two checks of the simulated time's progress (at least 1000 per particle)
+STALL_CHUNK = 10_000_000
 
-__all__ = ["DEFAULT_TC", "EventDriven", "collide_pair", "from_initial_state",
-           "scene_parameters", "with_bumps", "y_range"]
+__all__ = ["DEFAULT_TC", "STALL_CHUNK", "EventDriven", "advance_watched", "collide_pair",
+           "from_initial_state", "scene_parameters", "with_bumps", "y_range"]
 
 
 def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
@@ -167,3 +170,45 @@ def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -
                        c(state.angular_velocity, float), c(state.diameter, float),
                        c(state.mass, float), [float(b) for b in box], dim, e=e, beta=beta,
                        inertia_k=inertia_k, tc=tc, **options)
+
+
+def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int = 0,
+                    stop_collisions: int = 0) -> bool:
+    """``core.advance_to(t, max_events, stop_collisions)``, watched for a stall.
+
+    Events are processed in chunks of max(``STALL_CHUNK``, 1000 N). A chunk that moves the
+    simulated time by no more than max(t_c, 1e-9) means a zero-time collision loop. One
+    example is a particle caged between two fixed bumps at exactly zero gaps, which bounces
+    between them without time passing. Such a run could never finish, so it raises
+    ``EngineError`` naming the time and the cause, instead of hanging. A legitimately slow run
+    is not caught: a bed resting under the TC model costs about N/t_c events per time unit,
+    so one chunk still moves the time by about 1000 t_c.
+
+    Returns True when t is reached. Returns False when the run stopped early at
+    ``max_events`` (> 0, counted from the call) or at ``stop_collisions``.
+
+    Between chunks every particle is synchronised (as ``advance_to`` does at t), so the chunk
+    size belongs to the trajectory. It depends only on N, so runs stay deterministic and
+    resume bit-identically.
+    """
+    chunk = max(STALL_CHUNK, 1000 * core.n)
+    start = core.events
+    while True:
+        budget = chunk
+        if max_events > 0:
+            budget = min(chunk, max_events - (core.events - start))
+            if budget <= 0:
+                return False
+        t0, e0 = core.time, core.events
+        if core.advance_to(t, max_events=budget, stop_collisions=stop_collisions):
+            return True
+        if stop_collisions > 0 and core.collisions >= stop_collisions:
+            return False
+        if core.events - e0 >= chunk and core.time - t0 <= max(tc, 1e-9):
+            raise EngineError(
+                f"the event-driven run stalled at t = {core.time:.9g}: {core.events - e0} "
+                f"events moved the time by {core.time - t0:.3g} (at most max(t_c, 1e-9) = "
+                f"{max(tc, 1e-9):.3g}). A cluster of exactly touching particles is colliding "
+                "in a loop that takes no time, for example a particle caged at zero gaps "
+                "between fixed bumps or in a crystalline row. Perturb the start (seed, "
+                "random bumps), raise --tc, or use the LAMMPS engine")

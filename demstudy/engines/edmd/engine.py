@@ -38,7 +38,15 @@ from ...scene.initial import build_initial_state
 from ..base import EngineError, RunOptions, RunStopped
 from ..child import in_worker, launch_child
 from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
-from .core import DEFAULT_TC, EventDriven, from_initial_state, scene_parameters, with_bumps, y_range
+from .core import (
+    DEFAULT_TC,
+    EventDriven,
+    advance_watched,
+    from_initial_state,
+    scene_parameters,
+    with_bumps,
+    y_range,
+)
 
 CHECKPOINT = "checkpoint.pkl"
 ENGINE_VERSION = (f"demstudy-edmd {__version__} (gravity, flat walls, servo, Lees-Edwards, "
@@ -253,7 +261,7 @@ class _Run:
         while True:
             stops = [c for c in (target, state.next_servo if by_count else 0) if c > 0]
             t_stop = min(t_end, state.next_servo_time) if by_time else t_end
-            reached = core.advance_to(t_stop, max_events=guard,
+            reached = advance_watched(core, t_stop, tc=self.tc, max_events=guard,
                                       stop_collisions=min(stops, default=0))
             if reached and by_time and core.time >= state.next_servo_time:
                 self._servo_update(core, state)

@@ -172,7 +172,9 @@ public:
     std::int64_t collisions() const { return collisions_; }
     std::int64_t wall_collisions() const { return wall_collisions_; }
     std::int64_t cell_crossings() const { return crossings_; }
-    std::int64_t events() const { return collisions_ + crossings_; }
+    // every processed event: pair, wall and bump collisions, cell crossings (not the stale
+    // predictions discarded, nor the Lees–Edwards re-scans)
+    std::int64_t events() const { return collisions_ + wall_collisions_ + crossings_; }
     std::int64_t invalid_events() const { return invalid_; }
     std::int64_t elastic_tc_collisions() const { return tc_elastic_; }
     std::int64_t resting_bounces() const { return resting_; }
