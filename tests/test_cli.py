@@ -123,7 +123,8 @@ def test_analyze_stored_frames_adds_statistics(tmp_path, capsys):
 
 def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path, capsys):
     """`--engine edmd` goes through the same isolated child process as LAMMPS and writes the
-    same results layout; scenes outside its scope (bumpy walls) are refused with exit 2."""
+    same results layout; scenes outside its scope (regular bumps under gravity) are refused with
+    exit 2."""
     from demstudy.io.results import read_results
 
     scene = ROOT / "inputs" / "cooling" / "hcs-3d.toml"
@@ -136,7 +137,7 @@ def test_edmd_runs_through_the_cli_in_a_child_process(tmp_path, capsys):
     assert ke[-1] < ke[0]  # e = 0.9: it cools
     assert main(["run", str(CHUTE), "--engine", "edmd", "--out", str(tmp_path / "c.h5"),
                  "-q", "--set", "walls[0].kind=bumpy", "--set", "walls.0.bumps.spacing=1.0"]) == 2
-    assert "unsupported by edmd: walls[lower].kind" in capsys.readouterr().err
+    assert "unsupported by edmd: walls[lower].bumps.pattern = 'regular'" in capsys.readouterr().err
 
 
 def test_tc_option_reaches_the_event_driven_engine_and_is_checked_first(tmp_path, capfd):

@@ -457,13 +457,14 @@ def test_engine_resume_is_bit_identical(tmp_path):
 @pytest.mark.parametrize("overrides, field", [
     ({"box.periodic": ["x"], "gravity": {"angle": 20.0},
       "walls": [{"side": "lower", "restitution": 0.9, "kind": "bumpy",
-                 "bumps": {"spacing": 1.0}}]}, "walls[lower].kind"),
+                 "bumps": {"spacing": 1.0}}]}, "walls[lower].bumps.pattern"),
     ({"contact.law": {"model": "campbell-exp"}}, "contact.law.model"),  # needs g for √(gR)
     ({"box.size": [20.0, 2.5]}, "box.size"),
 ])
 def test_engine_refuses_what_it_cannot_do(overrides, field, tmp_path):
-    """Bumpy walls under gravity, Campbell's e(v) without gravity and periodic boxes too small
-    for the cell lists are refused before anything runs, naming the field."""
+    """Regular bumpy walls under gravity (the bottom layer cages itself at zero gaps),
+    Campbell's e(v) without gravity and periodic boxes too small for the cell lists are
+    refused before anything runs, naming the field."""
     scene = engine_scene(overrides)
     with pytest.raises(UnsupportedByEngine) as info:
         EdmdEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))

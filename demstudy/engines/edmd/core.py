@@ -99,13 +99,16 @@ def scene_parameters(scene: Scene) -> dict:
     if not scene.y_periodic:
         walls = []
         for wall in scene.walls:
-            if wall.kind == "bumpy" and scene.gravity is not None:
-                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].kind", wall.kind,
-                                          "bumpy walls under gravity are not supported by the "
-                                          "event-driven engine: particles resting in the "
-                                          "hollows between bumps jam (contacts with vanishing "
-                                          "gaps collide ever faster); use a flat wall with a "
-                                          "rough rule, or LAMMPS")
+            if (wall.kind == "bumpy" and scene.gravity is not None
+                    and wall.bumps.pattern != "random"):
+                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].bumps.pattern",
+                                          wall.bumps.pattern,
+                                          "under gravity the event-driven engine needs "
+                                          "pattern = 'random': on regular bumps the bottom "
+                                          "layer settles into the hollows at exactly zero "
+                                          "gaps and the hard particles' collisions loop "
+                                          "without time passing (a stall); use random bumps, "
+                                          "a flat wall with a rough rule, or LAMMPS")
             if wall.kind == "bumpy" and wall.servo is not None:
                 raise UnsupportedByEngine("edmd", f"walls[{wall.side}].servo", "servo",
                                           "a bumpy wall cannot be servo-controlled")

@@ -100,8 +100,9 @@ struct Params {
     double stress_lo = 0.0, stress_width = 1.0;
     // bumps of bumpy walls: per particle 0 (mobile), 1 (lower wall's bump), 2 (upper wall's);
     // empty = all mobile. Bumps keep their velocity (the wall's), feel no gravity (under
-    // gravity they must be static: a falling particle meets a bump at a root of a quartic,
-    // found by conservative advancement), collide with mobile particles by their wall's rule
+    // gravity they must be static: a falling particle meets a bump at the first root of a
+    // quartic, isolated between its turning points and found by bisection), collide with
+    // mobile particles by their wall's rule
     // and count in that wall's impulse and work.
     std::vector<std::int8_t> fixed;
     // collision log: every log_every-th collision, at most log_capacity records (0: off)

@@ -88,37 +88,97 @@ double first_hit(double y0, double vy, double ay) {
     if (vy <= 0.0 || disc < 0.0) return kInfinity;
     return -2.0 * y0 / (vy + std::sqrt(disc));
 }
-// First contact time in [0, horizon] of a particle and a fixed bump under gravity: the
-// separation d(t) = d0 + dv t + ½ a t² (a = −g) makes |d|² − σ² a quartic, so the root is
-// found by conservative advancement (safe steps from the gap h and the current relative speed:
-// no contact is stepped over) until the gap is below 1e-10 σ. Returns inf when there is none before the
-// horizon; after 2000 steps (a grazing approach) it returns the time reached, where the
-// engine re-checks the pair (an event with no impulse).
+// The point in [lo, hi] where fn, monotone there and of opposite signs at the ends, changes
+// sign: the last point on lo's side, to round-off (at most 100 halvings: 2^-100 of the span).
+template <typename F>
+double sign_change(F&& fn, double lo, double hi) {
+    const bool lo_positive = fn(lo) > 0.0;
+    for (int k = 0; k < 100; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        if (!(mid > lo && mid < hi)) break;
+        if ((fn(mid) > 0.0) == lo_positive)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+// First contact time in [0, horizon] of a particle and a fixed bump under gravity: with the
+// separation d(t) = d0 + dv t + ½ a t² (a = −g), f(t) = |d|² − σ² is a quartic. Its first
+// crossing from apart (f > 0) to contact (f <= 0) is found exactly: the roots of f'' (a
+// quadratic) split [0, horizon] into pieces where f' is monotone, bisection gives the roots
+// of f' (where f turns), and f is then monotone between them, so the first piece that ends in
+// contact holds the root, found by bisection to round-off (the last time still apart).
+// Touching or overlapping and approaching (or pressed on by gravity, from a turning point):
+// that time. None before the horizon: inf.
 double bump_contact_time(const double* d0, const double* dv, const double* a, double sigma,
                          double horizon) {
-    const double amag = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    double t = 0.0;
-    for (int step = 0; step < 2000; ++step) {
+    const double f0 = dot3(d0, d0) - sigma * sigma;
+    const double b0 = dot3(d0, dv);
+    if (f0 <= 0.0 && b0 < 0.0) return 0.0;
+    const double aa = dot3(a, a), va = dot3(dv, a), vv = dot3(dv, dv), da = dot3(d0, a);
+    // out of reach: the gap cannot close faster than |dv| t + |a| t²/2
+    double h = horizon;
+    if (!std::isfinite(h)) {  // the quartic's roots lie within Cauchy's bound
+        const double c4 = 0.25 * aa;
+        if (!(c4 > 0.0)) return kInfinity;
+        h = 1.0 + std::max({std::fabs(va), std::fabs(vv + da), std::fabs(2.0 * b0),
+                            std::fabs(f0)}) / c4;
+    }
+    const double gap = std::sqrt(dot3(d0, d0)) - sigma;
+    if (gap > std::sqrt(vv) * h + 0.5 * std::sqrt(aa) * h * h) return kInfinity;
+    auto f = [&](double t) {
+        double d[3];
+        for (int k = 0; k < 3; ++k) d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
+        return dot3(d, d) - sigma * sigma;
+    };
+    auto df = [&](double t) {  // f'/2 = d·u
         double d[3], u[3];
         for (int k = 0; k < 3; ++k) {
             d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
             u[k] = dv[k] + a[k] * t;
         }
-        const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        const double h = dist - sigma;
-        const double speed = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-        if (h <= 1e-10 * sigma) {
-            const double approach = -(d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / dist;
-            if (approach > 0.0) return t;  // within 1e-10 σ of contact, approaching
-            t += 1e-9 * sigma / (speed + amag * 1e-3 + 1e-300);  // touching, receding
-        } else {
-            // safe step τ: over [t, t + τ] |d'| <= speed + |a| τ, so the gap shrinks by at
-            // most (speed + |a| τ) τ = h
-            t += 2.0 * h / (speed + std::sqrt(speed * speed + 4.0 * amag * h));
+        return dot3(d, u);
+    };
+    // f''/2 = 1.5 |a|² t² + 3 (dv·a) t + |dv|² + d0·a: its roots in (0, h), ascending
+    double cuts[6];
+    int n_cuts = 0;
+    cuts[n_cuts++] = 0.0;
+    {
+        const double A = 1.5 * aa, B = 3.0 * va, C = vv + da;
+        const double disc = B * B - 4.0 * A * C;
+        if (A > 0.0 && disc > 0.0) {
+            const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+            double r1 = q / A, r2 = q != 0.0 ? C / q : -r1;
+            if (r1 > r2) std::swap(r1, r2);
+            for (double r : {r1, r2})
+                if (r > 0.0 && r < h) cuts[n_cuts++] = r;
         }
-        if (t > horizon) return kInfinity;
     }
-    return t;  // grazing: re-check there
+    cuts[n_cuts++] = h;
+    // the turning points of f (roots of f') in each piece where f' is monotone
+    double turns[8];
+    int n_turns = 0;
+    turns[n_turns++] = 0.0;
+    for (int k = 0; k + 1 < n_cuts; ++k) {
+        const double lo = cuts[k], hi = cuts[k + 1];
+        const double glo = df(lo), ghi = df(hi);
+        if ((glo > 0.0) != (ghi > 0.0) && hi > lo) {
+            const double r = sign_change(df, lo, hi);
+            if (r > turns[n_turns - 1]) turns[n_turns++] = r;
+        }
+    }
+    turns[n_turns++] = h;
+    // the first piece of monotone f that goes from apart to contact, or that starts in
+    // contact (round-off) and closes in further: there the pair meets at the piece's start
+    for (int k = 0; k + 1 < n_turns; ++k) {
+        const double lo = turns[k], hi = turns[k + 1];
+        const double flo = f(lo), fhi = f(hi);
+        if (flo > 0.0 && !(fhi > 0.0)) return sign_change(f, lo, hi);
+        if (!(flo > 0.0) && fhi < flo) return lo;
+    }
+    return kInfinity;
 }
 }  // namespace
 
