@@ -1,14 +1,15 @@
 """Event rate and memory of the event-driven engine (``--engine edmd``), elastic spheres.
 
 Run: .venv/bin/python benchmarks/bench_edmd.py [--n 4000 32000 256000] [--seconds 10]
-     [--system elastic|sheared]
+     [--system elastic|sheared] [--repeat 5]
 Dimensionless particle units (d = 1, m = 1, T = 1). The issue-3 systems: elastic smooth hard
 spheres at number density 0.5 (φ = 0.262), fully periodic cubic box, fcc start (N = 4 m³),
 Maxwellian velocities with zero total momentum. Each N runs in a fresh child process:
 a warm-up of 2 collisions per particle, then ``advance_to`` in chunks for ``--seconds`` of
-wall time. Prints Markdown rows: events/s (collisions + cell crossings), collisions/s,
-ns per event, the engine's own arrays in bytes per particle (``memory_bytes``) and the
-child's peak RSS growth per particle (includes the numpy inputs). No assertions.
+wall time. Prints Markdown rows: events/s (collisions + cell crossings; with ``--repeat k``
+the median and the range of k interleaved runs), collisions/s, ns per event, the engine's own
+arrays in bytes per particle (``memory_bytes``) and the child's peak RSS growth per particle
+(includes the numpy inputs; the largest of the runs). No assertions.
 ``--system sheared``: the issue's second system, inelastic smooth spheres (e = 0.9, TC model
 t_c = 1e-5) under Lees–Edwards shear (rate 1) at the same density, started from the fcc
 lattice with the linear profile u = y − L/2 on top of unit temperature; a warm-up of 2
@@ -78,6 +79,10 @@ def main() -> None:
     p.add_argument("--n", type=int, nargs="+", default=[4000, 32000, 256000])
     p.add_argument("--seconds", type=float, default=10.0)
     p.add_argument("--system", choices=["elastic", "sheared"], default="elastic")
+    p.add_argument("--repeat", type=int, default=1,
+                   help="measure every N this many times, interleaved (N1 N2 … N1 N2 …), and "
+                        "print the median and the range of events/s: a virtual machine's speed "
+                        "drifts by tens of per cent over minutes")
     p.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = p.parse_args()
     if args.child:
@@ -85,15 +90,25 @@ def main() -> None:
         return
     print(f"machine: {platform.processor() or platform.machine()}, {platform.system()}, "
           f"Python {platform.python_version()}; system: {args.system}")
-    print("| N | events/s | collisions/s | ns/event | engine B/particle | peak RSS B/particle |")
-    print("|---:|---:|---:|---:|---:|---:|")
-    for n in args.n:
-        out = subprocess.run([sys.executable, __file__, "--child", str(n), "--seconds",
-                              str(args.seconds), "--system", args.system],
-                             capture_output=True, text=True, check=True)
-        r = json.loads(out.stdout.strip().splitlines()[-1])
-        print(f"| {r['n']} | {r['events_per_s']:.3g} | {r['collisions_per_s']:.3g} | "
-              f"{r['ns_per_event']:.0f} | {r['engine_bytes']:.0f} | {r['rss_bytes']:.0f} |",
+    if args.repeat < 1:
+        raise SystemExit(f"--repeat {args.repeat}: need at least 1")
+    runs: dict[int, list[dict]] = {n: [] for n in args.n}
+    for _ in range(args.repeat):
+        for n in args.n:
+            out = subprocess.run([sys.executable, __file__, "--child", str(n), "--seconds",
+                                  str(args.seconds), "--system", args.system],
+                                 capture_output=True, text=True, check=True)
+            runs[n].append(json.loads(out.stdout.strip().splitlines()[-1]))
+    print("| N | events/s (median) | range | collisions/s (median) | ns/event (median) | "
+          "engine B/particle | peak RSS B/particle |")
+    print("|---:|---:|---:|---:|---:|---:|---:|")
+    for n, rs in runs.items():
+        med = {k: float(np.median([r[k] for r in rs]))
+               for k in ("events_per_s", "collisions_per_s", "ns_per_event")}
+        ev = [r["events_per_s"] for r in rs]
+        print(f"| {n} | {med['events_per_s']:.3g} | {min(ev):.3g}–{max(ev):.3g} | "
+              f"{med['collisions_per_s']:.3g} | {med['ns_per_event']:.0f} | "
+              f"{rs[0]['engine_bytes']:.0f} | {max(r['rss_bytes'] for r in rs):.0f} |",
               flush=True)
 
 
