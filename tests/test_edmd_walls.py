@@ -865,3 +865,23 @@ def test_zero_time_collision_loop_stops_with_a_clear_error(monkeypatch):
     assert roomy.time == 100.0 and roomy.wall_collisions == 500  # one bounce per 0.2 time units
     # a run that stops at its event budget is not a stall
     assert not core.advance_watched(caged_disc(), 1.0, tc=0.0, max_events=3_000)
+
+
+@pytest.mark.parametrize("vy", [0.0, 0.1])
+def test_disc_resting_on_a_bump_hops_instead_of_stalling(vy):
+    """A disc at rest on top of a static bump under gravity (or bouncing on it from v_y = 0.1,
+    e = 0.5): the contact search returns the turning point where gravity presses the disc on,
+    and the engine gives the minimum rebound there, as on a flat wall. Time reaches its end
+    with one hop per t_c, the disc stays on the bump, and there is no overlap (before the
+    rebound rule the same time was predicted again and again, for ever)."""
+    tc = 1e-4
+    s = EventDriven(np.array([[5.0, 3.0], [5.0, 2.0]]), np.array([[0.0, vy], [0.0, 0.0]]),
+                    np.zeros((2, 1)), np.ones(2), np.ones(2), [10.0, 10.0], 2, e=0.5, tc=tc,
+                    gravity=[0.0, -1.0], periodic_y=False, y_range=(0.0, 10.0),
+                    fixed=np.array([0, 1], np.int8),
+                    walls=[{"side": "lower", "position": 0.0, "e": 0.5}])
+    assert s.advance_to(1.0, max_events=200_000)
+    assert s.time == 1.0 and s.invalid_events == 0
+    assert 0.5 / tc < s.wall_collisions < 1.5 / tc and s.resting_bounces > 0.5 / tc
+    assert -1e-9 < s.min_gap() < 1e-8
+    np.testing.assert_allclose(s.positions()[0], [5.0, 3.0], atol=1e-8)

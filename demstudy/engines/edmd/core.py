@@ -179,8 +179,9 @@ def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int =
                     stop_collisions: int = 0) -> bool:
     """``core.advance_to(t, max_events, stop_collisions)``, watched for a stall.
 
-    Events are processed in chunks of max(``STALL_CHUNK``, 1000 N). A chunk that moves the
-    simulated time by no more than max(t_c, 1e-9) means a zero-time collision loop. One
+    Events (collisions, crossings and stale predictions) are processed in chunks of
+    max(``STALL_CHUNK``, 1000 N). A chunk that moves the simulated time by no more than
+    max(t_c, 1e-9) means a zero-time collision loop. One
     example is a particle caged between two fixed bumps at exactly zero gaps, which bounces
     between them without time passing. Such a run could never finish, so it raises
     ``EngineError`` naming the time and the cause, instead of hanging. A legitimately slow run
@@ -195,23 +196,29 @@ def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int =
     resume bit-identically.
     """
     chunk = max(STALL_CHUNK, 1000 * core.n)
-    start = core.events
+    start = _processed(core)
     while True:
         budget = chunk
         if max_events > 0:
-            budget = min(chunk, max_events - (core.events - start))
+            budget = min(chunk, max_events - (_processed(core) - start))
             if budget <= 0:
                 return False
-        t0, e0 = core.time, core.events
+        t0, e0 = core.time, _processed(core)
         if core.advance_to(t, max_events=budget, stop_collisions=stop_collisions):
             return True
         if stop_collisions > 0 and core.collisions >= stop_collisions:
             return False
-        if core.events - e0 >= chunk and core.time - t0 <= max(tc, 1e-9):
+        if _processed(core) - e0 >= chunk and core.time - t0 <= max(tc, 1e-9):
             raise EngineError(
-                f"the event-driven run stalled at t = {core.time:.9g}: {core.events - e0} "
-                f"events moved the time by {core.time - t0:.3g} (at most max(t_c, 1e-9) = "
-                f"{max(tc, 1e-9):.3g}). A cluster of exactly touching particles is colliding "
-                "in a loop that takes no time, for example a particle caged at zero gaps "
-                "between fixed bumps or in a crystalline row. Perturb the start (seed, "
-                "random bumps), raise --tc, or use the LAMMPS engine")
+                f"the event-driven run stalled at t = {core.time:.9g}: "
+                f"{_processed(core) - e0} events moved the time by {core.time - t0:.3g} "
+                f"(at most max(t_c, 1e-9) = {max(tc, 1e-9):.3g}). Most likely a cluster of "
+                "exactly touching particles is colliding in a loop that takes no time, for "
+                "example a particle caged at zero gaps between fixed bumps or in a crystalline "
+                "row. Perturb the start (another seed, random bumps) or use the LAMMPS engine")
+
+
+def _processed(core: EventDriven) -> int:
+    """Events the core has worked through: collisions, crossings and stale predictions (the
+    budget of ``advance_to(max_events=…)`` counts all three)."""
+    return core.events + core.invalid_events

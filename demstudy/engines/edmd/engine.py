@@ -49,8 +49,8 @@ from .core import (
 )
 
 CHECKPOINT = "checkpoint.pkl"
-ENGINE_VERSION = (f"demstudy-edmd {__version__} (gravity, flat walls, servo, Lees-Edwards, "
-                  "Walton, e(v), TC)")
+ENGINE_VERSION = (f"demstudy-edmd {__version__} (gravity, flat and bumpy walls, servo, "
+                  "Lees-Edwards, Walton, e(v), TC, events with wall collisions)")
 #: collision-log records kept per run (sampled every ``log_every`` collisions)
 LOG_CAPACITY = 200_000
 
@@ -275,8 +275,10 @@ class _Run:
                 continue
             if target and core.collisions >= target:
                 return
-            raise EngineError(f"no pair collisions within {guard} events after t = "
-                              f"{core.time:.6g}: a run counted in collisions cannot go on")
+            raise EngineError(f"the collision count {target} was not reached within {guard} "
+                              f"events (pair and wall collisions, cell crossings, stale "
+                              f"predictions) after t = {core.time:.6g}: a run counted in pair "
+                              f"collisions cannot go on")
 
     def _sample(self, core: EventDriven, state: EdmdRunState, production: bool) -> None:
         dim, t = self.scene.dimension, core.time

@@ -154,7 +154,8 @@ public:
                 const double* omega, const double* diameter, const double* mass);
 
     // Process every event up to time t, then advance all particles to t. Stops early (state
-    // synchronised to the last event time, returns false) after max_events events (> 0) or
+    // synchronised to the last event time, returns false) after max_events events (> 0; stale
+    // predictions count here too) or
     // once the total collision count reaches stop_collisions (> 0).
     bool advance_to(double t, std::int64_t max_events = 0, std::int64_t stop_collisions = 0);
 
@@ -344,7 +345,7 @@ private:
     void process_wall(std::int32_t i, int side);
     void process_bump(std::int32_t i, std::int32_t b);
     void body_contact(std::int32_t i, int side, const double n[3], const double u[3],
-                      bool tc_model, std::int32_t partner);
+                      bool tc_model, std::int32_t partner, bool apply_rule = true);
     void rebound_floor(const double n[3], const double u[3], double m, double v[3], double J[3]);
     void process_crossing(std::int32_t i, int axis);
     void process_reshuffle();

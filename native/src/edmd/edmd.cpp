@@ -110,8 +110,9 @@ double sign_change(F&& fn, double lo, double hi) {
 // quadratic) split [0, horizon] into pieces where f' is monotone, bisection gives the roots
 // of f' (where f turns), and f is then monotone between them, so the first piece that ends in
 // contact holds the root, found by bisection to round-off (the last time still apart).
-// Touching or overlapping and approaching (or pressed on by gravity, from a turning point):
-// that time. None before the horizon: inf.
+// Touching or overlapping and approaching: 0; in contact at a turning point and pressed on by
+// gravity: that time (the engine gives a minimum rebound there, as on a flat wall). None
+// before the horizon: inf.
 double bump_contact_time(const double* d0, const double* dv, const double* a, double sigma,
                          double horizon) {
     const double f0 = dot3(d0, d0) - sigma * sigma;
@@ -176,7 +177,14 @@ double bump_contact_time(const double* d0, const double* dv, const double* a, do
         const double lo = turns[k], hi = turns[k + 1];
         const double flo = f(lo), fhi = f(hi);
         if (flo > 0.0 && !(fhi > 0.0)) return sign_change(f, lo, hi);
-        if (!(flo > 0.0) && fhi < flo) return lo;
+        if (!(flo > 0.0) && fhi < flo) {
+            // in contact and closing: only gravity can close a contact from a turning point, so
+            // the particle is pressed onto the bump (the engine then gives it the minimum
+            // rebound); a decrease with no pressing is round-off
+            double d[3];
+            for (int c = 0; c < 3; ++c) d[c] = d0[c] + (dv[c] + 0.5 * a[c] * lo) * lo;
+            if (dot3(d, a) < 0.0) return lo;
+        }
     }
     return kInfinity;
 }
@@ -1230,10 +1238,16 @@ void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
         ub[a] = P_[b].v[a] + vs[a];
         vrel[a] = P_[i].v[a] - ub[a];
     }
+    const double sigma = P_[i].r + P_[b].r;
     if (dot3(vrel, n) > 0.0) {
         body_contact(i, fixed_[b] - 1, n, ub, true, b);
+    } else if (dot3(p_.gravity, n) > 0.0 && dist - sigma <= 1e-9 * sigma) {
+        // touching, not approaching, pressed on by gravity (resting or sliding on the bump: the
+        // contact search returns the turning point): the minimum rebound alone, as on a flat
+        // wall, so the particle hops instead of meeting the bump again at the same time
+        body_contact(i, fixed_[b] - 1, n, ub, false, b, false);
     } else {
-        ++invalid_;  // not approaching (a re-check after a grazing search, or round-off)
+        ++invalid_;  // not approaching (round-off)
     }
     predict(i);
     heap_update(i);
@@ -1283,7 +1297,7 @@ void EventDriven::process_wall(std::int32_t i, int side) {
 // LAMMPS contact stress, so the bins next to a wall carry its stress), energy is booked in
 // the body's frame. The caller re-predicts.
 void EventDriven::body_contact(std::int32_t i, int side, const double n[3], const double u[3],
-                               bool tc_model, std::int32_t partner) {
+                               bool tc_model, std::int32_t partner, bool apply_rule) {
     const Rule& rule = p_.wall[side].rule;
     double* v = P_[i].v;
     double* om = &w_[3 * i];
@@ -1299,7 +1313,7 @@ void EventDriven::body_contact(std::int32_t i, int side, const double n[3], cons
     const double gn = std::max(g_n, 0.0);
     double gt2 = 0.0;
     for (int a = 0; a < 3; ++a) gt2 += (g[a] - g_n * n[a]) * (g[a] - g_n * n[a]);
-    const bool elastic = tc_model && p_.tc > 0.0 && time_ - last_[i] < p_.tc;
+    const bool elastic = apply_rule && tc_model && p_.tc > 0.0 && time_ - last_[i] < p_.tc;
     if (elastic) ++tc_elastic_;
     const double e = elastic ? 1.0 : rule.restitution(gn);
     auto energy = [&]() {  // in the body's frame
@@ -1309,7 +1323,9 @@ void EventDriven::body_contact(std::int32_t i, int side, const double n[3], cons
     };
     const double before = energy();
     double J[3] = {0.0, 0.0, 0.0};
-    if (rule.tangential == Rule::kNoSlip) {  // walls only (bumps refuse it)
+    if (!apply_rule) {
+        // the minimum rebound below only
+    } else if (rule.tangential == Rule::kNoSlip) {  // walls only (bumps refuse it)
         const double vn = dot3(vrel, n);
         for (int a = 0; a < 3; ++a) {
             const double new_v = u[a] - e * vn * n[a];
@@ -1381,10 +1397,11 @@ void EventDriven::process_reshuffle() {
 bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t stop_collisions) {
     if (!(t >= time_)) throw std::invalid_argument("advance_to: time must not decrease");
     if (!std::isfinite(t)) throw std::invalid_argument("advance_to: time must be finite");
-    const std::int64_t start = events();
+    // the budget counts stale predictions too: a loop of them must not run for ever
+    const std::int64_t start = events() + invalid_;
     bool reached = true;
     while (true) {
-        if ((max_events > 0 && events() - start >= max_events) ||
+        if ((max_events > 0 && events() + invalid_ - start >= max_events) ||
             (stop_collisions > 0 && collisions_ >= stop_collisions)) {
             reached = false;
             break;
