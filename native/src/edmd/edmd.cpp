@@ -129,17 +129,18 @@ double bump_contact_time(const double* d0, const double* dv, const double* a, do
     }
     const double gap = std::sqrt(dot3(d0, d0)) - sigma;
     if (gap > std::sqrt(vv) * h + 0.5 * std::sqrt(aa) * h * h) return kInfinity;
+    auto separation_at = [&](double t, double d[3]) {
+        for (int k = 0; k < 3; ++k) d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
+    };
     auto f = [&](double t) {
         double d[3];
-        for (int k = 0; k < 3; ++k) d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
+        separation_at(t, d);
         return dot3(d, d) - sigma * sigma;
     };
     auto df = [&](double t) {  // f'/2 = d·u
         double d[3], u[3];
-        for (int k = 0; k < 3; ++k) {
-            d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
-            u[k] = dv[k] + a[k] * t;
-        }
+        separation_at(t, d);
+        for (int k = 0; k < 3; ++k) u[k] = dv[k] + a[k] * t;
         return dot3(d, u);
     };
     // f''/2 = 1.5 |a|² t² + 3 (dv·a) t + |dv|² + d0·a: its roots in (0, h), ascending
@@ -151,7 +152,7 @@ double bump_contact_time(const double* d0, const double* dv, const double* a, do
         const double disc = B * B - 4.0 * A * C;
         if (A > 0.0 && disc > 0.0) {
             const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
-            double r1 = q / A, r2 = q != 0.0 ? C / q : -r1;
+            double r1 = q / A, r2 = C / q;  // q != 0: disc > 0
             if (r1 > r2) std::swap(r1, r2);
             for (double r : {r1, r2})
                 if (r > 0.0 && r < h) cuts[n_cuts++] = r;
@@ -182,7 +183,7 @@ double bump_contact_time(const double* d0, const double* dv, const double* a, do
             // the particle is pressed onto the bump (the engine then gives it the minimum
             // rebound); a decrease with no pressing is round-off
             double d[3];
-            for (int c = 0; c < 3; ++c) d[c] = d0[c] + (dv[c] + 0.5 * a[c] * lo) * lo;
+            separation_at(lo, d);
             if (dot3(d, a) < 0.0) return lo;
         }
     }
@@ -1295,7 +1296,8 @@ void EventDriven::process_wall(std::int32_t i, int side) {
 // walls have the minimum rebound instead), the minimum rebound under gravity; the impulse and
 // work count for the wall, the contact's stress goes to the bins along the branch r n (as the
 // LAMMPS contact stress, so the bins next to a wall carry its stress), energy is booked in
-// the body's frame. The caller re-predicts.
+// the body's frame. apply_rule = false (a particle resting on a bump, touching but not
+// approaching): the minimum rebound alone. The caller re-predicts.
 void EventDriven::body_contact(std::int32_t i, int side, const double n[3], const double u[3],
                                bool tc_model, std::int32_t partner, bool apply_rule) {
     const Rule& rule = p_.wall[side].rule;
