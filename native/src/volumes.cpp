@@ -239,29 +239,12 @@ template <int Dim, int NV>
 inline void deposit(double c, double r, const double* __restrict vals, std::int64_t nv,
                     double lo, double width, double inv_width, std::int64_t nbins,
                     double* __restrict vol, double* __restrict sums) noexcept {
-    const double a = (c - r - lo) * inv_width;  // particle extent in bin units
-    const double b = (c + r - lo) * inv_width;
-    const double nb = static_cast<double>(nbins);
-    if (!(b > 0.0) || !(a < nb)) return;
-    const bool cut_lo = a < 0.0;
-    const bool cut_hi = b > nb;
-    const std::int64_t kb = cut_lo ? 0 : static_cast<std::int64_t>(a);
-    std::int64_t ke = cut_hi ? nbins - 1 : static_cast<std::int64_t>(b);
-    if (ke > kb && static_cast<double>(ke) == b) --ke;  // touches bin ke only at its lower edge
-    double prev = cut_lo ? cumulative<Dim>(lo - c, r) : 0.0;
-    for (std::int64_t k = kb; k < ke; ++k) {
-        // max(): keeps round-off from producing tiny negative overlaps
-        const double cur =
-            std::max(prev, cumulative_inside<Dim>(lo + static_cast<double>(k + 1) * width - c, r));
-        const double v = cur - prev;
-        prev = cur;
-        vol[k] += v;
-        add_row<NV>(sums + k * nv, vals, v, nv);
-    }
-    const double last = cut_hi ? cumulative<Dim>(lo + nb * width - c, r) : full_volume<Dim>(r);
-    const double v = std::max(0.0, last - prev);
-    vol[ke] += v;
-    add_row<NV>(sums + ke * nv, vals, v, nv);
+    Span sp;
+    if (!find_span<Dim>(c, r, lo, width, inv_width, nbins, sp)) return;
+    const auto inner = [&](std::int64_t j) {
+        return cumulative_inside<Dim>(lo + static_cast<double>(sp.kb + j + 1) * width - c, r);
+    };
+    deposit_span<NV, false>(sp, inner, vals, nv, vol, sums);
 }
 
 // The bin grid lo + b * width, b = 0..nbins, optionally periodic with period > 0.
