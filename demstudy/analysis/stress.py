@@ -272,14 +272,15 @@ def unsteady_inertia_between(start: Mapping[str, Any], end: Mapping[str, Any],
 def stress_results(scene: Any, profiles: Mapping[str, Any], timeseries: Mapping[str, Any],
                    start: float = 0.0, contact: tuple[np.ndarray, np.ndarray] | None = None,
                    collisional: tuple[np.ndarray, np.ndarray] | None = None,
-                   momentum: tuple[Mapping[str, Any], Mapping[str, Any]] | None = None,
+                   momentum: tuple[Mapping[str, Any] | None, Mapping[str, Any] | None]
+                   | None = None,
                    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     """The ``/stress`` group: ``edges``, ``y``, ``kinetic`` and optional ``contact`` /
     ``collisional`` (n_bins, dim, dim) with ``*_err``, ``total`` (their sum), the walls'
     ``wall_<side>`` columns P_ay, and with gravity the momentum balance ``balance_tau_xy``,
     ``balance_tau_yy`` (Campbell's signs, integrated down from a free surface or from the
     upper wall's measured stress). ``momentum``: snapshots (:func:`momentum_snapshot`) at the
-    start and the end of production; the balance then includes Campbell's unsteady term
+    start and the end of production; with both, the balance includes Campbell's unsteady term
     (``balance_inertia``, rho nu a per bin), otherwise it assumes a steady flow."""
     dim = scene.dimension
     edges = np.asarray(profiles["edges"], float)
@@ -304,8 +305,9 @@ def stress_results(scene: Any, profiles: Mapping[str, Any], timeseries: Mapping[
         top = (0.0, 0.0)
         if "upper" in walls:  # Campbell's tau(H) = (-P_xy, P_yy) at the upper wall
             top = (-float(walls["upper"][0][0]), float(walls["upper"][0][1]))
-        inertia = None if momentum is None else unsteady_inertia_between(*momentum, edges,
-                                                                         section)
+        inertia = None
+        if momentum is not None and None not in momentum:
+            inertia = unsteady_inertia_between(*momentum, edges, section)
         bal = dv.momentum_balance_stress(dict(profiles), scene, top_stress=top, inertia=inertia)
         for key in ("tau_xy", "tau_yy", "tau_xy_err", "tau_yy_err"):
             out[f"balance_{key}"] = bal[key]

@@ -181,12 +181,11 @@ def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int =
 
     Events (collisions, crossings and stale predictions) are processed in chunks of
     max(``STALL_CHUNK``, 1000 N). A chunk that moves the simulated time by no more than
-    max(t_c, 1e-9) means a zero-time collision loop. One
-    example is a particle caged between two fixed bumps at exactly zero gaps, which bounces
-    between them without time passing. Such a run could never finish, so it raises
-    ``EngineError`` naming the time and the cause, instead of hanging. A legitimately slow run
-    is not caught: a bed resting under the TC model costs about N/t_c events per time unit,
-    so one chunk still moves the time by about 1000 t_c.
+    max(t_c, 1e-9) means a zero-time collision loop, for example a particle caged between two
+    fixed bumps at exactly zero gaps, bouncing between them without time passing. Such a run
+    could never finish, so it raises ``EngineError`` naming the time and the cause, instead of
+    hanging. A legitimately slow run is not caught: a bed resting under the TC model costs
+    about N/t_c events per time unit, so one chunk still moves the time by about 1000 t_c.
 
     Returns True when t is reached. Returns False when the run stopped early at
     ``max_events`` (> 0, counted from the call) or at ``stop_collisions``.

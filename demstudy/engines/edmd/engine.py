@@ -429,12 +429,9 @@ class _Run:
                                              np.asarray(state.stress_durations),
                                              self.stress_edges, section)
         if self.stress:
-            momentum = None
-            if state.momentum_start is not None and state.momentum_end is not None:
-                momentum = (state.momentum_start, state.momentum_end)
-            stress, stress_attrs = stress_results(scene, analysis.results, timeseries,
-                                                  start=equilibration_end,
-                                                  collisional=collisional, momentum=momentum)
+            stress, stress_attrs = stress_results(
+                scene, analysis.results, timeseries, start=equilibration_end,
+                collisional=collisional, momentum=(state.momentum_start, state.momentum_end))
             groups["stress"], group_attrs["stress"] = stress, stress_attrs
         if state.log:
             groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}

@@ -370,12 +370,9 @@ class Driver:
         results = Results(attrs, timeseries, analysis.results, analysis.attrs, frames)
         if self.measure_stress:
             contact = state.stress.finish() if state.stress is not None else None
-            momentum = None
-            if state.momentum_start is not None and state.momentum_end is not None:
-                momentum = (state.momentum_start, state.momentum_end)
-            data, group_attrs = stress_results(self.scene, analysis.results, timeseries,
-                                               self.n_eq * self.dt, contact=contact,
-                                               momentum=momentum)
+            data, group_attrs = stress_results(
+                self.scene, analysis.results, timeseries, self.n_eq * self.dt, contact=contact,
+                momentum=(state.momentum_start, state.momentum_end))
             group_attrs["contact_samples"] = state.stress.samples if state.stress else 0
             results.groups["stress"], results.group_attrs["stress"] = data, group_attrs
         path = write_results(self.out, results)

@@ -115,7 +115,7 @@ double sign_change(F&& fn, double lo, double hi) {
 // before the horizon: inf.
 double bump_contact_time(const double* d0, const double* dv, const double* a, double sigma,
                          double horizon) {
-    const double f0 = dot3(d0, d0) - sigma * sigma;
+    const double d2 = dot3(d0, d0), f0 = d2 - sigma * sigma;
     const double b0 = dot3(d0, dv);
     if (f0 <= 0.0 && b0 < 0.0) return 0.0;
     const double aa = dot3(a, a), va = dot3(dv, a), vv = dot3(dv, dv), da = dot3(d0, a);
@@ -127,7 +127,7 @@ double bump_contact_time(const double* d0, const double* dv, const double* a, do
         h = 1.0 + std::max({std::fabs(va), std::fabs(vv + da), std::fabs(2.0 * b0),
                             std::fabs(f0)}) / c4;
     }
-    const double gap = std::sqrt(dot3(d0, d0)) - sigma;
+    const double gap = std::sqrt(d2) - sigma;
     if (gap > std::sqrt(vv) * h + 0.5 * std::sqrt(aa) * h * h) return kInfinity;
     auto separation_at = [&](double t, double d[3]) {
         for (int k = 0; k < 3; ++k) d[k] = d0[k] + (dv[k] + 0.5 * a[k] * t) * t;
