@@ -830,15 +830,20 @@ def test_chute_on_random_bumps_balances_energy_and_momentum(tmp_path):
         d[..., 0] -= width * np.round(d[..., 0] / width)
         assert np.sqrt((d**2).sum(-1)).min() > 1.0 - 1e-9
 
+def disc_on_bumps(pos, vel, bumps, e: float, **options) -> EventDriven:
+    """One unit disc at pos with velocity vel and fixed bumps (unit discs) of the lower wall
+    (restitution e for both) at the given centres, in a 10 × 10 box above y = 0."""
+    nb = len(bumps)
+    return particles([pos, *bumps], [vel, *[[0.0, 0.0]] * nb], np.zeros(nb + 1), 2,
+                     [10.0, 10.0], e=e, periodic_y=False, y_range=(0.0, 10.0),
+                     fixed=np.r_[0, np.ones(nb)].astype(np.int8),
+                     walls=[{"side": "lower", "position": 0.0, "e": e}], **options)
+
+
 def caged_disc(e: float = 1.0) -> EventDriven:
     """A disc between two fixed bumps of the lower wall, touching both (zero gaps), moving
     towards one: without time passing it bounces from bump to bump for ever."""
-    pos = np.array([[4.0, 2.0], [3.0, 2.0], [5.0, 2.0]])
-    vel = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]])
-    return EventDriven(pos, vel, np.zeros((3, 1)), np.ones(3), np.ones(3), [10.0, 10.0], 2,
-                       e=e, periodic_y=False, y_range=(0.0, 10.0),
-                       fixed=np.array([0, 1, 1], np.int8),
-                       walls=[{"side": "lower", "position": 0.0, "e": e}])
+    return disc_on_bumps([4.0, 2.0], [1.0, 0.0], [[3.0, 2.0], [5.0, 2.0]], e)
 
 
 def test_zero_time_collision_loop_stops_with_a_clear_error(monkeypatch):
@@ -857,11 +862,7 @@ def test_zero_time_collision_loop_stops_with_a_clear_error(monkeypatch):
         # the budget keeps a broken watch from hanging the test: it would return False
         core.advance_watched(caged_disc(), 1.0, tc=0.0, max_events=100_000)
     # the same watch on a disc with room to move: it rattles between the bumps and arrives
-    pos = np.array([[4.0, 2.0], [2.9, 2.0], [5.1, 2.0]])
-    roomy = EventDriven(pos, np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.0]]), np.zeros((3, 1)),
-                        np.ones(3), np.ones(3), [10.0, 10.0], 2, e=1.0, periodic_y=False,
-                        y_range=(0.0, 10.0), fixed=np.array([0, 1, 1], np.int8),
-                        walls=[{"side": "lower", "position": 0.0, "e": 1.0}])
+    roomy = disc_on_bumps([4.0, 2.0], [1.0, 0.0], [[2.9, 2.0], [5.1, 2.0]], 1.0)
     assert core.advance_watched(roomy, 100.0, tc=0.0)
     assert roomy.time == 100.0 and roomy.wall_collisions == 500  # one bounce per 0.2 time units
     # a run that stops at its event budget is not a stall
@@ -876,11 +877,7 @@ def test_disc_resting_on_a_bump_hops_instead_of_stalling(vy):
     with one hop per t_c, the disc stays on the bump, and there is no overlap (before the
     rebound rule the same time was predicted again and again, for ever)."""
     tc = 1e-4
-    s = EventDriven(np.array([[5.0, 3.0], [5.0, 2.0]]), np.array([[0.0, vy], [0.0, 0.0]]),
-                    np.zeros((2, 1)), np.ones(2), np.ones(2), [10.0, 10.0], 2, e=0.5, tc=tc,
-                    gravity=[0.0, -1.0], periodic_y=False, y_range=(0.0, 10.0),
-                    fixed=np.array([0, 1], np.int8),
-                    walls=[{"side": "lower", "position": 0.0, "e": 0.5}])
+    s = disc_on_bumps([5.0, 3.0], [0.0, vy], [[5.0, 2.0]], 0.5, tc=tc, gravity=[0.0, -1.0])
     assert s.advance_to(1.0, max_events=200_000)
     assert s.time == 1.0 and s.invalid_events == 0
     assert 0.5 / tc < s.wall_collisions < 1.5 / tc and s.resting_bounces > 0.5 / tc
