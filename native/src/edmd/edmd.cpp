@@ -891,7 +891,8 @@ void EventDriven::scan(std::int32_t i, int only_axis, int dir) {
             const Particle& pj = P_[j];
             const double dtj = time_ - pj.t;
             double dr[3], dv[3];
-            if (gravity_ && book_[j].fixed != 0) {  // a static bump: the relative motion is a parabola
+            // a static bump: the relative motion is a parabola
+            if (gravity_ && book_[j].fixed != 0) {
                 for (int a = 0; a < 3; ++a) {
                     dr[a] = pj.x[a] + pj.v[a] * dtj + (sh ? sh[a] : 0.0) - xi[a];
                     dv[a] = pj.v[a] + (sh ? vs[a] : 0.0) - vi[a];
@@ -1477,8 +1478,9 @@ void EventDriven::reorder() {
         book_[node.i].pos_in_heap = static_cast<std::int32_t>(k);
     }
     for (std::size_t k = 0; k < N; ++k) {
-        if (book_[k].co_partner >= 0) book_[k].co_partner = inv[static_cast<std::size_t>(book_[k].co_partner)];
-        if (book_[k].ev_partner >= 0) book_[k].ev_partner = inv[static_cast<std::size_t>(book_[k].ev_partner)];
+        Book& b = book_[k];
+        if (b.co_partner >= 0) b.co_partner = inv[static_cast<std::size_t>(b.co_partner)];
+        if (b.ev_partner >= 0) b.ev_partner = inv[static_cast<std::size_t>(b.ev_partner)];
     }
     build_cells();
     heap_build();
@@ -1630,22 +1632,20 @@ EventDriven::State EventDriven::get_state() const {
     s.co_partner.resize(N);
     s.co_count.resize(N);
     s.ev_partner.resize(N + 1);
+    s.ev_time.resize(N + 1);
+    s.ev_count.assign(N + 1, 0);
     for (std::size_t i = 0; i <= N; ++i) {
         const Book& b = book_[i];
         s.ev_partner[i] = b.ev_partner;
-        if (i == N) break;
+        s.ev_time[i] = node_at(b.pos_in_heap).t;
+        if (i == N) break;  // the system slot: its event only
+        if (b.ev_partner >= 0) s.ev_count[i] = b.co_count;
         s.last[i] = b.last;
         s.count[i] = b.count;
         for (int a = 0; a < 3; ++a) s.cell[3 * i + a] = b.cell[a];
         s.co_time[i] = b.co_t;
         s.co_partner[i] = b.co_partner;
         s.co_count[i] = b.co_count;
-    }
-    s.ev_time.resize(N + 1);
-    s.ev_count.assign(N + 1, 0);
-    for (std::size_t i = 0; i <= N; ++i) {
-        s.ev_time[i] = node_at(book_[i].pos_in_heap).t;
-        if (i < N && book_[i].ev_partner >= 0) s.ev_count[i] = book_[i].co_count;
     }
     s.stress = stress_;
     s.scalars = {time_, dissipated_, gravity_work_, p_.box[0], le_t_,
@@ -1710,9 +1710,8 @@ void EventDriven::set_state(const State& s) {
             P_[i].v[a] = s.vel[3 * i + a];
             P_[i].t = t;
         }
-    for (std::size_t i = 0; i < N; ++i)
-        for (int a = 0; a < 3; ++a) spin_[i].w[a] = s.omega[3 * i + a];
     for (std::size_t i = 0; i < N; ++i) {
+        for (int a = 0; a < 3; ++a) spin_[i].w[a] = s.omega[3 * i + a];
         Book& b = book_[i];
         b.last = s.last[i];
         b.count = s.count[i];
