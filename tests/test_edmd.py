@@ -16,6 +16,7 @@ Runtime about a minute on a 2-core machine (the elastic drift tests take most of
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import platform
 from pathlib import Path
@@ -368,6 +369,53 @@ def test_state_round_trip_continues_bit_identically():
     assert (a.collisions, a.virial, a.dissipated) == (b.collisions, b.virial, b.dissipated)
 
 
+def test_a_rejected_state_leaves_the_engine_as_it_was():
+    """set_state checks everything before it changes anything: after each corrupt state is
+    refused, the engine holds the same state and continues exactly as an untouched twin."""
+    scene = make_scene(2, 0.4, 300, seed=2, e=0.9)
+    donor = system(scene, tc=1e-5)
+    donor.advance_to(2.0)
+    good = donor.get_state()
+
+    def corrupt(change):
+        state = {k: np.array(v, copy=True) for k, v in good.items()}
+        change(state)
+        return state
+
+    def new_box_bad_order(s):  # another x period (re-grids) and then a corrupt order
+        s["scalars"][3] *= 3.0
+        s["order"][1] = s["order"][0]
+
+    def set_(key, index, value):
+        def change(s):
+            s[key].reshape(-1)[index] = value
+        return change
+
+    cases = {
+        "order is not a permutation": new_box_bad_order,
+        "non-finite position": set_("pos", 5, np.nan),
+        "stress bins": set_("scalars", 35, -1.0),
+        "non-finite scalar": set_("scalars", 7, np.inf),
+        "Lees-Edwards cell offset": set_("scalars", 5, 1e6),
+        "invalid scheduled event": set_("ev_partner", 3, -7),  # the lower wall: there is none
+        "invalid time of the last collision": set_("last", 0, np.inf),
+    }
+    a, twin = system(scene, tc=1e-5), system(scene, tc=1e-5)
+    a.advance_to(1.0)
+    twin.advance_to(1.0)
+    before, cells = a.get_state(), a.cells
+    for message, change in cases.items():
+        with pytest.raises(ValueError, match=message):
+            a.set_state(corrupt(change))
+        after = a.get_state()
+        assert all(np.array_equal(after[k], before[k]) for k in before), message
+        assert a.cells == cells
+    a.advance_to(3.0)
+    twin.advance_to(3.0)
+    assert_same_particles(a, twin)
+    assert (a.collisions, a.virial) == (twin.collisions, twin.virial)
+
+
 HAS_AVX2 = platform.machine() == "x86_64" and "avx2" in Path("/proc/cpuinfo").read_text()
 
 
@@ -403,10 +451,23 @@ def test_simd_pair_times_give_the_scalar_bits(dim, options):
 def test_rejects_bad_input():
     scene = make_scene(3, 0.2, 100)
     st = build_initial_state(scene)
-    with pytest.raises(ValueError, match="3 largest diameters"):
+    with pytest.raises(ValueError, match="at least 3 cell widths.*the largest diameter"):
         from_initial_state(st, [2.5, 2.5, 2.5])
     with pytest.raises(ValueError, match="restitution"):
         from_initial_state(st, scene.box.size, e=1.5)
+    with pytest.raises(ValueError, match="shear_rate must be finite and >= 0"):
+        from_initial_state(st, scene.box.size, shear_rate=-1.0)  # time would run backwards
+    with pytest.raises(ValueError, match="stress bins of finite positive width"):
+        from_initial_state(st, scene.box.size, stress_bins=[0.0, 0.0, 4])
+    with pytest.raises(ValueError, match="stress bins of finite positive width"):
+        from_initial_state(st, scene.box.size, stress_bins=[0.0, 1.0, 2.0**61])  # 9 n wraps
+    # a box far too large for its particles: the grid is coarsened (counted without overflow)
+    # until a short axis has too few cells, and the message says why
+    with pytest.raises(ValueError, match="widened from the largest diameter"):
+        from_initial_state(st, [2.0**30, 2.0**30, 16.0])
+    bad = dataclasses.replace(st, angular_velocity=np.full_like(st.angular_velocity, np.nan))
+    with pytest.raises(ValueError, match="non-finite angular velocity"):
+        from_initial_state(bad, scene.box.size)
     s = from_initial_state(st, scene.box.size)
     s.advance_to(1.0)
     with pytest.raises(ValueError, match="must not decrease"):

@@ -196,6 +196,10 @@ public:
     void set_wall(int side, double y, double vn, double ux, double uz);
     // New collisional-stress bins along y (sums restart from zero).
     void set_stress_bins(double lo, double width, std::int64_t n);
+    // Throws std::invalid_argument (prefixed by `who`) unless 0 <= n <= 10^7 is whole and, with
+    // bins, the width is finite and positive; lo must be finite.
+    static void check_stress_bins(double lo, double width, double n, const char* who);
+    static constexpr double kMaxStressBins = 1e7;
     // Scale x positions and the x period by `factor` (servo width scaling), limited so that
     // no pair overlaps; re-predicts. Returns the factor applied.
     double scale_width(double factor);

@@ -6,6 +6,7 @@
 #include <nanobind/stl/vector.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -95,7 +96,7 @@ EventDriven* make(InArr pos, InArr vel, InArr omega, InArr diameter, InArr mass,
     Params p;
     p.dim = dim;
     for (int a = 0; a < dim; ++a) {
-        require(box[a] > 0.0, "box lengths must be positive");
+        require(box[a] > 0.0 && std::isfinite(box[a]), "box lengths must be finite and positive");
         p.box[a] = box[a];
     }
     p.pair.e = e;
@@ -141,6 +142,7 @@ EventDriven* make(InArr pos, InArr vel, InArr omega, InArr diameter, InArr mass,
             require(b.size() == 3, "stress_bins needs (lo, width, count)");
             p.stress_lo = b[0];
             p.stress_width = b[1];
+            EventDriven::check_stress_bins(b[0], b[1], b[2], "stress_bins");
             p.stress_bins = static_cast<std::int64_t>(b[2]);
         } else if (key == "fixed") {
             auto f = nb::cast<nb::ndarray<const std::int8_t, nb::c_contig, nb::device::cpu>>(v);
@@ -210,7 +212,8 @@ void set_state(EventDriven& s, nb::dict d) {
         st.co_count = vec<std::int64_t>(d["co_count"], n, "co_count");
     }
     st.scalars = vec<double>(d["scalars"], 36, "scalars");
-    const auto bins = static_cast<std::size_t>(std::max(0.0, st.scalars[35]));
+    EventDriven::check_stress_bins(st.scalars[33], st.scalars[34], st.scalars[35], "set_state");
+    const auto bins = static_cast<std::size_t>(st.scalars[35]);
     st.stress = vec<double>(d["stress"], 9 * bins, "stress");
     st.counters = vec<std::int64_t>(d["counters"], 8, "counters");
     st.order = vec<std::int32_t>(d["order"], n, "order");

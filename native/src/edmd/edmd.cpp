@@ -437,7 +437,9 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
         p_.gravity[2] = 0.0;
     }
     gravity_ = p_.gravity[0] != 0.0 || p_.gravity[1] != 0.0 || p_.gravity[2] != 0.0;
-    if (p.shear_rate != 0.0 && (!p.periodic_y || !std::isfinite(p.shear_rate)))
+    if (!(p.shear_rate >= 0.0) || !std::isfinite(p.shear_rate))
+        throw std::invalid_argument("shear_rate must be finite and >= 0 (0: no shear)");
+    if (p.shear_rate != 0.0 && !p.periodic_y)
         throw std::invalid_argument("Lees-Edwards shear needs a periodic y");
     if (p.periodic_y) {
         p_.wall[0].present = p_.wall[1].present = false;
@@ -446,8 +448,8 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
             if (p.wall[s].present) check_rule(p.wall[s].rule, s == 0 ? "lower wall" : "upper wall");
         if (!(p.y_hi > p.y_lo)) throw std::invalid_argument("y_hi must exceed y_lo");
     }
-    if (p.stress_bins < 0 || (p.stress_bins > 0 && !(p.stress_width > 0.0)))
-        throw std::invalid_argument("stress bins need a positive width");
+    check_stress_bins(p.stress_lo, p.stress_width, static_cast<double>(p.stress_bins),
+                      "stress bins");
     if (!p.fixed.empty()) {
         if (static_cast<std::int64_t>(p.fixed.size()) != n)
             throw std::invalid_argument("fixed needs one entry per particle");
@@ -479,8 +481,12 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
         for (int a = 0; a < p.dim; ++a)
             if (!std::isfinite(pos[i * p.dim + a]) || !std::isfinite(vel[i * p.dim + a]))
                 throw std::invalid_argument("non-finite position or velocity");
-        if (!(diameter[i] > 0.0) || !(mass[i] > 0.0))
-            throw std::invalid_argument("diameters and masses must be positive");
+        for (int a = 0; a < nrot; ++a)
+            if (!std::isfinite(omega[i * nrot + a]))
+                throw std::invalid_argument("non-finite angular velocity");
+        if (!(diameter[i] > 0.0) || !(mass[i] > 0.0) || !std::isfinite(diameter[i]) ||
+            !std::isfinite(mass[i]))
+            throw std::invalid_argument("diameters and masses must be finite and positive");
         dmax_ = std::max(dmax_, diameter[i]);
     }
     setup_grid();
@@ -536,24 +542,33 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
 // Cells: width >= the largest diameter, >= 3 per periodic axis, at most ~8 per particle. A
 // non-periodic y is covered from y_lo to y_hi; its first and last rows are open-ended.
 void EventDriven::setup_grid() {
+    // counted in floating point: a huge box must not overflow the cell counts
     double width = dmax_;
-    const std::int64_t n = n_;
-    for (int iter = 0; iter < 400; ++iter) {
-        std::int64_t total = 1;
+    const double cap = static_cast<double>(std::max<std::int64_t>(8 * n_, 64));
+    double total = 0.0;
+    for (int iter = 0; iter < 1000; ++iter) {
+        total = 1.0;
         for (int a = 0; a < p_.dim; ++a) {
             const double L = (a == 1 && !p_.periodic_y) ? p_.y_hi - p_.y_lo : p_.box[a];
-            ncell_[a] = std::max(1, static_cast<int>(std::floor(L / width)));
-            total *= ncell_[a];
+            const double c = std::clamp(std::floor(L / width), 1.0, 1e9);
+            ncell_[a] = static_cast<int>(c);
+            total *= c;
         }
-        if (total <= std::max<std::int64_t>(8 * n, 64)) break;
+        if (total <= cap) break;
         width *= 1.1;
     }
+    if (total > cap)
+        throw std::invalid_argument("the box is too large for a cell grid of at most 8 cells per "
+                                    "particle");
     for (int a = 0; a < p_.dim; ++a) {
         const bool periodic = a != 1 || p_.periodic_y;
         if (periodic && ncell_[a] < 3)
             throw std::invalid_argument(
-                "every periodic box length must be at least 3 largest diameters (axis " +
-                std::to_string(a) + ": " + std::to_string(p_.box[a]) + ")");
+                "every periodic box length must be at least 3 cell widths (axis " +
+                std::to_string(a) + ": " + std::to_string(p_.box[a]) + "; cell width " +
+                std::to_string(width) +
+                (width > dmax_ ? ", widened from the largest diameter to keep at most 8 cells "
+                                 "per particle" : ", the largest diameter") + ")");
         const double L = periodic ? p_.box[a] : p_.y_hi - p_.y_lo;
         cw_[a] = L / ncell_[a];
         org_[a] = periodic ? 0.0 : p_.y_lo;
@@ -1112,8 +1127,18 @@ void EventDriven::add_stress(double yi, double yj, const double dr[3], const dou
         double* s = &stress_[9 * bin];
         for (int k = 0; k < 9; ++k) s[k] += frac * t[k];
     };
-    const auto b0 = static_cast<std::int64_t>(std::floor((ya - lo) / w));
-    const auto b1 = static_cast<std::int64_t>(std::floor((yb - lo) / w));
+    // bin numbers, clamped before the integer conversion: along a bounded y to one bin beyond
+    // each end (dropped), along a periodic y to one turn of the bins after the first
+    double f0 = std::floor((ya - lo) / w), f1 = std::floor((yb - lo) / w);
+    const double big = 1e15, nbd = static_cast<double>(nb);
+    if (p_.periodic_y) {
+        f0 = std::clamp(f0, -big, big);
+        f1 = std::clamp(f1, f0, f0 + nbd);
+    } else {
+        f0 = std::clamp(f0, -1.0, nbd);
+        f1 = std::clamp(f1, -1.0, nbd);
+    }
+    const auto b0 = static_cast<std::int64_t>(f0), b1 = static_cast<std::int64_t>(f1);
     if (b0 == b1 || yb == ya) {
         add(b0, 1.0);
         return;
@@ -1505,9 +1530,16 @@ void EventDriven::set_wall(int side, double y, double vn, double ux, double uz) 
     heap_build();
 }
 
+void EventDriven::check_stress_bins(double lo, double width, double n, const char* who) {
+    if (!(n >= 0.0 && n <= kMaxStressBins && n == std::floor(n)) ||
+        (n > 0.0 && !(width > 0.0 && std::isfinite(width))) || !std::isfinite(lo))
+        throw std::invalid_argument(std::string(who) +
+                                    ": need 0 to 10^7 stress bins of finite positive width "
+                                    "from a finite lower edge");
+}
+
 void EventDriven::set_stress_bins(double lo, double width, std::int64_t n) {
-    if (n < 0 || (n > 0 && !(width > 0.0)) || !std::isfinite(lo))
-        throw std::invalid_argument("set_stress_bins: need n >= 0 bins of positive width");
+    check_stress_bins(lo, width, static_cast<double>(n), "set_stress_bins");
     p_.stress_lo = lo;
     p_.stress_width = width;
     p_.stress_bins = n;
@@ -1666,14 +1698,33 @@ EventDriven::State EventDriven::get_state() const {
     return s;
 }
 
+// Everything is checked before anything changes: a rejected state leaves the engine as it was.
 void EventDriven::set_state(const State& s) {
     const std::size_t N = static_cast<std::size_t>(n_);
     if (s.pos.size() != 3 * N || s.vel.size() != 3 * N || s.omega.size() != 3 * N ||
         s.last.size() != N || s.count.size() != N || s.cell.size() != 3 * N ||
-        s.scalars.size() != 36 || s.counters.size() != 8 ||
-        s.stress.size() != 9 * static_cast<std::size_t>(std::max(0.0, s.scalars[35])) ||
-        s.order.size() != N)
+        s.scalars.size() != 36 || s.counters.size() != 8 || s.order.size() != N)
         throw std::invalid_argument("set_state: array sizes do not match this system");
+    for (double x : s.scalars)
+        if (!std::isfinite(x)) throw std::invalid_argument("set_state: non-finite scalar");
+    check_stress_bins(s.scalars[33], s.scalars[34], s.scalars[35], "set_state");
+    if (s.stress.size() != 9 * static_cast<std::size_t>(s.scalars[35]))
+        throw std::invalid_argument("set_state: stress sums do not match the stress bins");
+    for (std::size_t k = 0; k < 3 * N; ++k)
+        if (!std::isfinite(s.pos[k]) || !std::isfinite(s.vel[k]) || !std::isfinite(s.omega[k]))
+            throw std::invalid_argument("set_state: non-finite position or velocity");
+    for (std::size_t i = 0; i < N; ++i)
+        if (std::isnan(s.last[i]) || s.last[i] == kInf)
+            throw std::invalid_argument("set_state: invalid time of the last collision");
+    {
+        std::vector<char> seen(N, 0);
+        for (std::size_t i = 0; i < N; ++i) {
+            const std::int32_t o = s.order[i];
+            if (o < 0 || o >= n_ || seen[static_cast<std::size_t>(o)])
+                throw std::invalid_argument("set_state: order is not a permutation");
+            seen[static_cast<std::size_t>(o)] = 1;
+        }
+    }
     const bool events = !s.ev_time.empty();
     if (events && (s.ev_time.size() != N + 1 || s.ev_partner.size() != N + 1 ||
                    s.ev_count.size() != N + 1 || s.co_time.size() != N ||
@@ -1686,23 +1737,44 @@ void EventDriven::set_state(const State& s) {
                 throw std::invalid_argument("set_state: invalid collision candidate");
         for (std::size_t i = 0; i <= N; ++i) {
             const std::int32_t p = s.ev_partner[i];
-            const bool ok = i == N ? p == kReshuffle
-                                   : (p == kNone || (p < 0 && p >= kUpperWall) ||
-                                      (p >= 0 && p < n_ && p != static_cast<std::int32_t>(i)));
+            bool ok;
+            if (i == N)
+                ok = p == kReshuffle;
+            else if (p >= 0)
+                ok = p < n_ && p != static_cast<std::int32_t>(i);
+            else if (p == kLowerWall || p == kUpperWall)
+                ok = p_.wall[p == kLowerWall ? 0 : 1].present;
+            else if (p >= -6)
+                ok = (p >= -3 ? -p - 1 : -p - 4) < p_.dim;  // a crossing along an axis in use
+            else
+                ok = p == kNone;
             if (!ok || std::isnan(s.ev_time[i]) || s.ev_time[i] < t)
                 throw std::invalid_argument("set_state: invalid scheduled event");
         }
     }
-    const double box_x = s.scalars[3];
+    // the cells are checked against the grid of the stored x period (the servo may have scaled
+    // it); the grid is put back if the state is rejected
+    const double box_x = s.scalars[3], old_box_x = p_.box[0];
     if (!(box_x > 0.0)) throw std::invalid_argument("set_state: invalid box");
-    if (box_x != p_.box[0]) {
-        p_.box[0] = box_x;
-        setup_grid();
-    }
-    for (std::size_t k = 0; k < 3 * N; ++k) {
-        const int a = static_cast<int>(k % 3);
-        if (s.cell[k] < 0 || s.cell[k] >= ncell_[a])
-            throw std::invalid_argument("set_state: cell index out of range");
+    try {
+        if (box_x != old_box_x) {
+            p_.box[0] = box_x;
+            setup_grid();
+        }
+        for (std::size_t k = 0; k < 3 * N; ++k) {
+            const int a = static_cast<int>(k % 3);
+            if (s.cell[k] < 0 || s.cell[k] >= ncell_[a])
+                throw std::invalid_argument("set_state: cell index out of range");
+        }
+        const double le_cell = s.scalars[5];
+        if (!(le_cell >= 0.0 && le_cell < ncell_[0] && le_cell == std::floor(le_cell)))
+            throw std::invalid_argument("set_state: invalid Lees-Edwards cell offset");
+    } catch (...) {
+        if (p_.box[0] != old_box_x) {
+            p_.box[0] = old_box_x;
+            setup_grid();
+        }
+        throw;
     }
     for (std::size_t i = 0; i < N; ++i)
         for (int a = 0; a < 3; ++a) {
@@ -1749,13 +1821,6 @@ void EventDriven::set_state(const State& s) {
     log_seen_ = s.counters[6];
     sorted_at_ = s.counters[7];
     {
-        std::vector<char> seen(N, 0);
-        for (std::size_t i = 0; i < N; ++i) {
-            const std::int32_t o = s.order[i];
-            if (o < 0 || o >= n_ || seen[static_cast<std::size_t>(o)])
-                throw std::invalid_argument("set_state: order is not a permutation");
-            seen[static_cast<std::size_t>(o)] = 1;
-        }
         // masses and radii follow the stored order (the system may have been re-sorted)
         std::vector<double> m(N), r(N);
         std::vector<std::int8_t> f(N);
