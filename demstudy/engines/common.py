@@ -5,7 +5,6 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 
 from __future__ import annotations
 
-import os
 import pickle
 import signal
 import threading
@@ -17,6 +16,7 @@ import numpy as np
 
 from ..analysis.steady import energy_trend, is_steady
 from ..io.frames import Frame
+from ..io.results import write_atomically
 from ..scene import Scene, scene_to_toml
 
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
@@ -31,11 +31,9 @@ def keep_frame(frames: dict[str, list], frame: Frame) -> None:
 
 
 def pickle_atomically(path: Path, obj: Any) -> None:
-    """Write ``obj`` under a temporary name, then rename: a checkpoint is whole or absent."""
-    tmp = path.with_name(path.name + ".new")
-    with open(tmp, "wb") as fh:
-        pickle.dump(obj, fh)
-    os.replace(tmp, path)
+    """Pickle ``obj`` to ``path`` atomically (temporary file, fsync, rename): a checkpoint is
+    whole or absent, also when the disk is full."""
+    write_atomically(path, pickle.dumps(obj))
 
 
 def run_attrs(scene: Scene, engine: str, version: str, wall_seconds: float,

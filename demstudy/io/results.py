@@ -2,12 +2,14 @@
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
 or the shear rate sets the time scale); the root attribute ``units`` says so in every file.
-Writes are atomic: the file is written under a temporary name and renamed into place.
+Writes are atomic: the file is built in memory, written under a temporary name, flushed
+and renamed into place.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import io
 import os
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -46,33 +48,50 @@ def _write_group(group: h5py.Group, data: Mapping[str, Any], attrs: Mapping[str,
 
 
 def write_results(path: str | os.PathLike, results: Results) -> Path:
-    """Write ``results`` to ``path`` atomically (temp file in the same folder, then rename)."""
+    """Write ``results`` to ``path`` atomically: the HDF5 image is built in memory, written
+    to a temporary file in the same folder, flushed to disk, then renamed into place. A full
+    disk or another I/O error raises a plain ``OSError`` and leaves neither a partial file nor
+    the temporary one (HDF5 itself is never asked to write to a failing disk: a library
+    error there can crash the process)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    image = io.BytesIO()
+    with h5py.File(image, "w") as f:
+        attrs = {
+            "format_version": FORMAT_VERSION,
+            "demstudy_version": __version__,
+            "units": UNITS_NOTE,
+            "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+            **results.attrs,
+        }
+        for key, value in attrs.items():
+            f.attrs[key] = value
+        _write_group(f.create_group("timeseries"), results.timeseries)
+        if results.profiles:
+            _write_group(f.create_group("profiles"), results.profiles, results.profile_attrs)
+        if results.frames:
+            _write_group(f.create_group("frames"), results.frames)
+        for name, data in results.groups.items():
+            _write_group(f.require_group(name), data, results.group_attrs.get(name, {}))
+    write_atomically(path, image.getbuffer())
+    return path
+
+
+def write_atomically(path: Path, data: bytes | memoryview) -> None:
+    """``data`` to ``path`` via a temporary file in the same folder, fsync and rename: the file
+    is whole or absent (the temporary file is removed on any error)."""
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     try:
-        with h5py.File(tmp, "w") as f:
-            attrs = {
-                "format_version": FORMAT_VERSION,
-                "demstudy_version": __version__,
-                "units": UNITS_NOTE,
-                "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
-                **results.attrs,
-            }
-            for key, value in attrs.items():
-                f.attrs[key] = value
-            _write_group(f.create_group("timeseries"), results.timeseries)
-            if results.profiles:
-                _write_group(f.create_group("profiles"), results.profiles, results.profile_attrs)
-            if results.frames:
-                _write_group(f.create_group("frames"), results.frames)
-            for name, data in results.groups.items():
-                _write_group(f.require_group(name), data, results.group_attrs.get(name, {}))
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
         os.replace(tmp, path)
+    except OSError as err:  # say which file (a failed write names none)
+        raise OSError(err.errno, f"cannot write {path}: {err.strerror}") from err
     finally:
         if tmp.exists():
             tmp.unlink()
-    return path
 
 
 def read_results(path: str | os.PathLike, skip: tuple[str, ...] = ()) -> Results:
