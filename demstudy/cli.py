@@ -39,7 +39,7 @@ def _cmd_deck(args: argparse.Namespace) -> int:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .decks.base import UnsupportedByEngine
-    from .engines.base import RunOptions, get_engine
+    from .engines.base import RunOptions, check_run_options, get_engine
 
     scene = load_scene(args.scene, args.set)
     extra = {}
@@ -55,6 +55,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
                          progress=not args.quiet, keep_frames=args.keep_frames or None,
                          isolate=True, wall_limit=args.wall_limit, extra=extra)
+    check_run_options(args.engine, options)
     path = get_engine(args.engine).run(scene, options)
     print(f"results: {path}")
     return 0
@@ -243,6 +244,9 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, RunStopped):
             return 3  # checkpoint written: run again with --resume
         return 2 if isinstance(exc, SceneError | UnsupportedByEngine | RunRefused) else 1
+    except KeyboardInterrupt:  # outside a run loop (which checkpoints and stops by itself)
+        print("error: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

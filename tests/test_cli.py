@@ -41,6 +41,37 @@ def test_unsupported_scene_is_refused_with_exit_2(tmp_path, capsys):
     assert code == 2 and "unsupported by lammps" in err and "campbell-noslip" in err
 
 
+@pytest.mark.parametrize("engine", ["lammps", "edmd"])
+def test_bad_run_options_are_refused_before_any_engine_starts(tmp_path, capsys, engine):
+    """--out a folder, a name ending in the engine's work-folder suffix, below a file;
+    --np 0; --wall-limit nan: exit 2 naming the option, and nothing written."""
+    folder = tmp_path / "folder.h5"
+    folder.mkdir()
+    (tmp_path / "afile").write_text("")
+    cases = [
+        (["--out", str(folder)], "--out", "this is a folder"),
+        (["--out", str(tmp_path / f"r.{engine}")], "--out", f"ending in .{engine}"),
+        (["--out", str(tmp_path / "afile" / "x.h5")], "--out", "is a file, not a folder"),
+        (["--out", str(tmp_path / "x.h5"), "--np", "0"], "--np", "at least 1 rank"),
+        (["--out", str(tmp_path / "x.h5"), "--wall-limit", "nan"], "--wall-limit", "finite"),
+    ]
+    for args, option, reason in cases:
+        assert main(["run", str(CHUTE), "--engine", engine, "-q", *args, *SHORT]) == 2, args
+        err = capsys.readouterr().err
+        assert f"unsupported by {engine}: {option}" in err and reason in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "folder.h5"]
+
+
+def test_ctrl_c_outside_a_run_loop_is_one_line(monkeypatch, capsys):
+    import demstudy.engines.base as base
+
+    def interrupted(name):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(base, "get_engine", interrupted)
+    assert main(["run", str(CHUTE), "-q", *SHORT]) == 130
+    assert capsys.readouterr().err == "error: interrupted\n"
+
+
 def test_run_and_plot_end_to_end(tmp_path, capsys):
     out = tmp_path / "chute.h5"
     assert main(["run", str(CHUTE), "--out", str(out), "-q", *SHORT]) == 0

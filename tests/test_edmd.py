@@ -44,6 +44,7 @@ from demstudy.engines.edmd import (
     collide_pair,
     from_initial_state,
 )
+from demstudy.engines.edmd.engine import ENGINE_VERSION
 from demstudy.io.results import read_results
 from demstudy.scene.initial import build_initial_state
 from demstudy.theory import kinetic as theory
@@ -521,6 +522,7 @@ def test_engine_resume_is_bit_identical(tmp_path):
                  "bumps": {"spacing": 1.0}}]}, "walls[lower].bumps.pattern"),
     ({"contact.law": {"model": "campbell-exp"}}, "contact.law.model"),  # needs g for √(gR)
     ({"box.size": [20.0, 2.5]}, "box.size"),
+    ({"measure.axis": "x", "measure.statistics": ["profiles", "stress"]}, "measure.axis"),
 ])
 def test_engine_refuses_what_it_cannot_do(overrides, field, tmp_path):
     """Regular bumpy walls under gravity (the bottom layer cages itself at zero gaps),
@@ -531,6 +533,103 @@ def test_engine_refuses_what_it_cannot_do(overrides, field, tmp_path):
         EdmdEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))
     assert info.value.engine == "edmd" and info.value.field_name == field
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_resume_refuses_checkpoints_it_cannot_continue(tmp_path):
+    """A checkpoint continues only with the engine version that wrote it, whole, and with
+    frames kept as at the start; a fresh run must not delete another output's checkpoint
+    in the work folder they share (names that differ only in the suffix)."""
+    import pickle
+
+    from demstudy.engines.base import EngineError
+
+    scene = engine_scene({"run.production": 1.0})
+    out = tmp_path / "r.v1"
+    with pytest.raises(EngineError, match="--resume"):
+        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
+    ckpt = tmp_path / "r.edmd" / "checkpoint.pkl"
+    saved = pickle.loads(ckpt.read_bytes())
+    assert saved["version"] == ENGINE_VERSION and "diameter d = 1" in saved["units"]
+
+    def resume(**kw):
+        return EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True, **kw))
+
+    with pytest.raises(EngineError, match="keep-frames"):
+        resume(keep_frames=True)
+    with pytest.raises(EngineError, match="checkpoint of the interrupted run writing .*r.v1"):
+        EdmdEngine().run(scene, RunOptions(out=tmp_path / "r.v2", progress=False))
+    ckpt.write_bytes(pickle.dumps({**saved, "version": "demstudy-edmd 0.0"}))
+    with pytest.raises(EngineError, match="written by demstudy-edmd 0.0"):
+        resume()
+    ckpt.write_bytes(pickle.dumps(saved)[:1000])
+    with pytest.raises(EngineError, match="is not readable"):
+        resume()
+    ckpt.write_bytes(pickle.dumps(saved))
+    assert read_results(resume()).attrs["engine"] == "edmd"  # the intact one continues
+
+
+def test_a_stop_inside_a_sample_interval_resumes_bit_identically(tmp_path, monkeypatch):
+    """Ctrl-C or the wall-clock limit is honoured between two event chunks, not only at the
+    next sample: the run checkpoints mid-interval and the resumed run, its chunks starting
+    where the stopped one ended, gives the same results bit for bit. Chunks of 50 events
+    here (10^7 in production) so that an interval holds several."""
+    import pickle
+
+    from demstudy.engines.base import EngineError
+    from demstudy.engines.edmd import core
+
+    monkeypatch.setattr(core, "STALL_CHUNK", 50)
+    scene = engine_scene({"run.equilibration": 0.5, "run.production": 1.0})
+    whole = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5",
+                                                            progress=False)))
+    out = tmp_path / "parts.h5"
+    ckpt = tmp_path / "parts.edmd" / "checkpoint.pkl"
+    times, inside = [], 0
+    for k in range(4):  # each part stops after its first chunk (or at a sample reached first)
+        with pytest.raises(EngineError, match="after a checkpoint") as stopped:
+            EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=k > 0,
+                                               wall_limit=0.0))
+        saved = pickle.loads(ckpt.read_bytes())
+        times.append(saved["core"]["scalars"][0])
+        if "inside a sample interval" in str(stopped.value):
+            inside += 1
+            assert saved["run"].samples * 0.5 < times[-1] < (saved["run"].samples + 1) * 0.5
+    assert inside >= 2 and times == sorted(set(times))
+    parts = read_results(EdmdEngine().run(scene, RunOptions(out=out, progress=False,
+                                                            resume=True)))
+    for key, value in whole.timeseries.items():
+        assert np.array_equal(value, parts.timeseries[key], equal_nan=True), key
+    for key, value in whole.profiles.items():
+        assert np.array_equal(value, parts.profiles[key], equal_nan=True), key
+
+
+def test_lees_edwards_tilt_follows_the_results_convention(tmp_path):
+    """The recorded tilt (timeseries and frames) is the image offset γ̇ L_y t flipped into
+    [−L_x/2, L_x/2), as LAMMPS writes it (``flip yes``)."""
+    scene = engine_scene({"shear": {"rate": 0.3}, "run.equilibration": 0.0,
+                          "run.production": 6.0})
+    res = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "le.h5",
+                                                          progress=False, keep_frames=True)))
+    lx, ly = scene.box.size
+    t, tilt = res.timeseries["time"], res.timeseries["tilt"]
+    assert np.all((tilt >= -lx / 2) & (tilt < lx / 2))
+    drift = np.mod(tilt - 0.3 * ly * t + lx / 2, lx) - lx / 2
+    np.testing.assert_allclose(drift, 0.0, atol=1e-9)
+    assert tilt.min() < -lx / 4 and tilt.max() > lx / 4  # flipped at least once
+    np.testing.assert_array_equal(res.frames["tilt"], tilt[-len(res.frames["tilt"]):])
+
+
+def test_a_collision_count_that_cannot_be_reached_is_an_error(tmp_path):
+    """run.unit = 'collisions' with particles at rest: no event is left, so the first sample's
+    count can never be reached; the run says so instead of writing times of 1e300."""
+    from demstudy.engines.base import EngineError
+
+    scene = engine_scene({"run.unit": "collisions", "run.equilibration": 0.0,
+                          "run.production": 2.0, "run.sample_interval": 1.0,
+                          "initial.velocity.temperature": 0.0})
+    with pytest.raises(EngineError, match=r"after 0 pair collisions .* count \d+ cannot be"):
+        EdmdEngine().run(scene, RunOptions(out=tmp_path / "c.h5", progress=False))
+    assert not (tmp_path / "c.h5").exists()
 
 
 def test_cli_runs_the_edmd_engine(tmp_path, capsys):

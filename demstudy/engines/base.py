@@ -38,6 +38,33 @@ class RunOptions:
     extra: dict = field(default_factory=dict)
 
 
+def check_run_options(engine: str, options: RunOptions) -> None:
+    """Refuse run options no engine can use, before any engine starts (``UnsupportedByEngine``
+    naming the option, the value and what is allowed). The engine's work folder is the output
+    name with the suffix ``.<engine>`` (checkpoints, decks, logs)."""
+    import math  # noqa: PLC0415
+
+    from ..decks.base import UnsupportedByEngine  # noqa: PLC0415
+
+    if options.np < 1:
+        raise UnsupportedByEngine(engine, "--np", options.np, "at least 1 rank is needed")
+    limit = options.wall_limit
+    if limit is not None and not (math.isfinite(limit) and limit >= 0.0):
+        raise UnsupportedByEngine(engine, "--wall-limit", limit,
+                                  "a finite number of seconds >= 0 is allowed")
+    out = Path(options.out)
+    if out.is_dir():
+        raise UnsupportedByEngine(engine, "--out", str(out),
+                                  "a results file name is needed; this is a folder")
+    if out.suffix == f".{engine}":
+        raise UnsupportedByEngine(engine, "--out", str(out),
+                                  f"a name ending in .{engine} is the engine's work folder "
+                                  "(use .h5)")
+    blocking = next((p for p in out.resolve().parents if p.exists() and not p.is_dir()), None)
+    if blocking is not None:
+        raise UnsupportedByEngine(engine, "--out", str(out), f"{blocking} is a file, not a folder")
+
+
 class Engine(Protocol):
     name: str
 

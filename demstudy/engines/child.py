@@ -14,6 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from .. import UNITS_NOTE
 from .._lammps import mpirun_executable
 from ..scene import Scene, validate_scene
 from .base import EngineError, RunOptions, RunRefused, RunStopped
@@ -32,6 +33,7 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     Ctrl-C reaches the child too, which stops at the end of its current segment after a
     checkpoint; the caller then waits for it rather than killing it."""
     payload = {
+        "units": UNITS_NOTE,
         "engine": engine,
         "scene": scene.model_dump(mode="json"),
         "out": str(Path(options.out).resolve()),
@@ -115,4 +117,8 @@ def worker(job: str) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(worker(sys.argv[1]))
+    try:
+        sys.exit(worker(sys.argv[1]))
+    except KeyboardInterrupt:  # before the engine's own handler (while importing, say)
+        print("error: interrupted before the run started", file=sys.stderr)
+        sys.exit(FAILED)

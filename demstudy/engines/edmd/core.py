@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -44,8 +45,10 @@ from ...scene.initial import InitialState
 from ..base import EngineError
 
 DEFAULT_TC = 1e-5
-# events between two checks of the simulated time's progress (at least 1000 per particle)
+# events between two synchronisations and checks for a stop request; the simulated time's
+# progress is checked over windows of at least STALL_CHUNK and STALL_CHUNK_PER_PARTICLE × N
 STALL_CHUNK = 10_000_000
+STALL_CHUNK_PER_PARTICLE = 1000
 
 __all__ = ["DEFAULT_TC", "STALL_CHUNK", "EventDriven", "advance_watched", "collide_pair",
            "from_initial_state", "scene_parameters", "with_bumps", "y_range"]
@@ -176,45 +179,54 @@ def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -
 
 
 def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int = 0,
-                    stop_collisions: int = 0) -> bool:
+                    stop_collisions: int = 0,
+                    stop_requested: Callable[[], bool] | None = None) -> bool:
     """``core.advance_to(t, max_events, stop_collisions)``, watched for a stall.
 
     Events (collisions, crossings and stale predictions) are processed in chunks of
-    max(``STALL_CHUNK``, 1000 N). A chunk that moves the simulated time by no more than
-    max(t_c, 1e-9) means a zero-time collision loop, for example a particle caged between two
-    fixed bumps at exactly zero gaps, bouncing between them without time passing. Such a run
-    could never finish, so it raises ``EngineError`` naming the time and the cause, instead of
-    hanging. A legitimately slow run is not caught: a bed resting under the TC model costs
-    about N/t_c events per time unit, so one chunk still moves the time by about 1000 t_c.
+    ``STALL_CHUNK`` (10⁷). A window of at least max(``STALL_CHUNK``, 1000 N) events that
+    moves the simulated time by no more than max(t_c, 1e-9) means a zero-time collision loop,
+    for example a particle caged between two fixed bumps at exactly zero gaps, bouncing
+    between them without time passing. Such a run could never finish, so it raises
+    ``EngineError`` naming the time and the cause, instead of hanging. A legitimately slow run
+    is not caught: a bed resting under the TC model costs about N/t_c events per time unit,
+    so one window still moves the time by about 1000 t_c.
 
     Returns True when t is reached. Returns False when the run stopped early at
-    ``max_events`` (> 0, counted from the call) or at ``stop_collisions``.
+    ``max_events`` (> 0, counted from the call), at ``stop_collisions``, or because
+    ``stop_requested()`` (asked after every chunk) said so: Ctrl-C is then honoured within
+    one chunk (10⁷ events: seconds to a minute), not only at the next sample.
 
     Between chunks every particle is synchronised (as ``advance_to`` does at t), so the chunk
-    size belongs to the trajectory. It depends only on N, so runs stay deterministic and
-    resume bit-identically.
+    size belongs to the trajectory. It is fixed, so runs stay deterministic and resume
+    bit-identically (a resumed run's chunks start where the stopped one's ended).
     """
-    chunk = max(STALL_CHUNK, 1000 * core.n)
+    chunk = max(STALL_CHUNK, STALL_CHUNK_PER_PARTICLE * core.n)
     start = _processed(core)
+    t0, e0 = core.time, start  # the stall window: at least `chunk` events
     while True:
-        budget = chunk
+        budget = STALL_CHUNK  # a large system's window in steps, so stops come in time
         if max_events > 0:
-            budget = min(chunk, max_events - (_processed(core) - start))
+            budget = min(budget, max_events - (_processed(core) - start))
             if budget <= 0:
                 return False
-        t0, e0 = core.time, _processed(core)
         if core.advance_to(t, max_events=budget, stop_collisions=stop_collisions):
             return True
         if stop_collisions > 0 and core.collisions >= stop_collisions:
             return False
-        if _processed(core) - e0 >= chunk and core.time - t0 <= max(tc, 1e-9):
-            raise EngineError(
-                f"the event-driven run stalled at t = {core.time:.9g}: "
-                f"{_processed(core) - e0} events moved the time by {core.time - t0:.3g} "
-                f"(at most max(t_c, 1e-9) = {max(tc, 1e-9):.3g}). Most likely a cluster of "
-                "exactly touching particles is colliding in a loop that takes no time, for "
-                "example a particle caged at zero gaps between fixed bumps or in a crystalline "
-                "row. Perturb the start (another seed, random bumps) or use the LAMMPS engine")
+        if _processed(core) - e0 >= chunk:
+            if core.time - t0 <= max(tc, 1e-9):
+                raise EngineError(
+                    f"the event-driven run stalled at t = {core.time:.9g}: "
+                    f"{_processed(core) - e0} events moved the time by {core.time - t0:.3g} "
+                    f"(at most max(t_c, 1e-9) = {max(tc, 1e-9):.3g}). Most likely a cluster "
+                    "of exactly touching particles is colliding in a loop that takes no time, "
+                    "for example a particle caged at zero gaps between fixed bumps or in a "
+                    "crystalline row. Perturb the start (another seed, random bumps) or use "
+                    "the LAMMPS engine")
+            t0, e0 = core.time, _processed(core)
+        if stop_requested is not None and stop_requested():
+            return False
 
 
 def _processed(core: EventDriven) -> int:

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ... import __version__
+from ... import UNITS_NOTE, __version__
 from ...analysis.base import bin_edges
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.stress import collisional_stress, momentum_snapshot, stress_results
@@ -50,7 +50,8 @@ from .core import (
 
 CHECKPOINT = "checkpoint.pkl"
 ENGINE_VERSION = (f"demstudy-edmd {__version__} (gravity, flat and bumpy walls, servo, "
-                  "Lees-Edwards, Walton, e(v), TC, events with wall collisions)")
+                  "Lees-Edwards, Walton, e(v), TC, events with wall collisions, synchronised "
+                  "every 10^7 events)")
 #: collision-log records kept per run (sampled every ``log_every`` collisions)
 LOG_CAPACITY = 200_000
 
@@ -66,7 +67,15 @@ def check_supported(scene: Scene) -> dict:
         raise UnsupportedByEngine("edmd", "box.size", list(scene.box.size),
                                   f"every periodic box length must be at least 3 largest "
                                   f"diameters ({3 * d_max:g}) for the cell lists")
+    if "stress" in scene.measure.statistics and scene.measure.axis != "y":
+        raise UnsupportedByEngine("edmd", "measure.axis", scene.measure.axis,
+                                  "the collisional stress is binned along y only: use "
+                                  "measure.axis = 'y' with 'stress' in measure.statistics")
     return params
+
+
+class _StopInInterval(Exception):
+    """A stop request (Ctrl-C, wall-clock limit) honoured between two event chunks."""
 
 
 @dataclass
@@ -171,6 +180,7 @@ class _Run:
             options["fixed"] = fixed
         core = from_initial_state(everything, self.scene.box.size, tc=self.tc, **options)
         if not self.options.resume:
+            self._refuse_foreign_checkpoint()
             servo = ServoController(self.scene, None) if has_servo(self.scene) else None
             state = EdmdRunState(keep_frames=self.keep_frames, servo=servo)
             if servo is None:
@@ -182,11 +192,7 @@ class _Run:
                     state.next_servo = self._servo_interval()
                 state.servo_impulse = self._impulses(core)
             return core, state
-        path = self.workdir / CHECKPOINT
-        if not path.exists():
-            raise EngineError(f"--resume: no checkpoint in {self.workdir}")
-        with open(path, "rb") as fh:
-            saved = pickle.load(fh)
+        saved = self._load_checkpoint()
         if saved["scene"] != scene_to_toml(self.scene):
             raise EngineError("--resume: the checkpoint belongs to a different scene")
         if saved["tc"] != self.tc:
@@ -196,10 +202,50 @@ class _Run:
             self.tc = float(saved["tc"])  # not given: continue with the run's own t_c
             core = from_initial_state(everything, self.scene.box.size, tc=self.tc, **options)
         core.set_state(saved["core"])
-        self.keep_frames = saved["run"].keep_frames  # frames for the whole run or not at all
+        kept = saved["run"].keep_frames
+        if self.options.keep_frames is not None and self.options.keep_frames != kept:
+            raise EngineError(f"--resume: the run started {'with' if kept else 'without'} "
+                              "--keep-frames; frames are kept for the whole run or not at all")
+        self.keep_frames = saved["run"].keep_frames
         if saved["run"].stress_edges is not None:
             self.stress_edges = saved["run"].stress_edges
         return core, saved["run"]
+
+    def _refuse_foreign_checkpoint(self) -> None:
+        """Outputs that differ only in their suffix share a work folder: a fresh run must not
+        delete the checkpoint another output's interrupted run left there."""
+        path = self.workdir / CHECKPOINT
+        if not path.exists():
+            return
+        try:
+            with open(path, "rb") as fh:
+                other = pickle.load(fh).get("out")
+        except Exception:  # unreadable: a fresh run replaces it
+            return
+        if other is not None and other != str(self.out):
+            raise EngineError(f"{self.workdir} holds the checkpoint of the interrupted run "
+                              f"writing {other}: resume that run first, or remove the folder")
+
+    def _load_checkpoint(self) -> dict:
+        """The checkpoint of this output, refused when unreadable or written by another
+        version of the engine (it continues bit-identically only with its own)."""
+        path = self.workdir / CHECKPOINT
+        if not path.exists():
+            raise EngineError(f"--resume: no checkpoint in {self.workdir}")
+        try:
+            with open(path, "rb") as fh:
+                saved = pickle.load(fh)
+        except Exception as exc:  # truncated, corrupt or written by other code
+            raise EngineError(f"--resume: {path} is not readable ({type(exc).__name__}: "
+                              f"{exc}); remove it to start afresh") from exc
+        if not isinstance(saved, dict) or not {"scene", "tc", "core", "run"} <= saved.keys():
+            raise EngineError(f"--resume: {path} is not an edmd checkpoint")
+        version = saved.get("version", "an earlier version")
+        if version != ENGINE_VERSION:
+            raise EngineError(f"--resume: {path} was written by {version}, this is "
+                              f"{ENGINE_VERSION}: a checkpoint continues only with the engine "
+                              "that wrote it (remove it to start afresh)")
+        return saved
 
     def _checkpoint(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
         self.workdir.mkdir(parents=True, exist_ok=True)
@@ -207,7 +253,8 @@ class _Run:
             state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
         pickle_atomically(self.workdir / CHECKPOINT,
                           {"scene": scene_to_toml(self.scene), "tc": self.tc,
-                           "core": core.get_state(), "run": snapshot})
+                           "version": ENGINE_VERSION, "out": str(self.out),
+                           "units": UNITS_NOTE, "core": core.get_state(), "run": snapshot})
 
     def _impulses(self, core: EventDriven) -> dict[str, np.ndarray]:
         return {w.side: core.wall_impulse(0 if w.side == "lower" else 1)
@@ -247,6 +294,13 @@ class _Run:
         else:
             state.next_servo += self._servo_interval()
 
+    @staticmethod
+    def _tilt(core: EventDriven) -> float:
+        """The image offset flipped into [−L_x/2, L_x/2), the convention of the results file
+        (LAMMPS's ``flip yes``)."""
+        lx = float(core.box[0])
+        return (core.shear_offset + lx / 2) % lx - lx / 2
+
     # -- sampling -------------------------------------------------------------------------
     def _advance_interval(self, core: EventDriven, state: EdmdRunState) -> None:
         """Advance to the next sample: a time, or a collision count with run.unit =
@@ -262,7 +316,12 @@ class _Run:
             stops = [c for c in (target, state.next_servo if by_count else 0) if c > 0]
             t_stop = min(t_end, state.next_servo_time) if by_time else t_end
             reached = advance_watched(core, t_stop, tc=self.tc, max_events=guard,
-                                      stop_collisions=min(stops, default=0))
+                                      stop_collisions=min(stops, default=0),
+                                      stop_requested=self.stop.check)
+            if reached and target and core.collisions < target and core.time >= t_end:
+                raise EngineError(f"run.unit = 'collisions': no events are left after "
+                                  f"{core.collisions} pair collisions (the particles no longer "
+                                  f"meet), so the count {target} cannot be reached")
             if reached and by_time and core.time >= state.next_servo_time:
                 self._servo_update(core, state)
                 if core.time >= t_end:
@@ -275,6 +334,8 @@ class _Run:
                 continue
             if target and core.collisions >= target:
                 return
+            if self.stop.reason is not None:
+                raise _StopInInterval
             raise EngineError(f"the collision count {target} was not reached within {guard} "
                               f"events (pair and wall collisions, cell crossings, stale "
                               f"predictions) after t = {core.time:.6g}: a run counted in pair "
@@ -304,7 +365,7 @@ class _Run:
             state.record(f"wall_work_{side}", core.wall_work(0 if side == "lower" else 1))
         state.last_impulse = impulses
         if self.scene.shear is not None:
-            state.record("tilt", core.shear_offset)
+            state.record("tilt", self._tilt(core))
         if state.servo is not None:
             for side, wall in state.servo.walls.items():  # the core's positions are the truth
                 wall.y = core.wall_position(0 if side == "lower" else 1)
@@ -349,7 +410,7 @@ class _Run:
             hi[1] = core.wall_position(1) if self.scene.wall("upper") else hi[1]
         frame = Frame(time=t, box_lo=lo, box_hi=hi, position=position,
                       velocity=velocity, angular_velocity=core.angular_velocities()[:n],
-                      radius=self.radius, tilt=core.shear_offset)
+                      radius=self.radius, tilt=self._tilt(core))
         if state.profiles is None:  # servo: bins between the walls where production starts
             state.profiles = profile_analysis(self.scene, (float(lo[1]), float(hi[1])))
             if self.stress:  # the collisional stress in the same bins, from now on
@@ -368,15 +429,18 @@ class _Run:
         self.stop.request()
 
     def run(self) -> Path:
-        core, state = self._start()
-        started = time.perf_counter()
         self.stop = StopRequest(self.options.wall_limit)
+        # Ctrl-C from here on is a stop request, taken at the next sample (after a
+        # checkpoint), never a traceback: during the set-up the run stops after its first
+        # sample, during the final write it is ignored (the results are written)
         with self.stop:
+            core, state = self._start()
+            started = time.perf_counter()
             if state.samples == 0 and not state.timeseries:
                 self._sample(core, state, production=False)
             self._loop(core, state, started)
-        state.wall_seconds += time.perf_counter() - started
-        return self._write(core, state)
+            state.wall_seconds += time.perf_counter() - started
+            return self._write(core, state)
 
     def _loop(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
         unit = "coll/N" if self.by_collisions else "τ"
@@ -388,7 +452,18 @@ class _Run:
         with bar:
             while state.samples < self.n_total:
                 state.samples += 1
-                self._advance_interval(core, state)
+                try:
+                    self._advance_interval(core, state)
+                except _StopInInterval:
+                    # a stop asked for between two event chunks: the core is synchronised
+                    # there, and the resumed run redoes this interval from that point (its
+                    # chunks start where this one ended, so it continues bit-identically)
+                    state.samples -= 1
+                    self._checkpoint(core, state, started)
+                    raise RunStopped(
+                        f"stopped ({self.stop.reason}) at t = {core.time:.6g}, inside a sample "
+                        "interval, after a checkpoint: run the same command again with "
+                        "--resume to continue") from None
                 self._sample(core, state, production=state.samples > self.n_eq)
                 bar.update(self.dt)
                 checkpoint = self.n_ckpt and state.samples % self.n_ckpt == 0

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ... import UNITS_NOTE
 from ...analysis.base import bin_edges
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.stress import ContactStress, branch_sums, momentum_snapshot, stress_results
@@ -283,7 +284,8 @@ class Driver:
         snapshot = dataclasses.replace(
             state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
         pickle_atomically(self.workdir / CHECKPOINT_STATE,
-                          {"scene": scene_to_toml(self.scene), "run": snapshot})
+                          {"scene": scene_to_toml(self.scene), "units": UNITS_NOTE,
+                           "run": snapshot})
 
     # -- main loop ----------------------------------------------------------------------
     def _request_stop(self) -> None:
