@@ -556,6 +556,9 @@ def test_resume_refuses_checkpoints_it_cannot_continue(tmp_path):
 
     with pytest.raises(EngineError, match="keep-frames"):
         resume(keep_frames=True)
+    with pytest.raises(EngineError, match=r"run.production: 1.0 in the checkpoint, 2.0 now"):
+        EdmdEngine().run(engine_scene({"run.production": 2.0}),
+                         RunOptions(out=out, progress=False, resume=True))
     with pytest.raises(EngineError, match="checkpoint of the interrupted run writing .*r.v1"):
         EdmdEngine().run(scene, RunOptions(out=tmp_path / "r.v2", progress=False))
     ckpt.write_bytes(pickle.dumps({**saved, "version": "demstudy-edmd 0.0"}))

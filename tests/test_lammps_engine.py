@@ -145,7 +145,8 @@ def test_resume_after_interruption_continues_exactly(tmp_path, monkeypatch):
 def test_resume_refuses_a_changed_scene(tmp_path, monkeypatch):
     scene = rolling_pair()
     run_interrupted(scene, tmp_path, "r.h5", monkeypatch, 0.6)
-    with pytest.raises(EngineError, match="different scene"):
+    with pytest.raises(EngineError, match=r"different scene \(run.seed: \d+ in the checkpoint, "
+                                          r"7 now\)"):
         run(rolling_pair(seed=7), tmp_path, "r.h5", resume=True)
 
 

@@ -36,6 +36,29 @@ def pickle_atomically(path: Path, obj: Any) -> None:
     write_atomically(path, pickle.dumps(obj))
 
 
+def scene_difference(saved_toml: str, scene: Scene, most: int = 3) -> str:
+    """The scene a checkpoint was run with against ``scene``: the first ``most`` dotted keys
+    whose values differ, e.g. "run.production: 4.0 in the checkpoint, 1.0 now"."""
+    import tomllib  # noqa: PLC0415
+
+    def flat(data: dict, prefix: str = "") -> dict:
+        out = {}
+        for key, value in data.items():
+            if isinstance(value, dict):
+                out.update(flat(value, f"{prefix}{key}."))
+            else:
+                out[f"{prefix}{key}"] = value
+        return out
+
+    old, new = flat(tomllib.loads(saved_toml)), flat(tomllib.loads(scene_to_toml(scene)))
+    missing = object()
+    diffs = [f"{k}: {old.get(k, 'unset')!r} in the checkpoint, {new.get(k, 'unset')!r} now"
+             for k in sorted(old.keys() | new.keys())
+             if old.get(k, missing) != new.get(k, missing)]
+    more = f" and {len(diffs) - most} more" if len(diffs) > most else ""
+    return "; ".join(diffs[:most]) + more
+
+
 def run_attrs(scene: Scene, engine: str, version: str, wall_seconds: float,
               equilibration_end: float, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
     """Root attributes every results file carries, with Campbell's steadiness verdict over the

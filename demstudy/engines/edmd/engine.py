@@ -37,7 +37,7 @@ from ...scene import Scene, scene_to_toml
 from ...scene.initial import build_initial_state
 from ..base import EngineError, RunOptions, RunStopped
 from ..child import in_worker, launch_child
-from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
+from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs, scene_difference
 from .core import (
     DEFAULT_TC,
     EventDriven,
@@ -194,7 +194,8 @@ class _Run:
             return core, state
         saved = self._load_checkpoint()
         if saved["scene"] != scene_to_toml(self.scene):
-            raise EngineError("--resume: the checkpoint belongs to a different scene")
+            raise EngineError("--resume: the checkpoint belongs to a different scene ("
+                              f"{scene_difference(saved['scene'], self.scene)})")
         if saved["tc"] != self.tc:
             if "tc" in self.options.extra:  # asked for explicitly: refuse to change it
                 raise EngineError(f"--resume: the checkpoint was run with --tc "

@@ -42,7 +42,13 @@ from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
 from ..base import EngineError, RunOptions, RunStopped
-from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs
+from ..common import (
+    StopRequest,
+    keep_frame,
+    pickle_atomically,
+    run_attrs,
+    scene_difference,
+)
 from .session import LammpsSession, quoted
 
 CHECKPOINT_RESTART = "checkpoint.restart"
@@ -127,7 +133,8 @@ class Driver:
             with open(path, "rb") as fh:
                 saved = pickle.load(fh)
             if saved["scene"] != scene_to_toml(self.scene):
-                raise EngineError("--resume: the checkpoint belongs to a different scene")
+                raise EngineError("--resume: the checkpoint belongs to a different scene ("
+                                  f"{scene_difference(saved['scene'], self.scene)})")
             state = saved["run"]
             self.keep_frames = state.keep_frames  # frames are stored for the whole run or not
             return state
