@@ -57,7 +57,9 @@ LOG_CAPACITY = 200_000
 
 
 def check_supported(scene: Scene) -> dict:
-    """Refuse what the event-driven engine cannot do (bumpy walls, small periodic boxes);
+    """Refuse what the event-driven engine cannot do (``scene_parameters``: regular bumps under
+    gravity, servo-controlled or no-slip bumpy walls, Campbell's e(v) without gravity; here:
+    periodic boxes too small for the cell lists, the stress along an axis other than y);
     return the core's options for the scene."""
     params = scene_parameters(scene)
     d_max = 1.0 + scene.particles.diameter_spread / 2
@@ -170,6 +172,8 @@ class _Run:
         return options
 
     def _start(self) -> tuple[EventDriven, EdmdRunState]:
+        if not self.options.resume:
+            self._refuse_foreign_checkpoint()
         initial = build_initial_state(self.scene)
         self.radius = initial.diameter / 2
         self.mass = initial.mass
@@ -180,7 +184,6 @@ class _Run:
             options["fixed"] = fixed
         core = from_initial_state(everything, self.scene.box.size, tc=self.tc, **options)
         if not self.options.resume:
-            self._refuse_foreign_checkpoint()
             servo = ServoController(self.scene, None) if has_servo(self.scene) else None
             state = EdmdRunState(keep_frames=self.keep_frames, servo=servo)
             if servo is None:
@@ -431,9 +434,9 @@ class _Run:
 
     def run(self) -> Path:
         self.stop = StopRequest(self.options.wall_limit)
-        # Ctrl-C from here on is a stop request, taken at the next sample (after a
-        # checkpoint), never a traceback: during the set-up the run stops after its first
-        # sample, during the final write it is ignored (the results are written)
+        # Ctrl-C from here on is a stop request, never a traceback: taken between two event
+        # chunks or at the next sample (after a checkpoint); during the set-up the run stops
+        # after its first chunk, during the final write it is ignored (the results are written)
         with self.stop:
             core, state = self._start()
             started = time.perf_counter()
