@@ -129,10 +129,11 @@ def test_resume_after_interruption_continues_exactly(tmp_path, monkeypatch):
     parts = run(scene, tmp_path, "parts.h5", keep_frames=True, resume=True)
 
     np.testing.assert_array_equal(whole.timeseries["time"], parts.timeseries["time"])
-    # Restart files are binary-exact, but LAMMPS rebuilds neighbour lists and ghosts, so
-    # round-off differs inside the stiff contacts (k_n = 1e5: 1e-11 in position shows as
-    # 1e-8 in velocity). A lost tangential history would show as ~1e-2 (its force,
-    # m g sin α, acting for 0.25 time units).
+    # Restart files are binary-exact, but the resume's initialisation recomputes the damping
+    # forces from full-step velocities (velocity Verlet used half-step ones): a one-step
+    # perturbation that this chaos-free pair keeps at 1e-8 in position (docs/lammps-engine.md).
+    # A lost tangential history would show as ~1e-2 (its force, m g sin α, acting for 0.25
+    # time units).
     for key, tol in (("position", 1e-8), ("velocity", 1e-6), ("angular_velocity", 1e-6)):
         np.testing.assert_allclose(parts.frames[key], whole.frames[key], rtol=0, atol=tol,
                                    err_msg=key)
@@ -140,6 +141,62 @@ def test_resume_after_interruption_continues_exactly(tmp_path, monkeypatch):
     assert np.all(np.abs(whole.frames["angular_velocity"][-1]) > 0.1)
     np.testing.assert_allclose(parts.profiles["velocity"], whole.profiles["velocity"],
                                atol=1e-6)
+
+
+def test_a_checkpoint_cut_off_while_written_leaves_the_previous_pair(tmp_path, monkeypatch):
+    """The second checkpoint's state pickle fails (a full disk) after its restart file was
+    written: the resumed run continues from the first checkpoint, a consistent pair (the
+    pickle names its restart file), and ends where the uninterrupted run ends."""
+    import errno
+
+    import demstudy.engines.lammps.driver as driver
+
+    scene = rolling_pair()
+    whole = run(scene, tmp_path, "whole.h5")
+    original, calls = driver.pickle_atomically, []
+
+    def full_disk_on_second(path, obj):
+        calls.append(obj["run"].step)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        original(path, obj)
+
+    with monkeypatch.context() as patch:
+        patch.setattr(driver, "pickle_atomically", full_disk_on_second)
+        with pytest.raises(OSError, match="No space left"):
+            run(scene, tmp_path, "parts.h5")
+    workdir = tmp_path / "parts.lammps"
+    assert len(list(workdir.glob("checkpoint-*.restart"))) == 2  # the orphan is not named
+    parts = run(scene, tmp_path, "parts.h5", resume=True)
+    np.testing.assert_array_equal(whole.timeseries["time"], parts.timeseries["time"])
+    # a mismatched pair would shift every later sample by one checkpoint interval (0.5)
+    np.testing.assert_allclose(parts.timeseries["kinetic_energy"],
+                               whole.timeseries["kinetic_energy"], rtol=1e-4)
+    assert not list(workdir.glob("checkpoint*"))
+
+
+def test_resume_refuses_what_it_cannot_continue(tmp_path, monkeypatch):
+    """A changed --keep-frames or --dump, an unreadable state pickle (named) and one written
+    by another version are refused; the intact checkpoint then resumes."""
+    import pickle
+
+    scene = rolling_pair()
+    run_interrupted(scene, tmp_path, "r.h5", monkeypatch, 0.6)
+    state = tmp_path / "r.lammps" / "checkpoint.pkl"
+    saved = pickle.loads(state.read_bytes())
+    assert saved["units"].startswith("dimensionless particle units")
+    with pytest.raises(EngineError, match="keep-frames"):
+        run(scene, tmp_path, "r.h5", resume=True, keep_frames=True)
+    with pytest.raises(EngineError, match="--dump"):
+        run(scene, tmp_path, "r.h5", resume=True, dump=tmp_path / "new.dump")
+    state.write_bytes(pickle.dumps(saved)[:200])
+    with pytest.raises(EngineError, match=r"checkpoint.pkl is not readable"):
+        run(scene, tmp_path, "r.h5", resume=True)
+    state.write_bytes(pickle.dumps({**saved, "version": "demstudy 0.0"}))
+    with pytest.raises(EngineError, match="written by demstudy 0.0"):
+        run(scene, tmp_path, "r.h5", resume=True)
+    state.write_bytes(pickle.dumps(saved))
+    assert run(scene, tmp_path, "r.h5", resume=True).attrs["engine"] == "lammps"
 
 
 def test_resume_refuses_a_changed_scene(tmp_path, monkeypatch):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -59,6 +60,8 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     try:
         returncode = proc.wait()
     except KeyboardInterrupt:
+        print(f"\n{engine}: stopping after the current segment and a checkpoint "
+              "(Ctrl-C again aborts without one)", file=sys.stderr, flush=True)
         try:
             returncode = proc.wait(timeout=300)
         except (subprocess.TimeoutExpired, KeyboardInterrupt):
@@ -72,9 +75,11 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     if returncode == REFUSED:
         raise RunRefused(f"the {engine} engine refused the run (see the message above)")
     if returncode != 0:
-        how = (f"was killed by signal {-returncode}" if returncode < 0
+        how = ("was interrupted" if returncode == -signal.SIGINT
+               else f"was killed by signal {-returncode}" if returncode < 0
                else f"failed (exit {returncode})")
-        log = f" and {out.with_suffix('.lammps') / 'log.lammps'}" if engine == "lammps" else ""
+        log_file = out.with_suffix(".lammps") / "log.lammps"
+        log = f" and {log_file}" if engine == "lammps" and log_file.exists() else ""
         raise EngineError(f"the {engine} run on {options.np} rank(s) {how}; see the messages "
                           f"above{log}")
     return out
@@ -84,7 +89,6 @@ def _die_with_parent() -> None:
     """In the child before exec: SIGTERM when the parent dies (killed by a batch system's
     timeout, say), so no orphaned engine keeps running (Linux prctl PR_SET_PDEATHSIG)."""
     import ctypes  # noqa: PLC0415
-    import signal  # noqa: PLC0415
 
     ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ... import UNITS_NOTE
+from ... import UNITS_NOTE, __version__
 from ...analysis.base import bin_edges
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.stress import ContactStress, branch_sums, momentum_snapshot, stress_results
@@ -51,8 +51,11 @@ from ..common import (
 )
 from .session import LammpsSession, quoted
 
-CHECKPOINT_RESTART = "checkpoint.restart"
 CHECKPOINT_STATE = "checkpoint.pkl"
+# the restart file of a checkpoint is named by its step and the state pickle names it: the
+# pickle's atomic rename commits the pair, so a cut-off checkpoint leaves the previous pair
+CHECKPOINT_RESTARTS = "checkpoint-*.restart"
+CHECKPOINT_VERSION = f"demstudy {__version__} (lammps checkpoint 2)"
 
 
 @dataclass
@@ -116,7 +119,7 @@ class Driver:
     def _issue_deck(self, session: LammpsSession, resume: bool) -> None:
         for cmd in self.deck.commands("setup"):
             if cmd.startswith("read_data"):
-                cmd = (f"read_restart {quoted(self.workdir / CHECKPOINT_RESTART)}" if resume
+                cmd = (f"read_restart {quoted(self._restart)}" if resume
                        else f"read_data {quoted(self.workdir / DATA_FILE)}")
             elif resume and cmd.startswith("set "):
                 continue  # masses are in the restart file
@@ -127,16 +130,21 @@ class Driver:
 
     def _load_state(self) -> RunState:
         if self.options.resume:
-            path = self.workdir / CHECKPOINT_STATE
-            if not path.exists() or not (self.workdir / CHECKPOINT_RESTART).exists():
-                raise EngineError(f"--resume: no checkpoint in {self.workdir}")
-            with open(path, "rb") as fh:
-                saved = pickle.load(fh)
+            saved = self._load_checkpoint()
             if saved["scene"] != scene_to_toml(self.scene):
                 raise EngineError("--resume: the checkpoint belongs to a different scene ("
                                   f"{scene_difference(saved['scene'], self.scene)})")
             state = saved["run"]
-            self.keep_frames = state.keep_frames  # frames are stored for the whole run or not
+            kept = state.keep_frames  # frames are stored for the whole run or not at all
+            if self.options.keep_frames is not None and self.options.keep_frames != kept:
+                raise EngineError(f"--resume: the run started {'with' if kept else 'without'} "
+                                  "--keep-frames; frames are kept for the whole run or not at "
+                                  "all")
+            dump = str(self.dump) if self.dump else None
+            if saved.get("dump") != dump:
+                raise EngineError(f"--resume: the run started with --dump {saved.get('dump')}, "
+                                  f"this call has {dump}: the dump continues only in its file")
+            self.keep_frames = kept
             return state
         if has_servo(self.scene):
             # bins are laid between the walls where they stand when production starts
@@ -280,19 +288,46 @@ class Driver:
         return branch_sums(y, y - br[:, 1], f[:, :, None] * br[:, None, :], stress.edges,
                            stress.period)
 
+    def _load_checkpoint(self) -> dict:
+        """The state pickle of this output's checkpoint (and ``self._restart``, the restart
+        file it names), refused when missing, unreadable or written by another version."""
+        path = self.workdir / CHECKPOINT_STATE
+        if not path.exists():
+            raise EngineError(f"--resume: no checkpoint in {self.workdir}")
+        try:
+            with open(path, "rb") as fh:
+                saved = pickle.load(fh)
+        except Exception as exc:  # truncated, corrupt or written by other code
+            raise EngineError(f"--resume: {path} is not readable ({type(exc).__name__}: "
+                              f"{exc}); remove it to start afresh") from exc
+        if not isinstance(saved, dict) or not {"scene", "run"} <= saved.keys():
+            raise EngineError(f"--resume: {path} is not a LAMMPS-engine checkpoint")
+        version = saved.get("version", "an earlier version")
+        if version != CHECKPOINT_VERSION:
+            raise EngineError(f"--resume: {path} was written by {version}, this is "
+                              f"{CHECKPOINT_VERSION} (remove it to start afresh)")
+        self._restart = self.workdir / saved["restart"]
+        if not self._restart.exists():
+            raise EngineError(f"--resume: {self._restart}, the restart file of the checkpoint, "
+                              "is missing")
+        return saved
+
     def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
-        restart = self.workdir / CHECKPOINT_RESTART
-        session.command(f"write_restart {quoted(str(restart) + '.new')}")
+        restart = self.workdir / f"checkpoint-{state.step}.restart"
+        session.command(f"write_restart {quoted(restart)}")
         if session.rank != 0:
             return
-        os.replace(f"{restart}.new", restart)
         if self.dump is not None and self.dump.exists():
             state.dump_size = self.dump.stat().st_size
         snapshot = dataclasses.replace(
             state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
         pickle_atomically(self.workdir / CHECKPOINT_STATE,
                           {"scene": scene_to_toml(self.scene), "units": UNITS_NOTE,
-                           "run": snapshot})
+                           "version": CHECKPOINT_VERSION, "restart": restart.name,
+                           "dump": str(self.dump) if self.dump else None, "run": snapshot})
+        for old in self.workdir.glob(CHECKPOINT_RESTARTS):  # committed: the older pairs go
+            if old != restart:
+                old.unlink(missing_ok=True)
 
     # -- main loop ----------------------------------------------------------------------
     def _request_stop(self) -> None:
@@ -321,6 +356,11 @@ class Driver:
     def _start(self, session: LammpsSession, state: RunState) -> None:
         self._issue_deck(session, resume=self.options.resume)
         if self.options.resume:
+            step = session.lmp.extract_global("ntimestep")
+            if step != state.step:  # a safety net: the pickle names its own restart file
+                raise EngineError(f"--resume: {self._restart} holds step {step}, the "
+                                  f"checkpoint's state step {state.step}; remove "
+                                  f"{self.workdir} to start afresh")
             self._reanchor(session, state)  # variables are not in restart files
             if self.dump is not None and session.rank == 0 and self.dump.exists():
                 os.truncate(self.dump, state.dump_size)  # drop frames after the checkpoint
@@ -385,6 +425,7 @@ class Driver:
             group_attrs["contact_samples"] = state.stress.samples if state.stress else 0
             results.groups["stress"], results.group_attrs["stress"] = data, group_attrs
         path = write_results(self.out, results)
-        for name in (CHECKPOINT_RESTART, CHECKPOINT_STATE):
-            (self.workdir / name).unlink(missing_ok=True)
+        (self.workdir / CHECKPOINT_STATE).unlink(missing_ok=True)
+        for old in self.workdir.glob(CHECKPOINT_RESTARTS):
+            old.unlink(missing_ok=True)
         return path
