@@ -145,6 +145,7 @@ class Driver:
                 raise EngineError(f"--resume: the run started with --dump {saved.get('dump')}, "
                                   f"this call has {dump}: the dump continues only in its file")
             self.keep_frames = kept
+            self._saved_forces = saved.get("forces")
             return state
         if has_servo(self.scene):
             # bins are laid between the walls where they stand when production starts
@@ -312,11 +313,16 @@ class Driver:
                               "is missing")
         return saved
 
-    def _checkpoint(self, session: LammpsSession, state: RunState, started: float) -> None:
+    def _checkpoint(self, session: LammpsSession, state: RunState, started: float,
+                    resetup: bool) -> dict[str, np.ndarray]:
+        """Write the checkpoint; return the per-atom forces and torques of this step (velocity
+        Verlet's, from half-step velocities), which restart files do not hold. ``resetup``:
+        LAMMPS sets up again here anyway (a servo update), so they are not carried over."""
+        forces = {name: session.gather(name, 3).copy() for name in ("f", "torque")}
         restart = self.workdir / f"checkpoint-{state.step}.restart"
         session.command(f"write_restart {quoted(restart)}")
         if session.rank != 0:
-            return
+            return forces
         if self.dump is not None and self.dump.exists():
             state.dump_size = self.dump.stat().st_size
         snapshot = dataclasses.replace(
@@ -324,10 +330,24 @@ class Driver:
         pickle_atomically(self.workdir / CHECKPOINT_STATE,
                           {"scene": scene_to_toml(self.scene), "units": UNITS_NOTE,
                            "version": CHECKPOINT_VERSION, "restart": restart.name,
-                           "dump": str(self.dump) if self.dump else None, "run": snapshot})
+                           "dump": str(self.dump) if self.dump else None,
+                           "forces": None if resetup else forces, "run": snapshot})
         for old in self.workdir.glob(CHECKPOINT_RESTARTS):  # committed: the older pairs go
             if old != restart:
                 old.unlink(missing_ok=True)
+        return forces
+
+    def _set_up_again(self, session: LammpsSession, state: RunState,
+                      forces: dict[str, np.ndarray] | None) -> None:
+        """LAMMPS after ``write_restart`` or ``read_restart``: re-anchor the variables, set up
+        (``run 0``) and put back the forces and torques of the checkpoint's step. The set-up
+        would otherwise have recomputed them from full-step velocities, changing every
+        velocity-dependent (damping) force for one step; with them restored, a checkpoint
+        leaves the run as it was and a resumed run continues as the uninterrupted one."""
+        self._reanchor(session, state)
+        session.command("run 0 post no")
+        for name, value in (forces or {}).items():
+            session.scatter(name, value)
 
     # -- main loop ----------------------------------------------------------------------
     def _request_stop(self) -> None:
@@ -361,12 +381,13 @@ class Driver:
                 raise EngineError(f"--resume: {self._restart} holds step {step}, the "
                                   f"checkpoint's state step {state.step}; remove "
                                   f"{self.workdir} to start afresh")
-            self._reanchor(session, state)  # variables are not in restart files
             if self.dump is not None and session.rank == 0 and self.dump.exists():
                 os.truncate(self.dump, state.dump_size)  # drop frames after the checkpoint
-        elif self.dump is not None and session.rank == 0:
-            self.dump.unlink(missing_ok=True)
-        session.command("run 0 post no")
+            self._set_up_again(session, state, self._saved_forces)
+        else:
+            if self.dump is not None and session.rank == 0:
+                self.dump.unlink(missing_ok=True)
+            session.command("run 0 post no")
         if state.step == 0:
             self._sample(session, state, production=False)  # the initial state
 
@@ -400,8 +421,9 @@ class Driver:
                 stop = session.any_rank(self.stop.check())
                 checkpoint = self.n_ckpt and state.step % self.n_ckpt == 0
                 if (stop or checkpoint) and state.step < self.n_total:
-                    self._checkpoint(session, state, started)
-                    initialise = True  # write_restart re-initialised LAMMPS
+                    forces = self._checkpoint(session, state, started, resetup=initialise)
+                    if not initialise:  # write_restart re-initialised LAMMPS
+                        self._set_up_again(session, state, forces)
                 if stop and state.step < self.n_total:
                     raise RunStopped(
                         f"stopped ({self.stop.reason or 'on another rank'}) at t = "

@@ -49,6 +49,15 @@ class LammpsSession:
         arr = np.ctypeslib.as_array(data)
         return arr.reshape(-1, count) if count > 1 else arr.copy()
 
+    def scatter(self, name: str, values: np.ndarray) -> None:
+        """Set a per-atom float property from rows ordered by atom ID (the inverse of
+        ``gather``; every rank passes the same array and sets its owned atoms, so no atom
+        map is needed)."""
+        nlocal = int(self.lmp.extract_setting("nlocal"))
+        ids = np.array(self.lmp.numpy.extract_atom("id")[:nlocal], dtype=np.int64)
+        target = self.lmp.numpy.extract_atom(name)
+        target[:nlocal] = values[ids - 1]
+
     def fix_vector(self, fix_id: str, length: int) -> np.ndarray:
         """Global vector of a fix (e.g. ``fix ave/time``), identical on every rank."""
         style, kind = self._lam.LMP_STYLE_GLOBAL, self._lam.LMP_TYPE_VECTOR
