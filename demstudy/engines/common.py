@@ -36,6 +36,32 @@ def pickle_atomically(path: Path, obj: Any) -> None:
     write_atomically(path, pickle.dumps(obj))
 
 
+def load_checkpoint(path: Path, keys: set[str], version: str, engine: str) -> dict:
+    """The pickled checkpoint dict at ``path`` for ``--resume``, refused (``EngineError``
+    naming the file) when missing, unreadable, without the ``keys`` the engine needs, or
+    written by another ``version`` (a checkpoint continues only with the code that wrote it)."""
+    from .base import EngineError  # noqa: PLC0415
+
+    if not path.exists():
+        raise EngineError(f"--resume: no checkpoint in {path.parent}")
+    try:
+        with open(path, "rb") as fh:
+            saved = pickle.load(fh)
+    except Exception as exc:  # truncated, corrupt or written by other code
+        raise EngineError(f"--resume: {path} is not readable ({type(exc).__name__}: {exc}); "
+                          "remove it to start afresh") from exc
+    if not isinstance(saved, dict):
+        raise EngineError(f"--resume: {path} is not a checkpoint of the {engine} engine")
+    written = saved.get("version", "an earlier version")
+    if written != version:
+        raise EngineError(f"--resume: {path} was written by {written}, this is {version}: a "
+                          "checkpoint continues only with the code that wrote it (remove it "
+                          "to start afresh)")
+    if not keys <= saved.keys():
+        raise EngineError(f"--resume: {path} is not a checkpoint of the {engine} engine")
+    return saved
+
+
 def scene_difference(saved_toml: str, scene: Scene, most: int = 3) -> str:
     """The scene a checkpoint was run with against ``scene``: the first ``most`` dotted keys
     whose values differ, e.g. "run.production: 4.0 in the checkpoint, 1.0 now"."""

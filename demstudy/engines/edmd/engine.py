@@ -37,7 +37,14 @@ from ...scene import Scene, scene_to_toml
 from ...scene.initial import build_initial_state
 from ..base import EngineError, RunOptions, RunStopped
 from ..child import in_worker, launch_child
-from ..common import StopRequest, keep_frame, pickle_atomically, run_attrs, scene_difference
+from ..common import (
+    StopRequest,
+    keep_frame,
+    load_checkpoint,
+    pickle_atomically,
+    run_attrs,
+    scene_difference,
+)
 from .core import (
     DEFAULT_TC,
     EventDriven,
@@ -195,7 +202,8 @@ class _Run:
                     state.next_servo = self._servo_interval()
                 state.servo_impulse = self._impulses(core)
             return core, state
-        saved = self._load_checkpoint()
+        saved = load_checkpoint(self.workdir / CHECKPOINT, {"scene", "tc", "core", "run"},
+                                ENGINE_VERSION, "edmd")
         if saved["scene"] != scene_to_toml(self.scene):
             raise EngineError("--resume: the checkpoint belongs to a different scene ("
                               f"{scene_difference(saved['scene'], self.scene)})")
@@ -229,27 +237,6 @@ class _Run:
         if other is not None and other != str(self.out):
             raise EngineError(f"{self.workdir} holds the checkpoint of the interrupted run "
                               f"writing {other}: resume that run first, or remove the folder")
-
-    def _load_checkpoint(self) -> dict:
-        """The checkpoint of this output, refused when unreadable or written by another
-        version of the engine (it continues bit-identically only with its own)."""
-        path = self.workdir / CHECKPOINT
-        if not path.exists():
-            raise EngineError(f"--resume: no checkpoint in {self.workdir}")
-        try:
-            with open(path, "rb") as fh:
-                saved = pickle.load(fh)
-        except Exception as exc:  # truncated, corrupt or written by other code
-            raise EngineError(f"--resume: {path} is not readable ({type(exc).__name__}: "
-                              f"{exc}); remove it to start afresh") from exc
-        if not isinstance(saved, dict) or not {"scene", "tc", "core", "run"} <= saved.keys():
-            raise EngineError(f"--resume: {path} is not an edmd checkpoint")
-        version = saved.get("version", "an earlier version")
-        if version != ENGINE_VERSION:
-            raise EngineError(f"--resume: {path} was written by {version}, this is "
-                              f"{ENGINE_VERSION}: a checkpoint continues only with the engine "
-                              "that wrote it (remove it to start afresh)")
-        return saved
 
     def _checkpoint(self, core: EventDriven, state: EdmdRunState, started: float) -> None:
         self.workdir.mkdir(parents=True, exist_ok=True)

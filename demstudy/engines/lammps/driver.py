@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import pickle
 import sys
 import time
 from dataclasses import dataclass, field
@@ -45,6 +44,7 @@ from ..base import EngineError, RunOptions, RunStopped
 from ..common import (
     StopRequest,
     keep_frame,
+    load_checkpoint,
     pickle_atomically,
     run_attrs,
     scene_difference,
@@ -292,21 +292,8 @@ class Driver:
     def _load_checkpoint(self) -> dict:
         """The state pickle of this output's checkpoint (and ``self._restart``, the restart
         file it names), refused when missing, unreadable or written by another version."""
-        path = self.workdir / CHECKPOINT_STATE
-        if not path.exists():
-            raise EngineError(f"--resume: no checkpoint in {self.workdir}")
-        try:
-            with open(path, "rb") as fh:
-                saved = pickle.load(fh)
-        except Exception as exc:  # truncated, corrupt or written by other code
-            raise EngineError(f"--resume: {path} is not readable ({type(exc).__name__}: "
-                              f"{exc}); remove it to start afresh") from exc
-        if not isinstance(saved, dict) or not {"scene", "run"} <= saved.keys():
-            raise EngineError(f"--resume: {path} is not a LAMMPS-engine checkpoint")
-        version = saved.get("version", "an earlier version")
-        if version != CHECKPOINT_VERSION:
-            raise EngineError(f"--resume: {path} was written by {version}, this is "
-                              f"{CHECKPOINT_VERSION} (remove it to start afresh)")
+        saved = load_checkpoint(self.workdir / CHECKPOINT_STATE, {"scene", "run", "restart"},
+                                CHECKPOINT_VERSION, "LAMMPS")
         self._restart = self.workdir / saved["restart"]
         if not self._restart.exists():
             raise EngineError(f"--resume: {self._restart}, the restart file of the checkpoint, "
