@@ -38,10 +38,25 @@ class RunOptions:
     extra: dict = field(default_factory=dict)
 
 
+def work_folder(out: Path, engine: str) -> Path:
+    """The engine's work folder of results file ``out``: its name with the suffix
+    ``.<engine>`` (checkpoints, decks, logs)."""
+    return Path(out).with_suffix(f".{engine}")
+
+
+def frames_on_resume(requested: bool | None, kept: bool) -> bool:
+    """Whether a resumed run keeps frames: as the run started (``kept``); a ``--keep-frames``
+    that says otherwise (``requested``) is refused, as frames cover the whole run or none."""
+    if requested is not None and requested != kept:
+        raise EngineError(f"--resume: the run started {'with' if kept else 'without'} "
+                          "--keep-frames; frames are kept for the whole run or not at all")
+    return kept
+
+
 def check_run_options(engine: str, options: RunOptions) -> None:
     """Refuse run options no engine can use, before any engine starts (``UnsupportedByEngine``
-    naming the option, the value and what is allowed). The engine's work folder is the output
-    name with the suffix ``.<engine>`` (checkpoints, decks, logs)."""
+    naming the option, the value and what is allowed); the output must not be the engine's
+    work folder (``work_folder``)."""
     import math  # noqa: PLC0415
 
     from ..decks.base import UnsupportedByEngine  # noqa: PLC0415
@@ -56,7 +71,7 @@ def check_run_options(engine: str, options: RunOptions) -> None:
     if out.is_dir():
         raise UnsupportedByEngine(engine, "--out", str(out),
                                   "a results file name is needed; this is a folder")
-    if out.suffix == f".{engine}":
+    if work_folder(out, engine) == out:
         raise UnsupportedByEngine(engine, "--out", str(out),
                                   f"a name ending in .{engine} is the engine's work folder "
                                   "(use .h5)")

@@ -18,7 +18,7 @@ from pathlib import Path
 from .. import UNITS_NOTE
 from .._lammps import mpirun_executable
 from ..scene import Scene, validate_scene
-from .base import EngineError, RunOptions, RunRefused, RunStopped
+from .base import EngineError, RunOptions, RunRefused, RunStopped, work_folder
 
 WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
 FAILED, REFUSED, STOPPED = 1, 2, 3  # the child's exit codes
@@ -78,7 +78,7 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
         how = ("was interrupted" if returncode == -signal.SIGINT
                else f"was killed by signal {-returncode}" if returncode < 0
                else f"failed (exit {returncode})")
-        log_file = out.with_suffix(".lammps") / "log.lammps"
+        log_file = work_folder(out, engine) / "log.lammps"
         log = f" and {log_file}" if engine == "lammps" and log_file.exists() else ""
         raise EngineError(f"the {engine} run on {options.np} rank(s) {how}; see the messages "
                           f"above{log}")

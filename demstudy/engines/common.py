@@ -36,10 +36,12 @@ def pickle_atomically(path: Path, obj: Any) -> None:
     write_atomically(path, pickle.dumps(obj))
 
 
-def load_checkpoint(path: Path, keys: set[str], version: str, engine: str) -> dict:
+def load_checkpoint(path: Path, scene: Scene, keys: set[str], version: str,
+                    engine: str) -> dict:
     """The pickled checkpoint dict at ``path`` for ``--resume``, refused (``EngineError``
-    naming the file) when missing, unreadable, without the ``keys`` the engine needs, or
-    written by another ``version`` (a checkpoint continues only with the code that wrote it)."""
+    naming the file) when missing, unreadable, without the ``keys`` the engine needs (besides
+    ``scene``), written by another ``version`` (a checkpoint continues only with the code that
+    wrote it) or for a scene other than ``scene`` (naming the keys that differ)."""
     from .base import EngineError  # noqa: PLC0415
 
     if not path.exists():
@@ -57,8 +59,11 @@ def load_checkpoint(path: Path, keys: set[str], version: str, engine: str) -> di
         raise EngineError(f"--resume: {path} was written by {written}, this is {version}: a "
                           "checkpoint continues only with the code that wrote it (remove it "
                           "to start afresh)")
-    if not keys <= saved.keys():
+    if not keys | {"scene"} <= saved.keys():
         raise EngineError(f"--resume: {path} is not a checkpoint of the {engine} engine")
+    if saved["scene"] != scene_to_toml(scene):
+        raise EngineError("--resume: the checkpoint belongs to a different scene ("
+                          f"{scene_difference(saved['scene'], scene)})")
     return saved
 
 

@@ -35,7 +35,7 @@ from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
 from ...scene.initial import build_initial_state
-from ..base import EngineError, RunOptions, RunStopped
+from ..base import EngineError, RunOptions, RunStopped, frames_on_resume, work_folder
 from ..child import in_worker, launch_child
 from ..common import (
     StopRequest,
@@ -43,7 +43,6 @@ from ..common import (
     load_checkpoint,
     pickle_atomically,
     run_attrs,
-    scene_difference,
 )
 from .core import (
     DEFAULT_TC,
@@ -148,7 +147,7 @@ class _Run:
     def __init__(self, scene: Scene, options: RunOptions, params: dict, tc: float):
         self.scene, self.options, self.params, self.tc = scene, options, params, tc
         self.out = Path(options.out).resolve()
-        self.workdir = self.out.with_suffix(".edmd")
+        self.workdir = work_folder(self.out, "edmd")
         run = scene.run
         self.dt = run.sample_interval  # time, or collisions per particle
         self.by_collisions = run.unit == "collisions"
@@ -202,11 +201,8 @@ class _Run:
                     state.next_servo = self._servo_interval()
                 state.servo_impulse = self._impulses(core)
             return core, state
-        saved = load_checkpoint(self.workdir / CHECKPOINT, {"scene", "tc", "core", "run"},
+        saved = load_checkpoint(self.workdir / CHECKPOINT, self.scene, {"tc", "core", "run"},
                                 ENGINE_VERSION, "edmd")
-        if saved["scene"] != scene_to_toml(self.scene):
-            raise EngineError("--resume: the checkpoint belongs to a different scene ("
-                              f"{scene_difference(saved['scene'], self.scene)})")
         if saved["tc"] != self.tc:
             if "tc" in self.options.extra:  # asked for explicitly: refuse to change it
                 raise EngineError(f"--resume: the checkpoint was run with --tc "
@@ -214,11 +210,7 @@ class _Run:
             self.tc = float(saved["tc"])  # not given: continue with the run's own t_c
             core = from_initial_state(everything, self.scene.box.size, tc=self.tc, **options)
         core.set_state(saved["core"])
-        kept = saved["run"].keep_frames
-        if self.options.keep_frames is not None and self.options.keep_frames != kept:
-            raise EngineError(f"--resume: the run started {'with' if kept else 'without'} "
-                              "--keep-frames; frames are kept for the whole run or not at all")
-        self.keep_frames = saved["run"].keep_frames
+        self.keep_frames = frames_on_resume(self.options.keep_frames, saved["run"].keep_frames)
         if saved["run"].stress_edges is not None:
             self.stress_edges = saved["run"].stress_edges
         return core, saved["run"]

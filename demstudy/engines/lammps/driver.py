@@ -40,14 +40,13 @@ from ...decks.walls import wall_fix_id, wall_force_sources
 from ...io.frames import Frame
 from ...io.results import Results, write_results
 from ...scene import Scene, scene_to_toml
-from ..base import EngineError, RunOptions, RunStopped
+from ..base import EngineError, RunOptions, RunStopped, frames_on_resume
 from ..common import (
     StopRequest,
     keep_frame,
     load_checkpoint,
     pickle_atomically,
     run_attrs,
-    scene_difference,
 )
 from .session import LammpsSession, quoted
 
@@ -131,20 +130,12 @@ class Driver:
     def _load_state(self) -> RunState:
         if self.options.resume:
             saved = self._load_checkpoint()
-            if saved["scene"] != scene_to_toml(self.scene):
-                raise EngineError("--resume: the checkpoint belongs to a different scene ("
-                                  f"{scene_difference(saved['scene'], self.scene)})")
             state = saved["run"]
-            kept = state.keep_frames  # frames are stored for the whole run or not at all
-            if self.options.keep_frames is not None and self.options.keep_frames != kept:
-                raise EngineError(f"--resume: the run started {'with' if kept else 'without'} "
-                                  "--keep-frames; frames are kept for the whole run or not at "
-                                  "all")
             dump = str(self.dump) if self.dump else None
             if saved.get("dump") != dump:
                 raise EngineError(f"--resume: the run started with --dump {saved.get('dump')}, "
                                   f"this call has {dump}: the dump continues only in its file")
-            self.keep_frames = kept
+            self.keep_frames = frames_on_resume(self.options.keep_frames, state.keep_frames)
             self._saved_forces = saved.get("forces")
             return state
         if has_servo(self.scene):
@@ -292,7 +283,7 @@ class Driver:
     def _load_checkpoint(self) -> dict:
         """The state pickle of this output's checkpoint (and ``self._restart``, the restart
         file it names), refused when missing, unreadable or written by another version."""
-        saved = load_checkpoint(self.workdir / CHECKPOINT_STATE, {"scene", "run", "restart"},
+        saved = load_checkpoint(self.workdir / CHECKPOINT_STATE, self.scene, {"run", "restart"},
                                 CHECKPOINT_VERSION, "LAMMPS")
         self._restart = self.workdir / saved["restart"]
         if not self._restart.exists():
@@ -305,7 +296,8 @@ class Driver:
         """Write the checkpoint; return the per-atom forces and torques of this step (velocity
         Verlet's, from half-step velocities), which restart files do not hold. ``resetup``:
         LAMMPS sets up again here anyway (a servo update), so they are not carried over."""
-        forces = {name: session.gather(name, 3).copy() for name in ("f", "torque")}
+        forces = ({} if resetup else
+                  {name: session.gather(name, 3).copy() for name in ("f", "torque")})
         restart = self.workdir / f"checkpoint-{state.step}.restart"
         session.command(f"write_restart {quoted(restart)}")
         if session.rank != 0:
@@ -318,7 +310,7 @@ class Driver:
                           {"scene": scene_to_toml(self.scene), "units": UNITS_NOTE,
                            "version": CHECKPOINT_VERSION, "restart": restart.name,
                            "dump": str(self.dump) if self.dump else None,
-                           "forces": None if resetup else forces, "run": snapshot})
+                           "forces": forces, "run": snapshot})
         for old in self.workdir.glob(CHECKPOINT_RESTARTS):  # committed: the older pairs go
             if old != restart:
                 old.unlink(missing_ok=True)

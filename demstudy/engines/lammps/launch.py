@@ -10,7 +10,7 @@ from pathlib import Path
 from ...decks import build_deck
 from ...decks.contact import contact_setup
 from ...scene import Scene
-from ..base import RunOptions
+from ..base import RunOptions, work_folder
 from ..child import in_worker, launch_child
 from .driver import Driver
 
@@ -27,7 +27,7 @@ class LammpsEngine:
         setup = contact_setup(scene)  # raises UnsupportedByEngine before LAMMPS starts
         deck = build_deck(scene, setup=setup)  # so does every effect LAMMPS cannot express
         out = Path(options.out).resolve()
-        workdir = out.with_suffix(".lammps")
+        workdir = work_folder(out, self.name)
         workdir.mkdir(parents=True, exist_ok=True)
         for name, content in deck.files.items():
             (workdir / name).write_text(content)
