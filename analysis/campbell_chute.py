@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from demstudy.engines.base import RunOptions, get_engine
 from demstudy.io.results import read_results
 from demstudy.plot import plot_profiles
 from demstudy.scene import load_scene
+from demstudy.simulation import RunOptions, run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     files = []
     for engine in ("lammps", "edmd"):
         h5 = args.out / f"campbell1982-chute-30-{engine}.h5"
-        get_engine(engine).run(scene, RunOptions(out=h5))
+        run_scene(scene, engine, RunOptions(out=h5))
         files.append(h5)
     fig = plot_profiles(files, args.out / "campbell1982-chute-30-profiles.png")
     print(f"figure:  {fig}")

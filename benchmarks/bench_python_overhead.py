@@ -19,12 +19,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from demstudy._lammps import lmp_executable
-from demstudy.decks import write_deck
-from demstudy.decks.contact import contact_setup
-from demstudy.engines.base import RunOptions
-from demstudy.engines.lammps import LammpsEngine
+from demstudy.contact.stiffness import contact_setup
+from demstudy.engines.lammps.deck import write_deck
+from demstudy.engines.lammps.library import lmp_executable
 from demstudy.scene import validate_scene
+from demstudy.simulation import RunOptions, run_scene
 
 
 def chute_scene(steps: int, sample_every: int, dt: float | None = None) -> dict:
@@ -61,7 +60,7 @@ def timed_pair(scene, tmp: Path) -> tuple[float, float, float, float]:
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     bare_cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
     c0, t0 = time.process_time(), time.perf_counter()
-    LammpsEngine().run(scene, RunOptions(out=tmp / "py.h5", progress=False))
+    run_scene(scene, "lammps", RunOptions(out=tmp / "py.h5", progress=False))
     return bare, time.perf_counter() - t0, bare_cpu, time.process_time() - c0
 
 

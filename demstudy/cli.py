@@ -7,7 +7,6 @@ All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gra
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
@@ -25,38 +24,43 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             continue
         where = "open top" if scene.has_open_top else f"solid fraction {scene.solid_fraction:.4g}"
         print(f"ok: {path} ({scene.dimension}D, {scene.n_particles} particles, {where})")
-    return 1 if failed else 0
+    return 2 if failed else 0
 
 
 def _cmd_deck(args: argparse.Namespace) -> int:
-    from .decks import write_deck
+    from .engines import get_backend
 
     scene = load_scene(args.scene, args.set)
-    path = write_deck(scene, args.out, dump=args.dump)
-    print(f"wrote {path} (run it with: cd {path.parent} && lmp -in {path.name})")
+    backend = get_backend(args.engine)
+    path = backend.write_inputs(scene, Path(args.out), dump=args.dump)
+    print(f"wrote {path} (run it with: cd {path.parent} && {backend.run_inputs_hint(path)})")
     return 0
 
 
+def _engine_options(args: argparse.Namespace) -> dict:
+    """The engine options given on the command line (``--tc`` …), by name."""
+    from .engines import backend_names, get_backend
+
+    given = {}
+    for engine in backend_names():
+        for name in get_backend(engine).options:
+            value = getattr(args, f"engine_option_{name}", None)
+            if value is not None:
+                given[name] = value
+    return given
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .decks.base import UnsupportedByEngine
-    from .engines.base import RunOptions, check_run_options, get_engine
+    from .simulation import RunOptions, run_scene
 
     scene = load_scene(args.scene, args.set)
-    extra = {}
-    if args.tc is not None:  # checked before any engine starts
-        if args.engine != "edmd":
-            raise UnsupportedByEngine(args.engine, "--tc", args.tc,
-                                      "the TC-model time is an event-driven option (--engine edmd)")
-        if not (math.isfinite(args.tc) and args.tc >= 0.0):
-            raise UnsupportedByEngine(args.engine, "--tc", args.tc,
-                                      "a finite time >= 0 is allowed (0 switches the model off)")
-        extra["tc"] = args.tc
-    out = Path(args.out or Path("results") / f"{Path(args.scene).stem}-{args.engine}.h5")
+    name = Path(args.scene).stem
+    out = Path(args.out or Path("results") / f"{name}-{args.engine}.h5")
     options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
                          progress=not args.quiet, keep_frames=args.keep_frames or None,
-                         isolate=True, wall_limit=args.wall_limit, extra=extra)
-    check_run_options(args.engine, options)
-    path = get_engine(args.engine).run(scene, options)
+                         isolate=True, wall_limit=args.wall_limit,
+                         extra=_engine_options(args))
+    path = run_scene(scene, args.engine, options)
     print(f"results: {path}")
     return 0
 
@@ -83,9 +87,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    from .analysis.suite import run_statistics
-    from .io.dump import has_fast_columns, read_dump, read_dump_fast
-    from .io.results import Results, frames_of, read_results, write_results
+    from .analysis.registry import Context, compute_statistics
+    from .io.results import frames_of, read_results, write_results
     from .scene import apply_overrides, parse_scene_text, scene_to_toml, validate_scene
 
     what = [w.strip() for w in args.what.split(",") if w.strip()]
@@ -105,25 +108,16 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         def frames():
             return (f for f in frames_of(results, scene.dimension) if f.time >= args.start)
     else:
+        from .io.dump import dump_source
+
         if not args.scene:
             raise ValueError("analyzing a dump needs --scene SCENE.toml (the scene it ran)")
-        from .decks.contact import contact_setup
-
         scene = load_scene(args.scene, args.set)
-        dt = args.dt if args.dt is not None else contact_setup(scene).timestep
-        fast = args.reader == "fast" or (args.reader == "auto" and has_fast_columns(source))
-        reader = read_dump_fast if fast else read_dump
-        results = Results({"engine": "lammps-dump",
-                           "engine_version": "numpy fast reader" if fast else "MDAnalysis",
-                           "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
-                           "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(source)})
+        results, frames = dump_source(source, scene, args.dt, args.reader, args.start)
         out = Path(args.out or source.with_suffix(".h5"))
 
-        def frames():
-            return reader(source, scene.dimension, dt=dt, start_time=args.start)
-
-    for name, (data, attrs) in run_statistics(scene, frames, what, results,
-                                              args.z_cells).items():
+    ctx = Context(scene, frames=frames, results=results, z_cells=args.z_cells)
+    for name, (data, attrs) in compute_statistics(what, ctx).items():
         if name == "profiles":
             results.profiles, results.profile_attrs = data, attrs
         else:
@@ -135,17 +129,23 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from .contact import calibrate as cal
+    from .contact.calibration import format_table
+    from .engines import get_backend
 
-    rows = cal.calibrate(dim=args.dim, kind=args.kind, e=args.e, beta=args.beta,
-                         K=args.K if args.K is not None else (0.5 if args.dim == 2 else 0.4),
-                         kn=args.kn, steps_per_contact=args.steps,
-                         speeds=args.speeds, angles=args.angles)
-    print(cal.format_table(rows))
+    rows = get_backend(args.engine).calibrate(
+        dim=args.dim, kind=args.kind, e=args.e, beta=args.beta,
+        K=args.K if args.K is not None else (0.5 if args.dim == 2 else 0.4), kn=args.kn,
+        steps_per_contact=args.steps, speeds=args.speeds, angles=args.angles)
+    print(format_table(rows))
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .analysis.registry import STATISTICS
+    from .engines import DEFAULT_ENGINE, backend_names, get_backend
+    from .plots import KINDS
+
+    engines = backend_names()
     parser = argparse.ArgumentParser(
         prog="demstudy",
         description="Rapid granular shear flows from one scene file (units: d = m = 1, g = 1).",
@@ -154,33 +154,38 @@ def build_parser() -> argparse.ArgumentParser:
     overrides = argparse.ArgumentParser(add_help=False)
     overrides.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                            help="override a scene value, e.g. --set run.production=20")
+    scene_help = "a scene file, or a preset shipped with demstudy (e.g. campbell1982/chute-30)"
 
     p = sub.add_parser("validate", parents=[overrides], help="check scene files")
-    p.add_argument("scenes", nargs="+")
+    p.add_argument("scenes", nargs="+", help=scene_help)
     p.set_defaults(func=_cmd_validate)
 
-    p = sub.add_parser("deck", parents=[overrides], help="write the LAMMPS deck of a scene")
-    p.add_argument("scene")
+    with_inputs = [e for e in engines if get_backend(e).capabilities.inputs]
+    p = sub.add_parser("deck", parents=[overrides],
+                       help="write an engine's input files for a scene (they run without "
+                            "demstudy)")
+    p.add_argument("scene", help=scene_help)
+    p.add_argument("--engine", default=DEFAULT_ENGINE, choices=with_inputs)
     p.add_argument("-o", "--out", default="deck", help="output folder (default: ./deck)")
     p.add_argument("--dump", help="add a custom dump of the particles to this file")
     p.set_defaults(func=_cmd_deck)
 
     p = sub.add_parser("run", parents=[overrides], help="run a scene")
-    p.add_argument("scene")
-    p.add_argument("--engine", default="lammps", choices=["lammps", "edmd"])
+    p.add_argument("scene", help=scene_help)
+    p.add_argument("--engine", default=DEFAULT_ENGINE, choices=engines)
     p.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
     p.add_argument("--out", help="results file (default results/<scene>-<engine>.h5)")
-    p.add_argument("--dump", type=Path, help="also write a LAMMPS custom dump of the samples")
+    p.add_argument("--dump", type=Path, help="also write the engine's own dump of the samples")
     p.add_argument("--resume", action="store_true", help="continue from the last checkpoint")
     p.add_argument("--keep-frames", action="store_true", help="store every sampled frame")
     p.add_argument("--wall-limit", type=float, metavar="SECONDS",
                    help="checkpoint and stop after this much wall-clock time (then --resume)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--tc", type=float, metavar="TIME",
-                   help="edmd: TC-model time t_c (default 1e-5; 0 = off). A collision within t_c "
-                        "of a partner's previous one is elastic, and a particle resting on a "
-                        "wall hops with period t_c: a resting bed costs ~1/t_c events per "
-                        "particle and time unit (docs/edmd-engine.md)")
+    for engine in engines:  # each engine's own options, checked against --engine
+        for name, option in get_backend(engine).options.items():
+            p.add_argument(f"--{name.replace('_', '-')}", type=option.kind,
+                           dest=f"engine_option_{name}", metavar=option.metavar,
+                           help=f"{engine} only: {option.help}")
     p.set_defaults(func=_cmd_run)
 
     p = sub.add_parser("plot", help="figures of results files: profiles, stress, statistics",
@@ -190,8 +195,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--out", help="figure file (one kind), or OUT-<kind>.png for each of "
                                        "several kinds (default: <kind>.png)")
     p.add_argument("--kind", action="append", metavar="KIND",
-                   help="profiles (default), stress, eos, vdf, angles, freepath, gr, vcorr, "
-                        "lambda, waves, cooling or all; comma-separated or repeated")
+                   help=f"{', '.join(KINDS)} or all (default profiles); comma-separated or "
+                        "repeated")
     p.add_argument("--scaled", action="store_true",
                    help="profiles against (y - y0)/H: H the wall gap, or the flow depth with "
                         "an open top")
@@ -201,24 +206,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_plot)
 
     p = sub.add_parser("analyze", parents=[overrides],
-                       help="statistics from a results file's frames or from a LAMMPS dump")
-    p.add_argument("source", help="RUN.h5 (run with --keep-frames) or a LAMMPS dump")
+                       help="statistics from a results file's frames or from a dump")
+    p.add_argument("source", help="RUN.h5 or a LAMMPS-style custom dump")
     p.add_argument("--scene", help="the scene (needed for dumps; default for RUN.h5: its own)")
     p.add_argument("--what", default="profiles",
-                   help="comma-separated: profiles, vdf, gr, angles, freepath, stress, vcorr, "
-                        "lambda, waves, cgprofiles (default: profiles)")
+                   help="comma-separated, of: " + "; ".join(
+                       f"{n} ({s.description}; from {s.source})" for n, s in
+                       STATISTICS.items()) + " (default: profiles)")
     p.add_argument("--z-cells", type=int, default=1, metavar="N",
                    help="3D: Malik's cells, fluctuations about the means of N z-slabs of each "
-                        "y-bin for profiles (added cell_temperature*), vdf, vcorr, lambda "
-                        "(default 1: the y-bin means, Campbell's strips)")
-    p.add_argument("--dt", type=float, help="dump time step (default: the scene's LAMMPS one)")
+                        "y-bin for " + ", ".join(n for n, s in STATISTICS.items() if s.z_cells)
+                        + " (default 1: the y-bin means, Campbell's strips)")
+    p.add_argument("--dt", type=float, help="dump time step (default: the scene's soft-contact "
+                                            "time step)")
     p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")
     p.add_argument("--out", help="results file (default: RUN.h5 itself, or DUMP.h5)")
     p.add_argument("--reader", choices=["auto", "fast", "mdanalysis"], default="auto",
                    help="auto: the numpy fast path for demstudy's dumps, MDAnalysis otherwise")
     p.set_defaults(func=_cmd_analyze)
 
-    p = sub.add_parser("calibrate", help="measure e, beta, t_c of binary collisions in LAMMPS")
+    soft = [e for e in engines if get_backend(e).capabilities.time_step]
+    p = sub.add_parser("calibrate", help="measure e, beta, t_c of binary soft collisions")
+    p.add_argument("--engine", default=DEFAULT_ENGINE, choices=soft)
     p.add_argument("--dim", type=int, choices=[2, 3], default=3)
     p.add_argument("--kind", choices=["pair", "wall"], default="pair")
     p.add_argument("--e", type=float, default=0.8)
@@ -233,8 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .decks.base import UnsupportedByEngine
-    from .engines.base import EngineError, RunRefused, RunStopped
+    from .errors import EngineError, RunRefused, RunStopped, UnsupportedByEngine
 
     args = build_parser().parse_args(argv)
     try:

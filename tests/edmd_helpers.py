@@ -9,8 +9,7 @@ import math
 
 import numpy as np
 
-from demstudy.engines.edmd import EventDriven, check_supported, from_initial_state
-from demstudy.engines.edmd.core import y_range
+from demstudy.engines.edmd import EventDriven, core_options, from_initial_state, y_range
 from demstudy.scene import parse_scene_text, validate_scene
 from demstudy.scene.initial import build_initial_state
 
@@ -60,7 +59,7 @@ def scene_with(text: str, overrides: dict | None = None):
 
 def system(scene, tc: float = 0.0, **kw) -> EventDriven:
     """The core for a scene (with its cell range along a bounded y)."""
-    params = check_supported(scene)
+    params = core_options(scene)
     initial = build_initial_state(scene)
     if not scene.y_periodic:
         params["y_range"] = y_range(scene, initial.position)
@@ -83,16 +82,16 @@ def whole_and_resumed(scene, tmp_path):
     zero wall limit, which checkpoints, then resumed)."""
     import pytest
 
-    from demstudy.engines.base import EngineError, RunOptions
-    from demstudy.engines.edmd import EdmdEngine
+    from demstudy.errors import EngineError
     from demstudy.io.results import read_results
+    from demstudy.simulation import RunOptions, run_scene
 
-    whole = EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5", progress=False))
+    whole = run_scene(scene, "edmd", RunOptions(out=tmp_path / "whole.h5", progress=False))
     out = tmp_path / "parts.h5"
     with pytest.raises(EngineError, match="--resume"):
-        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, wall_limit=0.0))
     assert (tmp_path / "parts.edmd" / "checkpoint.pkl").exists()
-    EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True))
+    run_scene(scene, "edmd", RunOptions(out=out, progress=False, resume=True))
     return read_results(whole), read_results(out)
 
 

@@ -12,20 +12,15 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from demstudy._lammps import open_lammps
-from demstudy.contact.calibrate import (
-    calibrate,
-    collide,
-    format_table,
-    incline_acceleration,
-    rolling_acceleration,
-)
+from demstudy.contact.calibration import format_table, incline_acceleration
 from demstudy.contact.mapping import (
     inertia_factor,
     make_contact,
     spring_beta,
     walton_beta,
 )
+from demstudy.engines.lammps.calibrate import calibrate, collide, rolling_acceleration
+from demstudy.engines.lammps.library import open_lammps
 
 DIMS_KINDS = [(2, "pair"), (2, "wall"), (3, "pair"), (3, "wall")]
 

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demstudy._lammps import lmp_executable, mpirun_executable
 from demstudy.cli import main
+from demstudy.engines.lammps.library import lmp_executable, mpirun_executable
 
 ROOT = Path(__file__).resolve().parent.parent
 CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
@@ -23,14 +23,14 @@ SHORT = ["--set", "run.equilibration=0.5", "--set", "run.production=1", "--set",
 def test_validate_reports_field_value_and_allowed(tmp_path, capsys):
     bad = tmp_path / "bad.toml"
     bad.write_text(CHUTE.read_text().replace("restitution = 0.6", "restitution = 1.6"))
-    assert main(["validate", str(bad)]) == 1
+    assert main(["validate", str(bad)]) == 2  # invalid input: exit 2, as the README says
     err = capsys.readouterr().err
     assert "contact.restitution = 1.6" in err and "less than or equal to 1" in err
     assert "Traceback" not in err
 
 
 def test_validate_suggests_nearest_key(tmp_path, capsys):
-    assert main(["validate", str(CHUTE), "--set", "run.prodction=3"]) == 1
+    assert main(["validate", str(CHUTE), "--set", "run.prodction=3"]) == 2
     assert "did you mean 'production'" in capsys.readouterr().err
 
 
@@ -63,11 +63,11 @@ def test_bad_run_options_are_refused_before_any_engine_starts(tmp_path, capsys, 
 
 
 def test_ctrl_c_outside_a_run_loop_is_one_line(monkeypatch, capsys):
-    import demstudy.engines.base as base
+    import demstudy.simulation as simulation
 
-    def interrupted(name):
+    def interrupted(*args):
         raise KeyboardInterrupt
-    monkeypatch.setattr(base, "get_engine", interrupted)
+    monkeypatch.setattr(simulation, "run_scene", interrupted)
     assert main(["run", str(CHUTE), "-q", *SHORT]) == 130
     assert capsys.readouterr().err == "error: interrupted\n"
 

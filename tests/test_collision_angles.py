@@ -18,7 +18,7 @@ from demstudy.analysis.collisions import (
     collision_chunks,
     savage_jeffrey_projected,
 )
-from demstudy.analysis.suite import run_statistics
+from demstudy.analysis.registry import Context, compute_statistics
 from demstudy.io.results import Results, read_results, write_results
 from demstudy.scene import validate_scene
 from demstudy.theory import savage_jeffrey
@@ -193,11 +193,11 @@ def test_angles_from_a_results_file(tmp_path):
     path = write_results(tmp_path / "r.h5", Results(
         {"equilibration_end": 10.0, "scene_toml": ""}, {"time": np.zeros(1)},
         profiles_for(1.0, 1.0, 2), groups={"collisions": log}))
-    out = run_statistics(scene, lambda: iter(()), ["angles"], read_results(path))
+    out = compute_statistics(["angles"], Context(scene, results=read_results(path)))
     data, attrs = out["angles"]
     assert attrs["collisions"] == int((~early).sum())
     z = z_scores(data["p_text"], data["p_text_err"], data["sj_text_R"])
     assert np.mean(z**2) < 2.0
     with pytest.raises(ValueError, match="collisions"):
-        run_statistics(scene, lambda: iter(()), ["angles"],
-                       Results({}, {}, profiles_for(1.0, 1.0, 2)))
+        compute_statistics(["angles"],
+                           Context(scene, results=Results({}, {}, profiles_for(1.0, 1.0, 2))))

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from demstudy.decks import build_deck
-from demstudy.decks.base import UnsupportedByEngine
-from demstudy.decks.system import DATA_FILE
+from demstudy.engines.lammps.deck import build_deck
+from demstudy.engines.lammps.deck.system import DATA_FILE
+from demstudy.errors import UnsupportedByEngine
 from demstudy.scene import load_scene, validate_scene
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -11,11 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demstudy.engines.base import RunOptions
-from demstudy.engines.lammps import LammpsEngine
 from demstudy.io.dump import read_dump, read_dump_fast
 from demstudy.io.frames import Frame
 from demstudy.scene import load_scene
+from demstudy.simulation import RunOptions, run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -23,7 +22,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def lammps_dump(tmp_path: Path, scene_file: str, **run) -> tuple[Path, float, object]:
     scene = load_scene(ROOT / "inputs" / scene_file, [f"run.{k}={v}" for k, v in run.items()])
     dump = tmp_path / "frames.dump"
-    LammpsEngine().run(scene, RunOptions(out=tmp_path / "run.h5", progress=False, dump=dump))
+    run_scene(scene, "lammps", RunOptions(out=tmp_path / "run.h5", progress=False, dump=dump))
     from demstudy.io.results import read_results
 
     return dump, read_results(tmp_path / "run.h5").attrs["timestep"], scene

@@ -36,17 +36,17 @@ from edmd_helpers import (
 from scipy.spatial import cKDTree
 
 from demstudy.analysis.suite import profile_analysis
-from demstudy.decks.base import UnsupportedByEngine
-from demstudy.engines.base import RunOptions, get_engine
+from demstudy.engines import get_backend
 from demstudy.engines.edmd import (
-    EdmdEngine,
+    EdmdBackend,
     EventDriven,
     collide_pair,
     from_initial_state,
 )
-from demstudy.engines.edmd.engine import ENGINE_VERSION
+from demstudy.errors import UnsupportedByEngine
 from demstudy.io.results import read_results
 from demstudy.scene.initial import build_initial_state
+from demstudy.simulation import RunOptions, run_scene
 from demstudy.theory import kinetic as theory
 
 
@@ -480,9 +480,9 @@ def test_rejects_bad_input():
 
 
 def test_engine_writes_the_common_results_file(tmp_path):
-    assert isinstance(get_engine("edmd"), EdmdEngine)
+    assert get_backend("edmd") is EdmdBackend
     scene = engine_scene()
-    path = EdmdEngine().run(scene, RunOptions(out=tmp_path / "r.h5", progress=False,
+    path = run_scene(scene, "edmd", RunOptions(out=tmp_path / "r.h5", progress=False,
                                               keep_frames=True))
     res = read_results(path)
     assert res.attrs["engine"] == "edmd" and res.attrs["seed"] == 3
@@ -530,7 +530,7 @@ def test_engine_refuses_what_it_cannot_do(overrides, field, tmp_path):
     refused before anything runs, naming the field."""
     scene = engine_scene(overrides)
     with pytest.raises(UnsupportedByEngine) as info:
-        EdmdEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))
+        run_scene(scene, "edmd", RunOptions(out=tmp_path / "x.h5", progress=False))
     assert info.value.engine == "edmd" and info.value.field_name == field
     assert not (tmp_path / "x.h5").exists()
 
@@ -541,26 +541,26 @@ def test_resume_refuses_checkpoints_it_cannot_continue(tmp_path):
     in the work folder they share (names that differ only in the suffix)."""
     import pickle
 
-    from demstudy.engines.base import EngineError
+    from demstudy.errors import EngineError
 
     scene = engine_scene({"run.production": 1.0})
     out = tmp_path / "r.v1"
     with pytest.raises(EngineError, match="--resume"):
-        EdmdEngine().run(scene, RunOptions(out=out, progress=False, wall_limit=0.0))
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, wall_limit=0.0))
     ckpt = tmp_path / "r.edmd" / "checkpoint.pkl"
     saved = pickle.loads(ckpt.read_bytes())
-    assert saved["version"] == ENGINE_VERSION and "diameter d = 1" in saved["units"]
+    assert saved["version"].endswith(EdmdBackend.version) and "diameter d = 1" in saved["units"]
 
     def resume(**kw):
-        return EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=True, **kw))
+        return run_scene(scene, "edmd", RunOptions(out=out, progress=False, resume=True, **kw))
 
     with pytest.raises(EngineError, match="keep-frames"):
         resume(keep_frames=True)
     with pytest.raises(EngineError, match=r"run.production: 1.0 in the checkpoint, 2.0 now"):
-        EdmdEngine().run(engine_scene({"run.production": 2.0}),
+        run_scene(engine_scene({"run.production": 2.0}), "edmd",
                          RunOptions(out=out, progress=False, resume=True))
     with pytest.raises(EngineError, match="checkpoint of the interrupted run writing .*r.v1"):
-        EdmdEngine().run(scene, RunOptions(out=tmp_path / "r.v2", progress=False))
+        run_scene(scene, "edmd", RunOptions(out=tmp_path / "r.v2", progress=False))
     ckpt.write_bytes(pickle.dumps({**saved, "version": "demstudy-edmd 0.0"}))
     with pytest.raises(EngineError, match="written by demstudy-edmd 0.0"):
         resume()
@@ -578,27 +578,27 @@ def test_a_stop_inside_a_sample_interval_resumes_bit_identically(tmp_path, monke
     here (10^7 in production) so that an interval holds several."""
     import pickle
 
-    from demstudy.engines.base import EngineError
     from demstudy.engines.edmd import core
+    from demstudy.errors import EngineError
 
     monkeypatch.setattr(core, "STALL_CHUNK", 50)
     scene = engine_scene({"run.equilibration": 0.5, "run.production": 1.0})
-    whole = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "whole.h5",
+    whole = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "whole.h5",
                                                             progress=False)))
     out = tmp_path / "parts.h5"
     ckpt = tmp_path / "parts.edmd" / "checkpoint.pkl"
     times, inside = [], 0
     for k in range(4):  # each part stops after its first chunk (or at a sample reached first)
         with pytest.raises(EngineError, match="after a checkpoint") as stopped:
-            EdmdEngine().run(scene, RunOptions(out=out, progress=False, resume=k > 0,
+            run_scene(scene, "edmd", RunOptions(out=out, progress=False, resume=k > 0,
                                                wall_limit=0.0))
         saved = pickle.loads(ckpt.read_bytes())
-        times.append(saved["core"]["scalars"][0])
+        times.append(saved["backend"]["core"]["scalars"][0])
         if "inside a sample interval" in str(stopped.value):
             inside += 1
             assert saved["run"].samples * 0.5 < times[-1] < (saved["run"].samples + 1) * 0.5
     assert inside >= 2 and times == sorted(set(times))
-    parts = read_results(EdmdEngine().run(scene, RunOptions(out=out, progress=False,
+    parts = read_results(run_scene(scene, "edmd", RunOptions(out=out, progress=False,
                                                             resume=True)))
     for key, value in whole.timeseries.items():
         assert np.array_equal(value, parts.timeseries[key], equal_nan=True), key
@@ -611,7 +611,7 @@ def test_lees_edwards_tilt_follows_the_results_convention(tmp_path):
     [−L_x/2, L_x/2), as LAMMPS writes it (``flip yes``)."""
     scene = engine_scene({"shear": {"rate": 0.3}, "run.equilibration": 0.0,
                           "run.production": 6.0})
-    res = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "le.h5",
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "le.h5",
                                                           progress=False, keep_frames=True)))
     lx, ly = scene.box.size
     t, tilt = res.timeseries["time"], res.timeseries["tilt"]
@@ -625,13 +625,13 @@ def test_lees_edwards_tilt_follows_the_results_convention(tmp_path):
 def test_a_collision_count_that_cannot_be_reached_is_an_error(tmp_path):
     """run.unit = 'collisions' with particles at rest: no event is left, so the first sample's
     count can never be reached; the run says so instead of writing times of 1e300."""
-    from demstudy.engines.base import EngineError
+    from demstudy.errors import EngineError
 
     scene = engine_scene({"run.unit": "collisions", "run.equilibration": 0.0,
                           "run.production": 2.0, "run.sample_interval": 1.0,
                           "initial.velocity.temperature": 0.0})
     with pytest.raises(EngineError, match=r"after 0 pair collisions .* count \d+ cannot be"):
-        EdmdEngine().run(scene, RunOptions(out=tmp_path / "c.h5", progress=False))
+        run_scene(scene, "edmd", RunOptions(out=tmp_path / "c.h5", progress=False))
     assert not (tmp_path / "c.h5").exists()
 
 

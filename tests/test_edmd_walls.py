@@ -43,11 +43,11 @@ from edmd_helpers import (
 from edmd_helpers import engine_scene as base_engine_scene
 from scipy.spatial import cKDTree
 
-from demstudy.engines.base import RunOptions
-from demstudy.engines.edmd import EdmdEngine, EventDriven
+from demstudy.engines.edmd import EventDriven
 from demstudy.io.results import read_results
 from demstudy.scene import load_scene, parse_scene_text, validate_scene
 from demstudy.scene.initial import build_initial_state
+from demstudy.simulation import RunOptions, run_scene
 
 CHUTE_40 = "inputs/campbell1982/chute-40.toml"
 COUETTE = "inputs/campbell1982/couette-rough.toml"
@@ -439,7 +439,7 @@ def test_campbell_chute_40_runs_to_the_requested_time(tmp_path):
     """inputs/campbell1982/chute-40.toml with equilibration 10 and production 50 √(d/g)
     (measured: 4 s through the CLI)."""
     scene = load_scene(CHUTE_40, ["run.equilibration=10", "run.production=50"])
-    path = EdmdEngine().run(scene, RunOptions(out=tmp_path / "chute.h5", progress=False,
+    path = run_scene(scene, "edmd", RunOptions(out=tmp_path / "chute.h5", progress=False,
                                               keep_frames=True))
     res = read_results(path)
     ts = res.timeseries
@@ -541,7 +541,7 @@ def test_servo_at_high_stress_converges_to_sigma_n_within_2_percent(tmp_path):
             for key, value in (("normal_stress", SERVO_SIGMA), ("interval_unit", "time"),
                                ("clamp", "false"), ("gain", 0.025))]
     sets += ["run.equilibration=10000", "run.production=20000", "run.sample_interval=10"]
-    EdmdEngine().run(load_scene(COUETTE, sets), RunOptions(out=out, progress=False,
+    run_scene(load_scene(COUETTE, sets), "edmd", RunOptions(out=out, progress=False,
                                                             keep_frames=True))
     res = read_results(out)
     ts = res.timeseries
@@ -567,7 +567,7 @@ def test_time_interval_servo_without_clamp_holds_the_time_mean_stress(tmp_path):
             for key, value in (("interval_unit", "time"), ("clamp", "false"))]
     sets += ["run.equilibration=10000", "run.production=20000", "run.sample_interval=10"]
     scene = load_scene(COUETTE, sets)
-    EdmdEngine().run(scene, RunOptions(out=out, progress=False))
+    run_scene(scene, "edmd", RunOptions(out=out, progress=False))
     ts = read_results(out).timeseries
     production = ts["time"] > 10000.0
     for side, mean, err in wall_stress_ratios(ts, production, CAMPBELL_SIGMA_N):
@@ -669,7 +669,7 @@ def test_couette_stress_three_routes_agree(tmp_path):
     half the wall stress (0.040, 0.041: wall impulses, whose branch runs from the centre to the
     wall, are not binned; see the report)."""
     scene = validate_scene(parse_scene_text(COUETTE_SCENE))
-    path = EdmdEngine().run(scene, RunOptions(out=tmp_path / "c.h5", progress=False))
+    path = run_scene(scene, "edmd", RunOptions(out=tmp_path / "c.h5", progress=False))
     st = read_results(path).groups["stress"]
     pyy, err = st["total"][1:-1, 1, 1], st["total_err"][1:-1, 1, 1]
     wall = 0.5 * (st["wall_lower"][1] + st["wall_upper"][1])
@@ -697,7 +697,7 @@ def test_collision_counted_run_stops_at_the_requested_counts(walls, tmp_path):
         overrides.update({"walls": [{"side": "lower", "restitution": 0.9},
                                     {"side": "upper", "restitution": 0.9, "velocity": 1.0}]})
     scene = engine_scene(overrides)
-    res = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "u.h5",
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "u.h5",
                                                           progress=False)))
     n = build_initial_state(scene).mass.size
     ts = res.timeseries
@@ -753,14 +753,14 @@ def test_engine_resume_with_walls_gravity_and_servo_is_bit_identical(tmp_path):
 # ---- 9. absent effects leave no trace -----------------------------------------------------------
 
 def test_absent_effects_write_no_datasets(tmp_path):
-    plain = read_results(EdmdEngine().run(engine_scene(), RunOptions(
+    plain = read_results(run_scene(engine_scene(), "edmd", RunOptions(
         out=tmp_path / "plain.h5", progress=False)))
     assert "gravity_work" not in plain.timeseries
     assert not any(k.startswith(("wall_force_", "wall_work_")) for k in plain.timeseries)
     assert "collisions" not in plain.groups
     chute = load_scene(CHUTE_40, ["run.equilibration=0", "run.production=2",
                                   'measure.statistics=["profiles", "angles"]'])
-    full = read_results(EdmdEngine().run(chute, RunOptions(out=tmp_path / "chute.h5",
+    full = read_results(run_scene(chute, "edmd", RunOptions(out=tmp_path / "chute.h5",
                                                            progress=False)))
     assert "gravity_work" in full.timeseries and "wall_force_lower" in full.timeseries
     assert "wall_force_upper" not in full.timeseries
@@ -802,7 +802,7 @@ def test_chute_on_random_bumps_balances_energy_and_momentum(tmp_path):
     x-momentum balance P_x(t) − P_x(0) = M g sin α t + J_base,x (the base's impulse, bumps
     included, from the wall-force series) close to round-off; no disc overlaps a bump at any
     sample. (Regular bumps are refused under gravity: the bottom layer cages itself.)"""
-    from demstudy.decks.bumps import bump_rows
+    from demstudy.effects.bumps import bump_rows
 
     text = Path("inputs/campbell1982/chute-30.toml").read_text()
     text = text.replace('tangential = { model = "rough" }',
@@ -811,7 +811,7 @@ def test_chute_on_random_bumps_balances_energy_and_momentum(tmp_path):
     text = text.replace("equilibration = 200.0", "equilibration = 0.0", 1)
     scene = validate_scene(parse_scene_text(text.replace("production = 400.0",
                                                          "production = 20.0", 1)))
-    res = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "b.h5",
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "b.h5",
                                                           progress=False, keep_frames=True)))
     ts, n = res.timeseries, len(res.frames["position"][0])
     assert res.attrs["wall_collisions"] > 1000 and ts["time"][-1] == 20.0
@@ -851,8 +851,8 @@ def test_zero_time_collision_loop_stops_with_a_clear_error(monkeypatch):
     loop that takes no time (here a disc caged at zero gaps between two bumps). The engine's
     watched advance turns that hang into an EngineError naming the time and the cause, while
     an ordinary run with the same watch reaches its end."""
-    from demstudy.engines.base import EngineError
     from demstudy.engines.edmd import core
+    from demstudy.errors import EngineError
 
     stuck = caged_disc()
     assert not stuck.advance_to(1.0, max_events=20_000)  # the loop is real: time stays at 0

@@ -17,7 +17,7 @@ from scipy.integrate import quad
 from scipy.special import erf
 
 from demstudy.analysis.collisions import FreePath, flight_chunks, flight_length, free_flights
-from demstudy.analysis.suite import run_statistics
+from demstudy.analysis.registry import Context, compute_statistics
 from demstudy.cli import main
 from demstudy.io.results import Results
 from demstudy.scene import validate_scene
@@ -219,10 +219,10 @@ def test_freepath_refuses_sampled_logs_and_logs_without_indices():
     sampled = Results({}, groups={"collisions": log},
                       group_attrs={"collisions": {"log_every": 10}})
     with pytest.raises(ValueError, match="every collision"):
-        run_statistics(scene, lambda: iter(()), ["freepath"], sampled)
+        compute_statistics(["freepath"], Context(scene, results=sampled))
     old = Results({}, groups={"collisions": {k: v for k, v in log.items() if k not in "ij"}})
     with pytest.raises(ValueError, match="indices"):
-        run_statistics(scene, lambda: iter(()), ["freepath"], old)
+        compute_statistics(["freepath"], Context(scene, results=old))
 
 
 def dilute_moment_ratios() -> tuple[float, float]:

@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demstudy.decks.base import UnsupportedByEngine
-from demstudy.engines.base import EngineError, RunOptions
-from demstudy.engines.lammps import Driver, LammpsEngine, LammpsSession
+from demstudy.engines.lammps import LammpsSession
+from demstudy.errors import EngineError, UnsupportedByEngine
 from demstudy.io.results import read_results
 from demstudy.scene import load_scene, validate_scene
+from demstudy.simulation import RunOptions, Simulation, run_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
@@ -28,7 +28,7 @@ def chute(**run) -> object:
 
 
 def run(scene, tmp_path: Path, name: str = "run.h5", **options) -> object:
-    path = LammpsEngine().run(scene, RunOptions(out=tmp_path / name, progress=False, **options))
+    path = run_scene(scene, "lammps", RunOptions(out=tmp_path / name, progress=False, **options))
     return read_results(path)
 
 
@@ -36,15 +36,15 @@ def run_interrupted(scene, tmp_path: Path, name: str, monkeypatch, after: float,
                     **options) -> None:
     """Run until the first sample after time ``after``, then request a stop exactly as the
     SIGINT handler does (the driver stops at the end of the segment, after a checkpoint)."""
-    original = Driver._sample
+    original = Simulation._sample
 
-    def interrupt(self, session, state, production):
-        original(self, session, state, production)
-        if state.step * self.dt > after:
-            self._request_stop()
+    def interrupt(self, state, production):
+        original(self, state, production)
+        if self.backend.time > after:
+            self.stop.request()
 
     with monkeypatch.context() as patch:
-        patch.setattr(Driver, "_sample", interrupt)
+        patch.setattr(Simulation, "_sample", interrupt)
         with pytest.raises(EngineError, match="--resume"):
             run(scene, tmp_path, name, **options)
     assert not (tmp_path / name).exists()
@@ -86,7 +86,7 @@ def test_profiles_cover_every_particle(tmp_path):
 def test_in_memory_and_dump_profiles_agree(tmp_path, reader, rtol):
     """The dump holds every production sample at full precision: the numpy reader gives the
     in-memory profiles to round-off, MDAnalysis (single precision) to 1e-5."""
-    from demstudy.engines.lammps import profile_analysis
+    from demstudy.analysis.suite import profile_analysis
     from demstudy.io import dump as dumps
 
     scene = chute()
@@ -166,14 +166,14 @@ def test_a_checkpoint_cut_off_while_written_leaves_the_previous_pair(tmp_path, m
     pickle names its restart file), and ends where the uninterrupted run ends."""
     import errno
 
-    import demstudy.engines.lammps.driver as driver
+    import demstudy.simulation.loop as driver
 
     scene = rolling_pair()
     whole = run(scene, tmp_path, "whole.h5")
     original, calls = driver.pickle_atomically, []
 
     def full_disk_on_second(path, obj):
-        calls.append(obj["run"].step)
+        calls.append(obj["run"].samples)
         if len(calls) == 2:
             raise OSError(errno.ENOSPC, "No space left on device")
         original(path, obj)
@@ -237,7 +237,7 @@ def test_lammps_errors_name_the_deck_line(tmp_path):
 def test_unsupported_wall_rule_is_refused_before_lammps_starts(tmp_path):
     scene = load_scene(ROOT / "inputs" / "campbell1982" / "couette-noslip.toml")
     with pytest.raises(UnsupportedByEngine, match="campbell-noslip"):
-        LammpsEngine().run(scene, RunOptions(out=tmp_path / "x.h5", progress=False))
+        run_scene(scene, "lammps", RunOptions(out=tmp_path / "x.h5", progress=False))
     assert not (tmp_path / "x.lammps").exists()
 
 
@@ -264,8 +264,9 @@ def test_isolated_run_reports_failure_as_engine_error(tmp_path):
     scene = chute()
     bad = tmp_path / "not-a-dir"
     bad.write_text("a file where the results folder should be")
-    with pytest.raises((EngineError, OSError)):
-        LammpsEngine().run(scene, RunOptions(out=bad / "run.h5", progress=False, isolate=True))
+    # refused before the child starts (the output's folder is a file), or failing in it
+    with pytest.raises((EngineError, OSError, UnsupportedByEngine)):
+        run_scene(scene, "lammps", RunOptions(out=bad / "run.h5", progress=False, isolate=True))
 
 
 def test_mpi_two_ranks_with_dump_and_a_wall_clock_stop(tmp_path):

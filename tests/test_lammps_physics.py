@@ -11,15 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demstudy.engines.base import RunOptions
-from demstudy.engines.lammps import LammpsEngine
 from demstudy.io.results import read_results
 from demstudy.scene import validate_scene
+from demstudy.simulation import RunOptions, run_scene
 from demstudy.theory import haff_t0
 
 
 def run(scene, tmp_path: Path, **options):
-    return read_results(LammpsEngine().run(scene, RunOptions(out=tmp_path / "r.h5",
+    return read_results(run_scene(scene, "lammps", RunOptions(out=tmp_path / "r.h5",
                                                             progress=False, **options)))
 
 

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from demstudy import UNITS_NOTE
-from demstudy.engines.common import pickle_atomically
 from demstudy.io.results import Results, read_results, write_results
+from demstudy.simulation.checkpoint import pickle_atomically
 
 
 def results(scale: float) -> Results:

@@ -10,12 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demstudy.decks import build_deck
-from demstudy.decks.servo import ServoController
-from demstudy.engines.base import RunOptions
-from demstudy.engines.lammps import LammpsEngine
+from demstudy.effects.servo import ServoController
+from demstudy.engines.lammps.backend import servo_commands
+from demstudy.engines.lammps.deck import build_deck
 from demstudy.io.results import read_results
 from demstudy.scene import validate_scene
+from demstudy.simulation import RunOptions, run_scene
 
 SIGMA = 0.02
 
@@ -43,7 +43,7 @@ def couette(**changes) -> object:
 def test_update_rule_is_campbells_relaxation():
     """v ← ½ v ± gain · clamp(σ − σ_n, −σ_n, σ_n): outwards when pushed harder than σ_n."""
     scene = couette()
-    servo = ServoController(scene, dt=1e-3)
+    servo = ServoController(scene)
     width = scene.box.size[0]
     # upper wall pushed at 3 σ_n (clamped to +σ_n), lower wall at 0.5 σ_n
     servo.update(10.0, {"upper": -3 * SIGMA * width, "lower": 0.5 * SIGMA * width}, width)
@@ -56,8 +56,7 @@ def test_update_rule_is_campbells_relaxation():
     assert servo.walls["upper"].vy == pytest.approx(0.5 * v_up)  # memory ½, no excess
     assert servo.gap == pytest.approx(12.0 + 10 * (v_up - v_low), rel=1e-12)
     assert servo.width_rate == pytest.approx(0.4 * 0.5 * (v_up - v_low), rel=1e-12)
-    commands: list[str] = []
-    servo.apply(commands.append)
+    commands = servo_commands(servo, scene, 20.0)
     assert "fix servo_width all deform 1 x variable v_servo_dw v_servo_dw_rate remap none" in (
         commands)
     assert any(c.startswith("variable wall_upper_dy equal") for c in commands)
@@ -75,7 +74,7 @@ def test_servo_scene_deck_uses_moving_regions_and_static_scenes_do_not():
 
 def test_servo_walls_move_in_lammps_and_reach_the_stress(tmp_path: Path):
     scene = couette(measure={"keep_frames": True})
-    res = read_results(LammpsEngine().run(scene, RunOptions(out=tmp_path / "c.h5",
+    res = read_results(run_scene(scene, "lammps", RunOptions(out=tmp_path / "c.h5",
                                                            progress=False)))
     ts = res.timeseries
     gap, width, u_top = ts["gap"], ts["width"], ts["wall_velocity_upper"]

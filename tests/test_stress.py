@@ -22,11 +22,10 @@ from demstudy.analysis.stress import (
     kinetic_tensor,
     wall_stress,
 )
-from demstudy.engines.base import RunOptions
-from demstudy.engines.lammps import LammpsEngine
 from demstudy.io.frames import Frame
 from demstudy.io.results import read_results
 from demstudy.scene import validate_scene
+from demstudy.simulation import RunOptions, run_scene
 
 EDGES = np.array([0.0, 1.0, 2.0, 3.0])
 
@@ -168,7 +167,7 @@ def test_lammps_column_at_rest_carries_its_weight(tmp_path):
         "measure": {"bin_width": 0.25, "keep_frames": True, "statistics": ["profiles",
                                                                            "stress"]},
     })
-    res = read_results(LammpsEngine().run(scene, RunOptions(out=tmp_path / "r.h5",
+    res = read_results(run_scene(scene, "lammps", RunOptions(out=tmp_path / "r.h5",
                                                              progress=False)))
     st = res.groups["stress"]
     assert res.group_attrs["stress"]["contact_samples"] == 6
@@ -221,7 +220,7 @@ def test_lammps_couette_shear_stress_is_uniform_and_equals_the_walls(tmp_path):
         "soft": {"stiffness": 2e4, "steps_per_contact": 30},
         "measure": {"bin_width": 1.0, "statistics": ["profiles", "stress"]},
     })
-    res = read_results(LammpsEngine().run(scene, RunOptions(out=tmp_path / "c.h5",
+    res = read_results(run_scene(scene, "lammps", RunOptions(out=tmp_path / "c.h5",
                                                              progress=False)))
     st = res.groups["stress"]
     lower, upper = st["wall_lower"], st["wall_upper"]
@@ -263,13 +262,13 @@ def test_edmd_chute_three_stress_routes_agree(tmp_path):
     accelerates down the slope (it does not reach a steady state at 30°), so τ_xy needs
     Campbell's unsteady term ρνa (from the momentum change of each bin over production): with
     it the routes agree; without it the steady balance overstates τ_xy at the base."""
-    from demstudy.engines.edmd import EdmdEngine
     from demstudy.scene import load_scene
     from demstudy.scene.initial import build_initial_state
 
     chute = Path(__file__).resolve().parents[1] / "inputs/campbell1982/chute-30.toml"
-    scene = load_scene(chute, ["run.equilibration=50", "run.production=150"])
-    res = read_results(EdmdEngine().run(scene, RunOptions(out=tmp_path / "c.h5", progress=False)))
+    scene = load_scene(chute, ["run.equilibration=50", "run.production=150",
+                               'measure.statistics=["profiles", "stress"]'])
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "c.h5", progress=False)))
     st, prof, ts = res.groups["stress"], res.profiles, res.timeseries
     assert "unsteady" in res.group_attrs["stress"]["balance"]
     bed = np.asarray(prof["solid_fraction"]) > 0.1

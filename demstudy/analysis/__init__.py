@@ -1,79 +1,59 @@
 """Analyses of particle frames (dimensionless particle units: d = 1, m = 1).
 
-Requires the compiled extension ``demstudy._native`` (build with
-``pip install --no-build-isolation -e .`` at the repository root).
+Every statistic is registered by name in :mod:`demstudy.analysis.registry`; the classes and
+functions below are importable from here, loaded on first use (importing the package stays
+cheap: the engines' child processes import only what they run). The volume kernels need the
+compiled extension ``demstudy._native``.
 """
 
-from demstudy.analysis.base import AnalysisBase
-from demstudy.analysis.blocking import BlockAccumulator, blocking_curve, jackknife
-from demstudy.analysis.coarse_graining import CoarseGrainedProfiles, gaussian_kernel
-from demstudy.analysis.collisions import CollisionAngles, savage_jeffrey_projected
-from demstudy.analysis.pair_correlation import PairCorrelation, slab_shell_volume
-from demstudy.analysis.profiles import ProfileAnalysis
-from demstudy.analysis.stress import (
-    ContactStress,
-    branch_fractions,
-    branch_sums,
-    collisional_stress,
-    kinetic_tensor,
-    stress_results,
-    wall_stress,
-)
-from demstudy.analysis.vdf import (
-    VelocityDistribution,
-    folded_maxwellian,
-    velocity_distributions,
-)
-from demstudy.analysis.velocity_correlation import (
-    BinMeans,
-    OrientationalCorrelation,
-    VelocityCorrelation,
-    orientational_correlation,
-    velocity_correlations,
-)
-from demstudy.analysis.volumes import (
-    bin_overlaps,
-    bin_profile_sums,
-    disc_strip_area,
-    particle_volume,
-    profile_nvalues,
-    sphere_slab_volume,
-)
-from demstudy.analysis.waves import DensityWaves, classify_pattern
+from __future__ import annotations
 
-__all__ = [
-    "AnalysisBase",
-    "BinMeans",
-    "BlockAccumulator",
-    "CollisionAngles",
-    "ContactStress",
-    "CoarseGrainedProfiles",
-    "DensityWaves",
-    "OrientationalCorrelation",
-    "PairCorrelation",
-    "ProfileAnalysis",
-    "VelocityCorrelation",
-    "VelocityDistribution",
-    "bin_overlaps",
-    "bin_profile_sums",
-    "blocking_curve",
-    "branch_fractions",
-    "branch_sums",
-    "collisional_stress",
-    "classify_pattern",
-    "disc_strip_area",
-    "folded_maxwellian",
-    "gaussian_kernel",
-    "jackknife",
-    "kinetic_tensor",
-    "orientational_correlation",
-    "particle_volume",
-    "profile_nvalues",
-    "savage_jeffrey_projected",
-    "slab_shell_volume",
-    "sphere_slab_volume",
-    "stress_results",
-    "velocity_correlations",
-    "velocity_distributions",
-    "wall_stress",
-]
+import importlib
+from typing import Any
+
+#: public name -> the module of this package that defines it
+_WHERE = {
+    'AnalysisBase': 'base',
+    'BinMeans': 'velocity_correlation',
+    'BlockAccumulator': 'blocking',
+    'CoarseGrainedProfiles': 'coarse_graining',
+    'CollisionAngles': 'collisions',
+    'ContactStress': 'stress',
+    'DensityWaves': 'waves',
+    'OrientationalCorrelation': 'velocity_correlation',
+    'PairCorrelation': 'pair_correlation',
+    'ProfileAnalysis': 'profiles',
+    'VelocityCorrelation': 'velocity_correlation',
+    'VelocityDistribution': 'vdf',
+    'bin_overlaps': 'volumes',
+    'bin_profile_sums': 'volumes',
+    'blocking_curve': 'blocking',
+    'branch_fractions': 'stress',
+    'branch_sums': 'stress',
+    'classify_pattern': 'waves',
+    'collisional_stress': 'stress',
+    'disc_strip_area': 'volumes',
+    'folded_maxwellian': 'vdf',
+    'gaussian_kernel': 'coarse_graining',
+    'jackknife': 'blocking',
+    'kinetic_tensor': 'stress',
+    'orientational_correlation': 'velocity_correlation',
+    'particle_volume': 'volumes',
+    'profile_nvalues': 'volumes',
+    'savage_jeffrey_projected': 'collisions',
+    'slab_shell_volume': 'pair_correlation',
+    'sphere_slab_volume': 'volumes',
+    'stress_results': 'stress',
+    'velocity_correlations': 'velocity_correlation',
+    'velocity_distributions': 'vdf',
+    'wall_stress': 'stress',
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'demstudy.analysis' has no attribute {name!r}")
+    return getattr(importlib.import_module(f"demstudy.analysis.{module}"), name)

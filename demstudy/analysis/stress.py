@@ -42,6 +42,7 @@ from demstudy.analysis.base import bin_index
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
 
 __all__ = [
+    "CollisionalSums",
     "ContactStress",
     "branch_fractions",
     "branch_sums",
@@ -149,6 +150,26 @@ def collisional_stress(sums: ArrayLike, duration: ArrayLike, edges: ArrayLike,
     return est, err
 
 
+class CollisionalSums:
+    """Collisional stress of hard particles from the engine's cumulative per-bin sums of
+    −J_i ⊗ r_ij: the increments over the production sample intervals and their durations
+    (``collisional_stress`` turns them into the stress with a jackknife error)."""
+
+    def __init__(self) -> None:
+        self.chunks: list[np.ndarray] = []
+        self.durations: list[float] = []
+        self.last: np.ndarray | None = None
+
+    def add(self, sums: ArrayLike, span: float | None, cross_section: float = 0.0) -> None:
+        """The engine's sums now; ``span``: the production interval that ends here (None:
+        not in production, only the reference for the next increment)."""
+        sums = np.asarray(sums, float)
+        if span is not None and self.last is not None:
+            self.chunks.append(sums - self.last)
+            self.durations.append(span)
+        self.last = sums
+
+
 class ContactStress:
     """Contact stress profile of soft particles accumulated over samples.
 
@@ -167,6 +188,10 @@ class ContactStress:
     def add_sums(self, sums: ArrayLike, cross_section: float) -> None:
         vol = np.diff(self.edges)[:, None, None] * float(cross_section)
         self._acc.add(np.asarray(sums, float) / vol)
+
+    def add(self, sums: ArrayLike, span: float | None, cross_section: float) -> None:
+        """One production sample's sums (``span`` unused: contact sums are instantaneous)."""
+        self.add_sums(sums, cross_section)
 
     def add_contacts(self, y_i: ArrayLike, force: ArrayLike, branch: ArrayLike,
                      cross_section: float) -> None:

@@ -17,22 +17,13 @@ import numpy as np
 from ..io.frames import Frame
 from ..scene import Scene
 from .base import bin_edges
-from .coarse_graining import CoarseGrainedProfiles
-from .collisions import CollisionAngles, FreePath, collision_chunks, flight_chunks, free_flights
-from .derived import campbell_depth
-from .pair_correlation import PairCorrelation
 from .profiles import ProfileAnalysis
-from .stress import stress_results
-from .structure import StructureDistributions
-from .vdf import velocity_distributions
-from .velocity_correlation import orientational_correlation, velocity_correlations
-from .waves import DensityWaves
 
-#: Statistics ``demstudy analyze --what`` can compute from frames.
-AVAILABLE = ("profiles", "vdf", "gr", "structure", "angles", "freepath", "stress", "vcorr",
-             "lambda", "waves", "cgprofiles")
-#: Those that take Malik's cells (``z_cells``: fluctuations about y-bin × z-slab means).
-Z_CELLS = ("profiles", "vdf", "vcorr", "lambda")
+
+def periodic_lengths(scene: Scene) -> list[float]:
+    """The box lengths along the periodic axes."""
+    return [scene.box.size[i] for i, a in enumerate("xyz"[:scene.dimension])
+            if a in scene.periodic]
 
 
 def profile_bounds(scene: Scene) -> tuple[float, float, float]:
@@ -65,67 +56,6 @@ def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None,
                            z_cells=z_cells)
 
 
-def run_statistics(scene: Scene, frames: Callable[[], Iterable[Frame]],
-                   what: Iterable[str], results: Any = None,
-                   z_cells: int = 1) -> dict[str, tuple[dict, dict]]:
-    """``{name: (results, attrs)}`` for each requested statistic; ``frames`` returns a fresh
-    iterable each call (the velocity distributions read the frames twice). ``results``: the
-    source results file's content (:class:`~demstudy.io.results.Results`), needed by
-    ``angles`` (its ``/collisions`` log) and ``stress`` (its profiles and wall forces).
-    ``z_cells``: Malik's cells for the statistics in :data:`Z_CELLS` (3D only; 1 = bins)."""
-    if z_cells != 1 and scene.dimension != 3:
-        raise ValueError(f"--z-cells {z_cells}: Malik's cells split the y-bins along z, so "
-                         f"they need a 3D run (this one is {scene.dimension}D; use 1)")
-    if z_cells < 1:
-        raise ValueError(f"--z-cells {z_cells}: the number of z cells per y-bin must be >= 1")
-    what = list(what)
-    if z_cells != 1 and not set(what) & set(Z_CELLS):
-        raise ValueError(f"--z-cells {z_cells}: applies to {', '.join(Z_CELLS)}; none of them "
-                         f"is requested (--what {','.join(what)})")
-    out: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
-    lo, hi, period = profile_bounds(scene)
-    for name in what:
-        if name == "profiles":
-            ana = profile_analysis(scene, z_cells=z_cells).run(frames()).finish()
-        elif name == "vdf":
-            edges = bin_edges(lo, hi, scene.measure.bin_width)
-            ana = velocity_distributions(frames, dim=scene.dimension, edges=edges,
-                                         inertia_factor=scene.inertia_k, period=period,
-                                         image_velocity_shift=image_shift(scene, period),
-                                         z_cells=z_cells)
-        elif name == "gr":
-            periodic = [scene.box.size[i] for i, a in enumerate("xyz"[: scene.dimension])
-                        if a in scene.periodic]
-            # stay below half the shortest periodic length (no image counted twice)
-            r_max = min(5.0, 0.5 * min(periodic) - 0.05) if periodic else 5.0
-            ana = PairCorrelation(dim=scene.dimension, r_max=r_max, dr=0.05,
-                                  periodic_y=scene.y_periodic).run(frames()).finish()
-        elif name == "structure":  # Campbell's normal and parallel distributions
-            periodic = [scene.box.size[i] for i, a in enumerate("xyz"[: scene.dimension])
-                        if a != "y"]
-            r_max = min(4.0, 0.5 * min(periodic) - 0.05)
-            y_mid = 0.5 * (lo + hi)
-            ana = StructureDistributions(dim=scene.dimension, r_max=r_max, dr=0.08,
-                                         half_width=scene.measure.bin_width,
-                                         y_mid=y_mid).run(frames()).finish()
-        elif name == "angles":
-            ana = collision_angle_analysis(scene, results)
-        elif name == "freepath":
-            ana = free_path_analysis(scene, results)
-        elif name == "stress":
-            data, attrs = stress_from_results(scene, results)
-            out[name] = (data, attrs)
-            continue
-        elif name in ("vcorr", "lambda", "waves", "cgprofiles"):
-            ana = correlation_analysis(scene, frames, name,
-                                       z_cells if name in Z_CELLS else 1)
-        else:
-            raise ValueError(f"--what {name!r}: unknown statistic (allowed: "
-                             f"{', '.join(AVAILABLE)})")
-        out[name] = (ana.results, ana.attrs)
-    return out
-
-
 def _need_results(results: Any, name: str) -> Any:
     if results is None:
         raise ValueError(f"--what {name}: needs a results file (RUN.h5), not a dump")
@@ -142,9 +72,11 @@ def _collision_log(results: Any, name: str) -> tuple[Any, dict]:
     return res, log
 
 
-def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> CollisionAngles:
+def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
     """P(theta) per profile bin from the ``/collisions`` log of a results file (production
     only), with the Savage–Jeffrey overlay when the file's profiles use the same bins."""
+    from .collisions import CollisionAngles, collision_chunks
+
     res, log = _collision_log(results, "angles")
     lo, hi, _period = profile_bounds(scene)
     edges = res.profiles.get("edges")
@@ -158,12 +90,14 @@ def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> 
     return ana
 
 
-def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> FreePath:
+def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
     """Free paths and times per profile bin from the ``/collisions`` log (every collision
     needed: ``log_every`` = 1), radii from the scene's initial state, Kn with the wall gap
     (or the periodic height; an open top: Campbell's flow depth from the profiles), Enskog
     references when the file's profiles use the same bins."""
     from ..scene.initial import build_initial_state  # only this statistic needs the radii
+    from .collisions import FreePath, flight_chunks, free_flights
+    from .derived import campbell_depth
 
     res, log = _collision_log(results, "freepath")
     every = int(res.group_attrs.get("collisions", {}).get("log_every", 1))
@@ -236,6 +170,8 @@ def stress_from_results(scene: Scene, results: Any) -> tuple[dict, dict]:
     """The ``/stress`` datasets from a results file: kinetic (its profiles), wall stresses
     and momentum balance (its time series), plus the contact / collisional tensors the
     engine stored in ``/stress`` (carried over)."""
+    from .stress import stress_results
+
     res = _need_results(results, "stress")
     if not res.profiles:
         raise ValueError("--what stress: the results file has no /profiles")
@@ -247,11 +183,16 @@ def stress_from_results(scene: Scene, results: Any) -> tuple[dict, dict]:
                           contact=parts.get("contact"), collisional=parts.get("collisional"))
 
 
-def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], name: str,
+def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]] | None, name: str,
                          z_cells: int = 1) -> Any:
-    """vcorr / lambda (two passes: run-mean bin (``z_cells`` > 1: cell) velocities first) and
-    waves in bins of ``measure.bin_width`` along y; cgprofiles along ``measure.axis`` with
-    w = bin_width / 2 at points spaced bin_width / 2."""
+    """vcorr / lambda (two passes over ``frames``: run-mean bin (``z_cells`` > 1: cell)
+    velocities first) and, not yet run (``frames`` None), waves in bins of
+    ``measure.bin_width`` along y and cgprofiles along ``measure.axis`` with w = bin_width / 2
+    at points spaced bin_width / 2."""
+    from .coarse_graining import CoarseGrainedProfiles
+    from .velocity_correlation import orientational_correlation, velocity_correlations
+    from .waves import DensityWaves
+
     lo, hi, period = profile_bounds(scene)
     dim, shift = scene.dimension, image_shift(scene, period)
     if name == "cgprofiles":  # along measure.axis, like the profiles
@@ -259,7 +200,7 @@ def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], na
         return CoarseGrainedProfiles(width=0.5 * scene.measure.bin_width,
                                      axis=scene.measure.axis, lo=lo, hi=hi, dim=dim,
                                      period=period, image_velocity_shift=shift,
-                                     n_points=2 * n_bins).run(frames()).finish()
+                                     n_points=2 * n_bins)
     if scene.measure.axis != "y":  # the other statistics bin along y
         lo, hi = 0.0, scene.box.size[1]
     y_period = scene.box.size[1] if scene.y_periodic else 0.0
@@ -267,7 +208,7 @@ def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], na
     y_bins = {"dim": dim, "edges": edges, "period": y_period,
               "image_velocity_shift": scene.shear.rate * y_period if scene.shear else 0.0}
     if name == "vcorr":
-        periodic = [scene.box.size[i] for i, a in enumerate("xyz"[:dim]) if a in scene.periodic]
+        periodic = periodic_lengths(scene)
         r_max = min(5.0, 0.5 * min(periodic) - 0.05) if periodic else 5.0
         return velocity_correlations(frames, r_max=r_max, dr=0.1, z_cells=z_cells, **y_bins)
     if name == "lambda":
@@ -276,6 +217,5 @@ def correlation_analysis(scene: Scene, frames: Callable[[], Iterable[Frame]], na
         ranges: list[tuple[float, float] | None] = [None] * dim
         if not scene.y_periodic:  # where the centres can be: walls -/+ d/2
             ranges[1] = (lo + 0.5, hi - 0.5)
-        return DensityWaves(dim=dim, ranges=ranges, periodic_y=scene.y_periodic
-                            ).run(frames()).finish()
+        return DensityWaves(dim=dim, ranges=ranges, periodic_y=scene.y_periodic)
     raise ValueError(f"unknown statistic {name!r}")

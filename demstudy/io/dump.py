@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from .frames import Frame
+from .results import Results
 
 _BOUNDS = re.compile(rb"ITEM: BOX BOUNDS([^\n]*)\n([^\n]*)\n([^\n]*)\n([^\n]*)\n")
 
@@ -155,3 +156,28 @@ def read_dump_fast(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int
                 angular_velocity=np.ascontiguousarray(omega[:, 2:3] if dim == 2 else omega),
                 radius=data[:, col["radius"]].copy(), tilt=tilt,
             )
+
+
+def dump_source(path: str | Path, scene, dt: float | None, reader: str = "auto",
+                start: float = 0.0):
+    """(an empty ``Results`` naming the dump, a callable returning its frames) for
+    ``demstudy analyze DUMP``: ``dt`` the dump's time step (None: the scene's soft-contact
+    time step), ``reader`` "fast" (numpy, demstudy's column layout), "mdanalysis" or
+    "auto" (fast when the columns allow)."""
+    from ..contact.stiffness import contact_setup
+    from ..scene import scene_to_toml
+
+    path = Path(path)
+    dt = dt if dt is not None else contact_setup(scene).timestep
+    fast = reader == "fast" or (reader == "auto" and has_fast_columns(path))
+    read = read_dump_fast if fast else read_dump
+    results = Results({"engine": "dump", "source_format": "custom dump (id type radius x y z "
+                       "vx vy vz omegax omegay omegaz)",
+                       "engine_version": "numpy fast reader" if fast else "MDAnalysis",
+                       "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
+                       "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(path)})
+
+    def frames():
+        return read(path, scene.dimension, dt=dt, start_time=start)
+
+    return results, frames

@@ -29,15 +29,28 @@ from typing import Any
 
 from matplotlib.figure import Figure
 
-from .common import Run, missing_notice, save
+from ..analysis.registry import STATISTICS
+from .common import HOW_PLOT_ONLY, Run, missing_notice, save
 from .correlations import draw_gr, draw_lambda, draw_vcorr
 from .distributions import draw_angles, draw_freepath, draw_vdf
 from .profiles import draw_cooling, draw_eos, draw_profiles, draw_stress, reference_height
 from .waves import draw_waves
 
-#: the kinds, in the order ``--kind all`` draws them
-KINDS = ("profiles", "stress", "eos", "vdf", "angles", "freepath", "gr", "vcorr", "lambda",
-         "waves", "cooling")
+#: the drawing function of every kind; ``bins``: it takes the bins to draw
+DRAW: dict[str, tuple[Callable[..., Figure], bool]] = {
+    "profiles": (draw_profiles, False), "stress": (draw_stress, False),
+    "eos": (draw_eos, False), "vdf": (draw_vdf, True), "angles": (draw_angles, True),
+    "freepath": (draw_freepath, True), "gr": (draw_gr, True), "vcorr": (draw_vcorr, True),
+    "lambda": (draw_lambda, False), "waves": (draw_waves, False),
+    "cooling": (draw_cooling, False),
+}
+#: the kinds, in the order ``--kind all`` draws them: each registered statistic's figures
+#: (``demstudy.analysis.registry``), then those drawn from the time series
+KINDS = tuple(dict.fromkeys([k for s in STATISTICS.values() for k in s.plots] +
+                            list(HOW_PLOT_ONLY)))
+if set(KINDS) != set(DRAW):  # a statistic declares a figure nobody draws, or vice versa
+    raise ImportError(f"plot kinds out of step: registered {sorted(KINDS)}, drawn "
+                      f"{sorted(DRAW)}")
 
 __all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_cooling", "draw_eos", "draw_freepath",
            "draw_gr",
@@ -67,15 +80,10 @@ def draw(kind: str, runs: Sequence[Run], *, scaled: bool = False,
     """The Figure of ``kind`` for ``runs`` (each must hold the kind)."""
     if kind not in KINDS:
         raise ValueError(f"unknown plot kind {kind!r} (allowed: {', '.join(KINDS)})")
+    fn, takes_bins = DRAW[kind]
     if kind == "profiles":
-        return draw_profiles(runs, scaled=scaled)
-    if kind in ("stress", "eos", "lambda", "waves", "cooling"):
-        return {"stress": draw_stress, "eos": draw_eos, "lambda": draw_lambda,
-                "waves": draw_waves, "cooling": draw_cooling}[kind](runs)
-    fn: dict[str, Callable[..., Figure]] = {"vdf": draw_vdf, "angles": draw_angles,
-                                            "freepath": draw_freepath, "gr": draw_gr,
-                                            "vcorr": draw_vcorr}
-    return fn[kind](runs, bins=bins)
+        return fn(runs, scaled=scaled)
+    return fn(runs, bins=bins) if takes_bins else fn(runs)
 
 
 def output_path(out: str | Path | None, kind: str, several: bool) -> Path:

@@ -19,35 +19,51 @@ from matplotlib.figure import Figure
 
 from ..io.results import Results, read_results
 
-#: results-file groups holding each kind (first present wins)
-GROUPS = {
-    "stress": ("statistics/stress", "stress"),
-    "eos": ("statistics/stress", "stress"),
-    "vdf": ("statistics/vdf",),
-    "angles": ("statistics/angles",),
-    "freepath": ("statistics/freepath",),
-    "gr": ("statistics/gr",),
-    "vcorr": ("statistics/vcorr",),
-    "lambda": ("statistics/lambda",),
-    "waves": ("statistics/waves",),
-}
 #: a dataset that must be present for the kind to be drawable
 REQUIRED = {"stress": "total", "eos": "total", "vdf": "X", "angles": "p_text",
             "freepath": "p_lambda", "gr": "g",
             "vcorr": "C", "lambda": "lambda", "waves": "series_time"}
-#: how to obtain a missing kind ({file}: the results file's name)
-HOW = {"profiles": "add them with `demstudy analyze {file} --what profiles`",
-       "stress": "add it with measure.statistics = [\"stress\"] or "
-                 "`demstudy analyze {file} --what stress`",
-       "eos": "it needs /stress: measure.statistics = [\"stress\"] or "
-              "`demstudy analyze {file} --what stress`",
-       "angles": "add it with `demstudy analyze {file} --what angles`, which needs an "
-                 "event-driven run's /collisions log",
-       "freepath": "add it with `demstudy analyze {file} --what freepath`, which needs an "
-                   "event-driven run's /collisions log of every collision (log_every = 1)",
-       "lambda": "add it with `demstudy analyze {file} --what lambda`, 3D only",
-       "cooling": "Haff's law needs every axis periodic, no walls, gravity or shear, equal "
-                  "particles and a constant e < 1"}
+#: figures drawn from a run's time series and scene rather than from a statistic
+HOW_PLOT_ONLY = {"cooling": "Haff's law needs every axis periodic, no walls, gravity or "
+                            "shear, equal particles and a constant e < 1"}
+
+
+def statistic_of(kind: str) -> str:
+    """The registered statistic whose group a plot kind draws."""
+    from ..analysis.registry import STATISTICS
+
+    return next(name for name, stat in STATISTICS.items() if kind in stat.plots)
+
+
+def groups_of(kind: str) -> tuple[str, ...]:
+    """Results-file groups holding ``kind`` (first present wins): the statistic's group, and
+    the run's own top-level group of that name (``/stress``)."""
+    from ..analysis.registry import STATISTICS
+
+    name = statistic_of(kind)
+    run_group = STATISTICS[name].run_group
+    return (f"statistics/{name}",) + ((run_group,) if run_group else ())
+
+
+def how_to_get(kind: str) -> str:
+    """How to obtain a missing kind ({file}: the results file's name), from the registry."""
+    if kind in HOW_PLOT_ONLY:
+        return HOW_PLOT_ONLY[kind]
+    from ..analysis.registry import STATISTICS
+
+    name = statistic_of(kind)
+    stat = STATISTICS[name]
+    how = (f"add it with measure.statistics = [\"{name}\"] or "
+           f"`demstudy analyze {{file}} --what {name}`")
+    if stat.capability == "collision_log":
+        every = " of every collision (log_every = 1)" if name == "freepath" else ""
+        how += f", which needs an event-driven run's /collisions log{every}"
+    if stat.dims == (3,):
+        how += ", 3D only"
+    if stat.source == "frames":
+        how += " (from stored frames: --keep-frames)"
+    return how
+
 
 LINESTYLES = ("-", "--", ":", "-.")
 MARKERS = ("o", "s", "^", "v", "D", "P")
@@ -119,20 +135,20 @@ class Run:
             ts = self.results.timeseries
             ok = homogeneous_cooling(self.scene) and "kinetic_energy" in ts and "time" in ts
             return (ts, {}) if ok else None
-        for name in GROUPS[kind]:
+        for name in groups_of(kind):
             data = self.results.groups.get(name)
-            if data and REQUIRED[kind] in data:
+            if data and REQUIRED.get(kind, next(iter(data), "")) in data:
                 return data, self.results.group_attrs.get(name, {})
         return None
 
     def where(self, kind: str) -> str:
         if kind == "cooling":
             return "homogeneous cooling scene with /timeseries/kinetic_energy"
-        return "/profiles" if kind == "profiles" else " or ".join(f"/{g}" for g in GROUPS[kind])
+        return "/profiles" if kind == "profiles" else " or ".join(f"/{g}" for g in groups_of(kind))
 
 
 def missing_notice(run: Run, kind: str) -> str:
-    how = HOW.get(kind, "add it with `demstudy analyze {file} --what " + kind + "`")
+    how = how_to_get(kind)
     return (f"notice: {run.path}: no {run.where(kind)}: {kind} skipped "
             f"({how.format(file=run.path.name)})")
 

@@ -166,6 +166,9 @@ class Scene(StrictModel):
         if g is not None and g.direction is not None and len(g.direction) != dim:
             problems.append(f"gravity.direction = {g.direction}: needs {dim} components")
         problems += self._initial_problems()
+        from ..analysis.registry import scene_problems  # the statistics' own registry
+
+        problems += scene_problems(self)
         if self.run.sample_interval > self.run.production:
             problems.append(
                 f"run.sample_interval = {self.run.sample_interval}: longer than "

@@ -347,15 +347,14 @@ class Soft(StrictModel):
         return self
 
 
-#: Statistics the engines compute today (issue 4 extends the list).
-Statistic = Literal["profiles", "vdf", "gr", "structure", "angles", "stress", "vcorr",
-                    "lambda", "waves", "cgprofiles"]
-
-
 class Measure(StrictModel):
-    """What to measure: profiles along ``axis`` in bins of ``bin_width`` diameters."""
+    """What to measure: profiles along ``axis`` in bins of ``bin_width`` diameters, and the
+    ``statistics`` registered in :mod:`demstudy.analysis.registry` (``demstudy analyze
+    --help`` lists them). Each named statistic ends in the results file: the run feeds it,
+    or keeps the frames or the collision log it needs; one the scene or the engine cannot
+    supply is refused before anything runs. ``keep_frames`` stores every production frame."""
 
     axis: Axis = "y"
     bin_width: PositiveFloat = 1.0
-    statistics: list[Statistic] = ["profiles"]
+    statistics: list[str] = ["profiles"]
     keep_frames: bool = False

@@ -31,18 +31,13 @@ impulse). ``DEFAULT_TC`` = 1e-5 time units (the engine's default; 0 disables the
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from collections.abc import Callable
 
 import numpy as np
 
 from ..._native import EventDriven, edmd_collide_pair
-from ...decks.base import UnsupportedByEngine
-from ...decks.bumps import bump_rows
-from ...scene import Scene
+from ...errors import EngineError
 from ...scene.initial import InitialState
-from ..base import EngineError
 
 DEFAULT_TC = 1e-5
 # events between two synchronisations and checks for a stop request; the simulated time's
@@ -51,7 +46,7 @@ STALL_CHUNK = 10_000_000
 STALL_CHUNK_PER_PARTICLE = 1000
 
 __all__ = ["DEFAULT_TC", "STALL_CHUNK", "EventDriven", "advance_watched", "collide_pair",
-           "from_initial_state", "scene_parameters", "with_bumps", "y_range"]
+           "from_initial_state"]
 
 
 def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
@@ -60,109 +55,6 @@ def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
     n3, vi3, vj3, wi3, wj3 = as3
     return edmd_collide_pair(n3, float(ri), float(rj), float(mi), float(mj), float(inertia_k),
                              float(e), float(beta), vi3, vj3, wi3, wj3)
-
-
-def _rule(restitution: float, rule, law=None, gravity: float | None = None,
-          who: str = "contact") -> dict:
-    """Collision-rule options of the core from a scene's restitution, tangential rule and law."""
-    out: dict = {"e": float(restitution)}
-    if rule.model == "coulomb":
-        out.update(tangential="coulomb", mu=float(rule.mu), beta0=float(rule.beta0))
-    elif rule.model == "campbell-noslip":
-        out.update(tangential="noslip")
-    else:
-        out.update(tangential="beta", beta=float(rule.beta))
-    if law is not None and law.model == "campbell-exp":
-        if gravity is None:
-            raise UnsupportedByEngine("edmd", f"{who}.law.model", law.model,
-                                      "Campbell's e(v) = ½[1 + exp(−3v/√(gR))] needs gravity "
-                                      "(its speed scale is √(gR))")
-        # e(v) = ½[1 + exp(−v/speed)], speed = √(g R)/3 with R = ½
-        out.update(law="campbell-exp", speed=math.sqrt(gravity * 0.5) / 3.0)
-    elif law is not None and law.model == "gutt-piecewise":
-        out.update(law="gutt-piecewise", e1=float(law.e1), e2=float(law.e2),
-                   crossover_speed=float(law.crossover_speed))
-    return out
-
-
-def scene_parameters(scene: Scene) -> dict:
-    """e, β and K of a scene's pair collisions plus every other core option the scene needs
-    (gravity, Lees–Edwards, walls, cell range along a bounded y)."""
-    contact = scene.contact
-    g = scene.gravity.magnitude if scene.gravity is not None else None
-    pair = _rule(contact.restitution, contact.tangential, contact.law, g)
-    params: dict = {"e": pair.pop("e"), "beta": float(pair.get("beta", -1.0)),
-                    "inertia_k": float(scene.inertia_k)}
-    if pair != {"tangential": "beta", "beta": params["beta"]}:
-        params["pair"] = pair
-    if scene.gravity_vector is not None:
-        params["gravity"] = [float(c) for c in scene.gravity_vector]
-    if scene.shear is not None:
-        params["shear_rate"] = float(scene.shear.rate)
-    if not scene.y_periodic:
-        walls = []
-        for wall in scene.walls:
-            if (wall.kind == "bumpy" and scene.gravity is not None
-                    and wall.bumps.pattern != "random"):
-                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].bumps.pattern",
-                                          wall.bumps.pattern,
-                                          "under gravity the event-driven engine needs "
-                                          "pattern = 'random': on regular bumps the bottom "
-                                          "layer settles into the hollows at exactly zero "
-                                          "gaps and the hard particles' collisions loop "
-                                          "without time passing (a stall); use random bumps, "
-                                          "a flat wall with a rough rule, or LAMMPS")
-            if wall.kind == "bumpy" and wall.servo is not None:
-                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].servo", "servo",
-                                          "a bumpy wall cannot be servo-controlled")
-            if wall.kind == "bumpy" and wall.tangential.model == "campbell-noslip":
-                raise UnsupportedByEngine("edmd", f"walls[{wall.side}].tangential.model",
-                                          wall.tangential.model,
-                                          "bumps collide as particles: use beta, rough or "
-                                          "coulomb")
-            rule = _rule(wall.restitution, wall.tangential, who=f"walls[{wall.side}]")
-            walls.append({"side": wall.side, "position": scene.wall_position(wall.side),
-                          "velocity": float(wall.velocity), **rule})
-        params.update(periodic_y=False, walls=walls)
-    return params
-
-
-def with_bumps(scene: Scene, state: InitialState) -> tuple[InitialState, np.ndarray]:
-    """The initial state with every bumpy wall's bumps appended (``decks.bumps.bump_rows``:
-    the same layout LAMMPS uses), and the core's ``fixed`` codes (0 mobile, 1 lower wall's
-    bump, 2 upper wall's). Bumps move with their wall's velocity along x; the flat plane of a
-    bumpy wall stays as a backstop with the same rule."""
-    rows = bump_rows(scene)
-    fixed = np.zeros(len(state.diameter), np.int8)
-    if not rows:
-        return state, fixed
-    dim = scene.dimension
-    pos, vel, omega = [state.position], [state.velocity], [state.angular_velocity]
-    diam, codes = [state.diameter], [fixed]
-    for row in rows:
-        n = len(row.centres)
-        v = np.zeros((n, dim))
-        v[:, 0] = scene.wall(row.side).velocity
-        pos.append(row.centres)
-        vel.append(v)
-        omega.append(np.zeros((n, state.angular_velocity.shape[1])))
-        diam.append(np.full(n, row.diameter))
-        codes.append(np.full(n, 1 if row.side == "lower" else 2, np.int8))
-    full = dataclasses.replace(state, position=np.concatenate(pos), velocity=np.concatenate(vel),
-                               angular_velocity=np.concatenate(omega),
-                               diameter=np.concatenate(diam))
-    return full, np.concatenate(codes)
-
-
-def y_range(scene: Scene, positions: np.ndarray) -> tuple[float, float]:
-    """Extent of the cell grid along a bounded y: from the lower wall (or the lowest particle)
-    to the upper wall (or the top of the box or the highest particle); the first and last
-    rows are open-ended, so walls that move out and particles that fly off stay covered."""
-    y = positions[:, 1]
-    lo = scene.wall_position("lower") if scene.wall("lower") else float(y.min()) - 1.0
-    hi = scene.wall_position("upper") if scene.wall("upper") else \
-        max(scene.box.size[1], float(y.max()) + 1.0)
-    return lo, hi
 
 
 def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -1.0,

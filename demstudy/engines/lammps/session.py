@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._lammps import open_lammps, preload_mpi
-from ..base import EngineError
+from ...errors import EngineError
+from .library import open_lammps, preload_mpi
 
 # MPICH ABI handles (the runtime is the `mpich` wheel's): MPI_COMM_WORLD, MPI_INT, MPI_MAX
 _MPI_COMM_WORLD, _MPI_INT, _MPI_MAX = 0x44000000, 0x4C000405, 0x58000001

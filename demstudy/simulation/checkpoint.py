@@ -1,33 +1,22 @@
-"""Bookkeeping every engine shares: stored frames, stop requests, checkpoints, result attrs.
+"""Checkpoints: written atomically, refused when they cannot continue this run.
 
-Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. A checkpoint is one
+pickle in the run's work folder (``checkpoint.pkl``): the scene, the version of the code
+that wrote it, the output it belongs to, the loop's state and the engine's state. A resumed
+run continues only with the code and the scene that wrote it.
 """
 
 from __future__ import annotations
 
 import pickle
-import signal
-import threading
-import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from ..analysis.steady import energy_trend, is_steady
-from ..io.frames import Frame
+from ..errors import EngineError
 from ..io.results import write_atomically
 from ..scene import Scene, scene_to_toml
 
-FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
-
-
-def keep_frame(frames: dict[str, list], frame: Frame) -> None:
-    """Append one frame to the ``/frames`` lists (copies: engines reuse their buffers)."""
-    for key in FRAME_ARRAYS:
-        frames.setdefault(key, []).append(np.array(getattr(frame, key)))
-    frames.setdefault("time", []).append(frame.time)
-    frames.setdefault("tilt", []).append(frame.tilt)
+CHECKPOINT = "checkpoint.pkl"
 
 
 def pickle_atomically(path: Path, obj: Any) -> None:
@@ -42,8 +31,6 @@ def load_checkpoint(path: Path, scene: Scene, keys: set[str], version: str,
     naming the file) when missing, unreadable, without the ``keys`` the engine needs (besides
     ``scene``), written by another ``version`` (a checkpoint continues only with the code that
     wrote it) or for a scene other than ``scene`` (naming the keys that differ)."""
-    from .base import EngineError  # noqa: PLC0415
-
     if not path.exists():
         raise EngineError(f"--resume: no checkpoint in {path.parent}")
     try:
@@ -90,51 +77,16 @@ def scene_difference(saved_toml: str, scene: Scene, most: int = 3) -> str:
     return "; ".join(diffs[:most]) + more
 
 
-def run_attrs(scene: Scene, engine: str, version: str, wall_seconds: float,
-              equilibration_end: float, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
-    """Root attributes every results file carries, with Campbell's steadiness verdict over the
-    production samples (those after ``equilibration_end``)."""
-    t = timeseries["time"]
-    production = t > equilibration_end + 1e-9 * max(1.0, abs(equilibration_end))
-    trend = energy_trend(t[production], timeseries["kinetic_energy"][production])
-    return {
-        "engine": engine,
-        "engine_version": version,
-        "scene_toml": scene_to_toml(scene),
-        "scene_name": scene.meta.name,
-        "seed": scene.run.seed,
-        "wall_seconds": wall_seconds,
-        "equilibration_end": equilibration_end,
-        "kinetic_energy_trend": trend,
-        "steady": is_steady(trend),
-    }
-
-
-class StopRequest:
-    """Ctrl-C (SIGINT, main thread only) or a wall-clock limit asks the run loop to stop at
-    the end of its current segment; ``with StopRequest(limit) as stop: … stop.reason``."""
-
-    def __init__(self, wall_limit: float | None):
-        self.wall_limit = wall_limit
-        self.reason: str | None = None
-        self.started = time.perf_counter()
-        self._previous = None
-
-    def request(self, _signum=None, _frame=None) -> None:
-        self.reason = self.reason or "interrupted"
-
-    def check(self) -> bool:
-        """True once a stop was asked for (checks the wall-clock limit too)."""
-        elapsed = time.perf_counter() - self.started
-        if self.wall_limit is not None and elapsed > self.wall_limit:
-            self.reason = self.reason or "wall-clock limit"
-        return self.reason is not None
-
-    def __enter__(self) -> StopRequest:
-        if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self.request)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
+def refuse_foreign_checkpoint(path: Path, out: Path) -> None:
+    """Outputs that differ only in their suffix share a work folder: a fresh run must not
+    delete the checkpoint another output's interrupted run left there."""
+    if not path.exists():
+        return
+    try:
+        with open(path, "rb") as fh:
+            other = pickle.load(fh).get("out")
+    except Exception:  # unreadable: a fresh run replaces it
+        return
+    if other is not None and other != str(out):
+        raise EngineError(f"{path.parent} holds the checkpoint of the interrupted run "
+                          f"writing {other}: resume that run first, or remove the folder")

@@ -1,9 +1,8 @@
-"""Bumpy walls: rows (2D) or square grids (3D) of heavy particles that move with their wall.
+"""Bumpy walls: the geometry of the bumps, the same in every engine.
 
-Dimensionless particle units: d = 1, m = 1. Each bumpy wall owns an atom type and a group
-(type 2 for the first bumpy wall, 3 for the second), so each collides with its own wall rule
-and moves with its own wall. Bumps are 1e6 times heavier than a particle of their size, so the
-pair contact sees m_eff = m to 1 part in 1e6, and ``fix move`` prescribes their motion.
+Dimensionless particle units: d = 1, m = 1. A bumpy wall carries a row (2D) or square grid
+(3D) of fixed particles centred on its plane, moving with the wall along x; ``random`` bumps
+stand up to a quarter diameter proud of the plane (seeded from ``run.seed``).
 """
 
 from __future__ import annotations
@@ -15,33 +14,18 @@ import numpy as np
 from ..scene import Scene
 from ..scene.schema import Wall
 
-MASS_FACTOR = 1e6
+__all__ = ["BumpRow", "bump_padding", "bump_rows", "bumpy_walls"]
 
 
 @dataclass(frozen=True)
 class BumpRow:
     side: str
-    atom_type: int
     centres: np.ndarray  # (n, dim)
     diameter: float
-
-    @property
-    def group(self) -> str:
-        return bump_group(self.side)
-
-
-def bump_group(side: str) -> str:
-    """LAMMPS group (and ID prefix) of one wall's bumps."""
-    return f"bumps_{side}"
 
 
 def bumpy_walls(scene: Scene) -> list[Wall]:
     return [w for w in scene.walls if w.kind == "bumpy"]
-
-
-def bump_type(scene: Scene, side: str) -> int:
-    sides = [w.side for w in bumpy_walls(scene)]
-    return 2 + sides.index(side)
 
 
 def bump_rows(scene: Scene) -> list[BumpRow]:
@@ -64,14 +48,10 @@ def bump_rows(scene: Scene) -> list[BumpRow]:
         if b.pattern == "random":
             sign = 1.0 if wall.side == "lower" else -1.0
             pts[:, 1] += sign * rng.uniform(0.0, 0.25 * b.diameter, len(pts))
-        rows.append(BumpRow(wall.side, bump_type(scene, wall.side), pts, b.diameter))
+        rows.append(BumpRow(wall.side, pts, b.diameter))
     return rows
 
 
 def bump_padding(scene: Scene) -> float:
-    """How far bumps reach beyond their wall plane (the data file's box must hold them)."""
+    """How far bumps reach beyond their wall plane."""
     return max((w.bumps.diameter * 0.5 + 1e-3 for w in bumpy_walls(scene)), default=0.0)
-
-
-def n_atom_types(scene: Scene) -> int:
-    return 1 + len(bumpy_walls(scene))

@@ -1,9 +1,10 @@
-"""Run any engine in a child process (on MPI ranks when asked), so that a crash in compiled
+"""Run a simulation in a child process (on MPI ranks when asked), so that a crash in compiled
 code (a segfault, an MPI abort) ends the child and reaches the caller as an ``EngineError``.
 
-``python -m demstudy.engines.child JOB.json`` is the child's entry point: exit 0 when done,
-3 when it stopped after a checkpoint (Ctrl-C or the wall-clock limit), 1 on an engine error.
-Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+``python -m demstudy.simulation.isolation JOB.json`` is the child's entry point: exit 0 when
+done, 2 when the engine refused the run, 3 when it stopped after a checkpoint (Ctrl-C or the
+wall-clock limit), 1 on an engine error. Dimensionless particle units: d = 1, m = 1, g = 1
+when gravity acts.
 """
 
 from __future__ import annotations
@@ -16,26 +17,29 @@ import sys
 from pathlib import Path
 
 from .. import UNITS_NOTE
-from .._lammps import mpirun_executable
-from ..scene import Scene, validate_scene
-from .base import EngineError, RunOptions, RunRefused, RunStopped, work_folder
+from ..errors import EngineError, RunRefused, RunStopped
+from ..scene import Scene
+from .options import RunOptions, work_folder
 
 WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
 FAILED, REFUSED, STOPPED = 1, 2, 3  # the child's exit codes
+
+__all__ = ["in_worker", "launch_child"]
 
 
 def in_worker() -> bool:
     return os.environ.get(WORKER_FLAG) == "1"
 
 
-def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
-    """Run ``engine`` on ``scene`` in a child process (``mpirun -np N`` when np > 1).
+def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
+    """Run ``scene`` in ``backend`` (a registered backend class) in a child process, started
+    by the backend's launcher (``mpirun -np N``) when np > 1.
 
     Ctrl-C reaches the child too, which stops at the end of its current segment after a
     checkpoint; the caller then waits for it rather than killing it."""
     payload = {
         "units": UNITS_NOTE,
-        "engine": engine,
+        "engine": backend.name,
         "scene": scene.model_dump(mode="json"),
         "out": str(Path(options.out).resolve()),
         "dump": str(Path(options.dump).resolve()) if options.dump else None,
@@ -52,15 +56,15 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
     job = out.with_name(f".{out.name}.job.json")
     job.write_text(json.dumps(payload))
     env = dict(os.environ, **{WORKER_FLAG: "1"})
-    cmd = [sys.executable, "-m", "demstudy.engines.child", str(job)]
+    cmd = [sys.executable, "-m", "demstudy.simulation.isolation", str(job)]
     if options.np > 1:
-        cmd = [mpirun_executable(), "-np", str(options.np), *cmd]
+        cmd = [*backend.launcher(options.np), *cmd]
     proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL,
                             preexec_fn=_die_with_parent if sys.platform == "linux" else None)
     try:
         returncode = proc.wait()
     except KeyboardInterrupt:
-        print(f"\n{engine}: stopping after the current segment and a checkpoint "
+        print(f"\n{backend.name}: stopping after the current segment and a checkpoint "
               "(Ctrl-C again aborts without one)", file=sys.stderr, flush=True)
         try:
             returncode = proc.wait(timeout=300)
@@ -73,15 +77,15 @@ def launch_child(engine: str, scene: Scene, options: RunOptions) -> Path:
         raise RunStopped("the run stopped after writing a checkpoint: run the same command "
                          "again with --resume to continue")
     if returncode == REFUSED:
-        raise RunRefused(f"the {engine} engine refused the run (see the message above)")
+        raise RunRefused(f"the {backend.name} engine refused the run (see the message above)")
     if returncode != 0:
         how = ("was interrupted" if returncode == -signal.SIGINT
                else f"was killed by signal {-returncode}" if returncode < 0
                else f"failed (exit {returncode})")
-        log_file = work_folder(out, engine) / "log.lammps"
-        log = f" and {log_file}" if engine == "lammps" and log_file.exists() else ""
-        raise EngineError(f"the {engine} run on {options.np} rank(s) {how}; see the messages "
-                          f"above{log}")
+        log_file = backend.log_file(work_folder(out, backend.name))
+        log = f" and {log_file}" if log_file is not None and log_file.exists() else ""
+        raise EngineError(f"the {backend.name} run on {options.np} rank(s) {how}; see the "
+                          f"messages above{log}")
     return out
 
 
@@ -94,7 +98,11 @@ def _die_with_parent() -> None:
 
 
 def worker(job: str) -> int:
-    from .base import get_engine  # noqa: PLC0415 - the engines import this module
+    from ..engines import get_backend
+    from ..errors import UnsupportedByEngine
+    from ..scene import validate_scene
+    from ..scene.load import SceneError
+    from .loop import Simulation
 
     payload = json.loads(Path(job).read_text())
     scene = validate_scene(payload["scene"], source=job)
@@ -104,11 +112,8 @@ def worker(job: str) -> int:
                          keep_frames=payload["keep_frames"],
                          checkpoint_interval=payload["checkpoint_interval"],
                          wall_limit=payload["wall_limit"], extra=payload["extra"])
-    from ..decks.base import UnsupportedByEngine  # noqa: PLC0415
-    from ..scene.load import SceneError  # noqa: PLC0415
-
     try:
-        get_engine(payload["engine"]).run(scene, options)
+        Simulation(scene, get_backend(payload["engine"]), options).run()
     except RunStopped:
         return STOPPED  # the parent says so, once
     except (UnsupportedByEngine, SceneError) as exc:  # refused before anything ran

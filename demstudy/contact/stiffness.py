@@ -1,4 +1,5 @@
-"""Contact model of a scene: pair and wall parameters, stiffness and time step.
+"""Soft contacts of a scene: pair and wall parameters, stiffness and time step, for every
+soft-contact engine.
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise the wall speed
 or shear rate sets the time unit τ). k_n is a force per length, m/τ², for Hooke contacts and a
@@ -11,11 +12,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..contact import mapping
+from ..errors import UnsupportedByEngine
 from ..scene import Scene
 from ..scene.schema import Wall
-from .base import Block, UnsupportedByEngine
-from .bumps import bump_type, bumpy_walls
+from . import mapping
 
 #: Default hardness: at most this overlap (in d) at the reference speed.
 DEFAULT_OVERLAP = 0.005
@@ -45,20 +45,18 @@ class ContactSetup:
     kn: float
 
 
-def _rule(rule) -> dict:
+def _rule(rule, engine: str) -> dict:
     """make_contact's arguments for a tangential rule (smooth, beta and rough all carry β)."""
     if rule.model == "coulomb":
         return {"mu": rule.mu, "beta0": rule.beta0}
     if rule.model != "campbell-noslip":
         return {"beta": rule.beta}
-    raise UnsupportedByEngine(
-        "lammps", "walls.tangential.model", rule.model,
-        "Campbell's no-slip wall (centre takes the wall velocity, spin unchanged) has no "
-        "soft-contact equivalent; use model = 'rough' or run it with --engine edmd",
-    )
+    raise UnsupportedByEngine(engine, "walls.tangential.model", rule.model,
+                              "Campbell's no-slip wall has no soft-contact equivalent")
 
 
-def choose_stiffness(scene: Scene, e: float, m_eff: float) -> float:
+def choose_stiffness(scene: Scene, e: float, m_eff: float,
+                     engine: str = "soft contacts") -> float:
     """k_n from ``soft.stiffness``, a hardness target, or by default an overlap of
     DEFAULT_OVERLAP at the reference speed (Hooke: force/length; Hertz: force/length^3/2)."""
     soft = scene.soft
@@ -71,12 +69,12 @@ def choose_stiffness(scene: Scene, e: float, m_eff: float) -> float:
     elif h is not None:
         if soft.model == "hertz":
             raise UnsupportedByEngine(
-                "lammps", "soft.hardness", h.model_dump(exclude_none=True),
+                engine, "soft.hardness", h.model_dump(exclude_none=True),
                 "k* and κ define a Hooke stiffness; for Hertz give overlap and impact_speed",
             )
         if h.k_star is not None:
             if scene.shear is None:
-                raise UnsupportedByEngine("lammps", "soft.hardness.k_star", h.k_star,
+                raise UnsupportedByEngine(engine, "soft.hardness.k_star", h.k_star,
                                           "k* = k/(ρ d³ γ̇²) needs a shear rate ([shear])")
             return mapping.kn_from_kstar(h.k_star, scene.shear.rate, 1.0, scene.dimension)
         return mapping.kn_from_kappa(h.kappa, h.pressure, scene.dimension)
@@ -97,54 +95,24 @@ def shortest_contact_time(scene: Scene, kn: float, speed: float) -> float:
     return min(mapping.hooke_contact(kn, e, m).contact_time for e, m, _ in cases)
 
 
-def contact_setup(scene: Scene) -> ContactSetup:
-    """Pair (m_eff = m/2) and per-wall (m_eff = m) contacts with a common time step."""
-    if scene.contact.law.model != "constant":
-        raise UnsupportedByEngine(
-            "lammps", "contact.law.model", scene.contact.law.model,
-            "LAMMPS granular contacts have a constant restitution; use --engine edmd",
-        )
+def contact_setup(scene: Scene, engine: str = "soft contacts") -> ContactSetup:
+    """Pair (m_eff = m/2) and per-wall (m_eff = m) contacts with a common time step;
+    ``engine`` names the soft-contact engine in refusals (a hardness target that defines no
+    stiffness for the contact model)."""
     K, e, model = scene.inertia_k, scene.contact.restitution, scene.soft.model
-    kn = choose_stiffness(scene, e, 0.5)
+    kn = choose_stiffness(scene, e, 0.5, engine)
     speed = reference_speed(scene)
     if scene.soft.hardness is not None and scene.soft.hardness.impact_speed is not None:
         speed = max(speed, scene.soft.hardness.impact_speed)  # Hertz t_c shrinks with speed
     extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
-    lammps_k = (0.5, 0.4) if scene.dimension == 2 else (0.4,)
-    if scene.rotation_matters and not any(abs(K - k) < 1e-12 for k in lammps_k):
-        raise UnsupportedByEngine(
-            "lammps", "particles.inertia", scene.particles.inertia,
-            f"LAMMPS fixes the moment of inertia: K = 4I/(m d²) must be one of {lammps_k} in "
-            f"{scene.dimension}D (disc 1/2, sphere 2/5) when contacts are rough",
-        )
     pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
-                                **_rule(scene.contact.tangential), **extra)
-    walls = {w.side: _wall_contact(w, kn, K, model, speed) for w in scene.walls}
+                                **_rule(scene.contact.tangential, engine), **extra)
+    walls = {w.side: _wall_contact(w, kn, K, model, speed, engine) for w in scene.walls}
     dt = mapping.timestep(shortest_contact_time(scene, kn, speed), scene.soft.steps_per_contact)
     return ContactSetup(pair, walls, dt, kn)
 
 
-def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float):
+def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float, engine: str):
     extra = {"r_eff": 0.5, "speed": speed} if model == "hertz" else {}
     return mapping.make_contact(kn=kn, e=wall.restitution, m_eff=1.0, K=K, model=model,
-                                **_rule(wall.tangential), **extra)
-
-
-def pair_block(scene: Scene, setup: ContactSetup) -> Block:
-    p = setup.pair
-    cmds = ["pair_style granular", f"pair_coeff * * {p.granular_args()}"]
-    bumpy = bumpy_walls(scene)
-    for wall in bumpy:
-        # each wall's bumps collide with that wall's rule, with m_eff = m (they are heavy)
-        kind = bump_type(scene, wall.side)
-        cmds.append(f"pair_coeff 1 {kind} {setup.walls[wall.side].granular_args()}")
-    types = [bump_type(scene, w.side) for w in bumpy]
-    for i, a in enumerate(types):  # bumps never interact with bumps
-        cmds += [f"neigh_modify exclude type {a} {b}" for b in types[i:]]
-    cmds += ["neighbor 0.3 bin", "neigh_modify delay 0 every 1 check yes"]
-    comment = (
-        f"{p.model} contacts, k_n = {p.kn:.6g}, e = {p.restitution:g}, "
-        f"t_c = {p.contact_time:.6g} (m_eff = m/2)"
-        + ("" if p.tangential == "none" else f", k_t = {p.kt:.6g}, {p.tangential} tangential")
-    )
-    return Block("contact", comment, cmds)
+                                **_rule(wall.tangential, engine), **extra)

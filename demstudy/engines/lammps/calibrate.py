@@ -1,7 +1,7 @@
 """Measure e, beta and contact time of LAMMPS ``granular`` contacts from isolated collisions.
 
 Units: dimensionless particle units, diameter d = 1, mass m = 1 (g = 1 on the incline).
-Each collision is a fresh LAMMPS instance (opened with ``demstudy._lammps.open_lammps``) holding
+Each collision is a fresh LAMMPS instance (opened with ``open_lammps``) holding
 two equal particles (``kind='pair'``) or one particle above a ``wall/gran granular`` plane
 (``kind='wall'``), stepped one step at a time. Contact-point relative velocities
 ``g = v_i - v_j - (R_i w_i + R_j w_j) x n`` (wall: ``v_i - R w_i x n``) are projected on the
@@ -20,8 +20,8 @@ from typing import Literal
 
 import numpy as np
 
-from demstudy._lammps import open_lammps
-from demstudy.contact.mapping import (
+from ...contact.calibration import CollisionRow, incline_acceleration
+from ...contact.mapping import (
     ContactParameters,
     Model,
     hertz_contact,
@@ -33,26 +33,9 @@ from demstudy.contact.mapping import (
     spring_beta,
     walton_beta,
 )
+from .library import open_lammps
 
 Kind = Literal["pair", "wall"]
-
-
-@dataclass(frozen=True)
-class CollisionRow:
-    """One measured collision; angle from the normal in degrees, speed = |g| before impact."""
-
-    dim: int
-    kind: str
-    model: str
-    angle: float
-    speed: float
-    e: float
-    beta: float
-    contact_time: float
-    e_target: float
-    beta_target: float
-    contact_time_target: float
-    spin_after: float
 
 
 def _f(x: float) -> str:
@@ -221,15 +204,6 @@ class RollingResult:
     contact: ContactParameters
 
 
-def incline_acceleration(alpha: float, K: float, mu: float | None = None) -> float:
-    """Acceleration (g = 1) down an incline of ``alpha`` degrees: rolling g sin a / (1 + K),
-    or sliding g (sin a - mu cos a) when mu < K tan a / (1 + K)."""
-    a = math.radians(alpha)
-    if mu is not None and mu < K * math.tan(a) / (1.0 + K):
-        return math.sin(a) - mu * math.cos(a)
-    return math.sin(a) / (1.0 + K)
-
-
 def rolling_acceleration(dim: int, alpha: float = 30.0, e: float = 0.5, beta: float = 0.9,
                          mu: float | None = None, kn: float = 1e5,
                          steps_per_contact: float = 50, duration: float = 2.0,
@@ -259,22 +233,3 @@ def rolling_acceleration(dim: int, alpha: float = 30.0, e: float = 0.5, beta: fl
         lmp.close()
     coef = np.polyfit(np.array(ts), np.array(xs), 2)
     return RollingResult(2.0 * float(coef[0]), incline_acceleration(alpha, K, mu), params)
-
-
-def _clean(x: float) -> float:
-    return 0.0 if abs(x) < 1e-12 else x
-
-
-def format_table(rows: Sequence[CollisionRow]) -> str:
-    """Plain-text table of measured vs target e, beta and contact time (for ``demstudy``)."""
-    head = (f"{'dim':>3} {'kind':>4} {'model':>5} {'angle':>6} {'speed':>6} {'e_tgt':>7} "
-            f"{'e_meas':>8} {'b_tgt':>7} {'b_meas':>8} {'tc_tgt':>10} {'tc_meas':>10} "
-            f"{'tc_err%':>7}")
-    lines = [head, "-" * len(head)]
-    for r in rows:
-        err = 100.0 * (r.contact_time / r.contact_time_target - 1.0)
-        lines.append(
-            f"{r.dim:>3} {r.kind:>4} {r.model:>5} {r.angle:>6.1f} {r.speed:>6.3g} "
-            f"{r.e_target:>7.4f} {r.e:>8.5f} {_clean(r.beta_target):>7.3f} {r.beta:>8.4f} "
-            f"{r.contact_time_target:>10.4e} {r.contact_time:>10.4e} {err:>7.3f}")
-    return "\n".join(lines)

@@ -1,0 +1,35 @@
+"""The exceptions demstudy raises, in one place (the CLI maps each to an exit code).
+
+``SceneError`` (invalid scene, :mod:`demstudy.scene.load`) and ``UnsupportedByEngine`` (an
+engine cannot express what the scene or a run option asks for) are raised before any engine
+starts (exit 2); ``EngineError`` is a failure during a run (exit 1), ``RunStopped`` a run that
+stopped on request after a checkpoint (exit 3, continue with ``--resume``).
+"""
+
+from __future__ import annotations
+
+
+class UnsupportedByEngine(ValueError):
+    """The scene or a run option asks for something this engine cannot express exactly.
+
+    ``engine``, ``field_name`` (the scene field or option), ``value`` and the reason (what
+    is allowed instead) are attributes and in the message."""
+
+    def __init__(self, engine: str, field_name: str, value: object, reason: str):
+        self.engine, self.field_name, self.value = engine, field_name, value
+        super().__init__(f"unsupported by {engine}: {field_name} = {value!r}: {reason}")
+
+
+class EngineError(RuntimeError):
+    """An engine failed; the message says what the engine reported and where."""
+
+
+class RunStopped(EngineError):
+    """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint."""
+
+
+class RunRefused(EngineError):
+    """The engine refused the scene or the options (reported by an engine's child process)."""
+
+
+__all__ = ["EngineError", "RunRefused", "RunStopped", "UnsupportedByEngine"]

@@ -1,0 +1,34 @@
+"""The one simulation loop over every engine backend, its run options, checkpoints and the
+child process that isolates a run.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. :func:`run_scene` is
+what the CLI and :func:`demstudy.run` call: refuse what cannot run, then run the scene in a
+child process (``isolate``, or MPI with ``np > 1``) or in this one.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..scene import Scene
+from .loop import RunState, Simulation, check_run
+from .options import RunOptions, check_run_options, work_folder
+
+__all__ = ["RunOptions", "RunState", "Simulation", "check_run", "check_run_options",
+           "run_scene", "work_folder"]
+
+
+def run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
+    """Run ``scene`` in ``engine`` (a registered name or a backend class) and return the
+    results file's path. Everything the engine cannot do is refused before it starts
+    (``UnsupportedByEngine``); ``options.isolate`` or ``options.np > 1`` runs it in a child
+    process, where a crash becomes ``EngineError``."""
+    from ..engines import get_backend
+    from .isolation import in_worker, launch_child
+
+    backend = get_backend(engine) if isinstance(engine, str) else engine
+    if (options.isolate or options.np > 1) and not in_worker():
+        check_run(backend, scene, options)
+        return launch_child(backend, scene, options)
+    return Simulation(scene, backend, options).run()

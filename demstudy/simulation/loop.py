@@ -1,0 +1,575 @@
+"""The one simulation loop: schedule, sampling, servo, stop requests, checkpoints, results.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
+or the shear rate sets the time unit τ); with ``run.unit = 'collisions'`` the schedule counts
+pair collisions per particle instead of time.
+
+:class:`Simulation` runs a scene in any engine backend (:mod:`demstudy.engines.backend`):
+samples every ``run.sample_interval`` from t = 0 (the initial state), equilibration and
+production in whole sample intervals (time-stepped engines: in whole steps); at each sample
+the timeseries (the engine's observables, the walls' mean forces over the interval that
+ended, the Lees–Edwards tilt, the servo's state), and in production the profiles and the
+streaming statistics of ``measure.statistics``, the frames when kept, the interaction stress
+and the collision log. Campbell's servo is updated every servo interval (time-stepped
+engines: at sample ends; event-driven ones: at exact times or collision counts). A stop
+request (Ctrl-C or ``--wall-limit``) is honoured at the end of a sample, or between two
+event chunks inside one, after a checkpoint; ``--resume`` continues from it. With MPI every
+rank runs this loop with identical bookkeeping; rank 0 alone analyses and writes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+from .. import UNITS_NOTE, __version__
+from ..analysis.base import AnalysisBase, bin_edges
+from ..analysis.registry import STATISTICS, Context, engine_problems
+from ..analysis.steady import energy_trend, is_steady
+from ..analysis.stress import (
+    CollisionalSums,
+    ContactStress,
+    collisional_stress,
+    momentum_snapshot,
+    stress_results,
+)
+from ..analysis.suite import profile_bounds
+from ..effects.servo import ServoController, has_servo, servo_settings
+from ..engines.backend import BackendBase, Needs, frame_mass
+from ..errors import EngineError, RunStopped, UnsupportedByEngine
+from ..io.frames import Frame
+from ..io.results import Results, frames_of, write_results
+from ..scene import Scene, scene_to_toml
+from .checkpoint import (
+    CHECKPOINT,
+    load_checkpoint,
+    pickle_atomically,
+    refuse_foreign_checkpoint,
+)
+from .options import RunOptions, check_run_options, frames_on_resume, work_folder
+
+__all__ = ["RunState", "Simulation", "StopRequest", "check_run", "run_attrs"]
+
+LOOP_VERSION = f"demstudy {__version__} (simulation loop 1)"
+FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
+#: collision-log records kept per run (sampled every ``log_every`` collisions)
+LOG_CAPACITY = 200_000
+
+
+def check_run(backend: type[BackendBase], scene: Scene, options: RunOptions) -> None:
+    """Everything refused before any engine starts: the run options, the effects and the
+    statistics the engine cannot supply (``UnsupportedByEngine``)."""
+    check_run_options(backend, options)
+    backend.check(scene, options)
+    for field_name, value, reason in engine_problems(scene, backend.capabilities):
+        raise UnsupportedByEngine(backend.name, field_name, value, reason)
+    log_every = int(options.extra.get("log_every", 1))
+    for name in scene.measure.statistics:
+        if STATISTICS[name].log_every and log_every != 1:
+            raise UnsupportedByEngine(backend.name, "--log-every", log_every,
+                                      f"{name!r} needs every collision logged (1)")
+
+
+def run_attrs(scene: Scene, engine: str, version: str, wall_seconds: float,
+              equilibration_end: float, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
+    """Root attributes every results file carries, with Campbell's steadiness verdict over the
+    production samples (those after ``equilibration_end``)."""
+    t = timeseries["time"]
+    production = t > equilibration_end + 1e-9 * max(1.0, abs(equilibration_end))
+    trend = energy_trend(t[production], timeseries["kinetic_energy"][production])
+    return {
+        "engine": engine,
+        "engine_version": version,
+        "scene_toml": scene_to_toml(scene),
+        "scene_name": scene.meta.name,
+        "seed": scene.run.seed,
+        "run_unit": scene.run.unit,
+        "wall_seconds": wall_seconds,
+        "equilibration_end": equilibration_end,
+        "kinetic_energy_trend": trend,
+        "steady": is_steady(trend),
+    }
+
+
+class StopRequest:
+    """Ctrl-C (SIGINT, main thread only) or a wall-clock limit asks the run loop to stop at
+    the end of its current segment; ``with StopRequest(limit) as stop: … stop.reason``."""
+
+    def __init__(self, wall_limit: float | None):
+        self.wall_limit = wall_limit
+        self.reason: str | None = None
+        self.started = time.perf_counter()
+        self._previous = None
+
+    def request(self, _signum=None, _frame=None) -> None:
+        self.reason = self.reason or "interrupted"
+
+    def check(self) -> bool:
+        """True once a stop was asked for (checks the wall-clock limit too)."""
+        elapsed = time.perf_counter() - self.started
+        if self.wall_limit is not None and elapsed > self.wall_limit:
+            self.reason = self.reason or "wall-clock limit"
+        return self.reason is not None
+
+    def __enter__(self) -> StopRequest:
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self.request)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+
+
+class _StopInInterval(Exception):
+    """A stop request honoured between two event chunks, inside a sample interval."""
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """Samples every ``interval`` (time, or collisions per particle); ``n_eq`` of them in
+    equilibration, ``n_total`` in all, a checkpoint every ``n_ckpt`` (0: none)."""
+
+    interval: float
+    n_eq: int
+    n_total: int
+    n_ckpt: int
+    by_collisions: bool
+
+    @classmethod
+    def of(cls, scene: Scene, options: RunOptions, time_step: float | None) -> Schedule:
+        run = scene.run
+        ckpt = options.checkpoint_interval or run.checkpoint_interval
+        if time_step:  # whole steps: the interval and both phases rounded to them
+            n_sample = max(1, round(run.sample_interval / time_step))
+
+            def steps(duration: float) -> int:
+                return max(0, math.ceil(duration / time_step - 1e-9))
+
+            n_eq = round(steps(run.equilibration) / n_sample)
+            n_prod = max(1, round(steps(run.production) / n_sample))
+            n_ckpt = max(1, round(ckpt / time_step / n_sample)) if ckpt else 0
+            return cls(n_sample * time_step, n_eq, n_eq + n_prod, n_ckpt, False)
+        dt = run.sample_interval
+        n_eq = round(run.equilibration / dt)
+        return cls(dt, n_eq, n_eq + max(1, round(run.production / dt)),
+                   max(1, round(ckpt / dt)) if ckpt else 0, run.unit == "collisions")
+
+
+@dataclass
+class RunState:
+    """Everything the loop needs to continue a run (pickled into checkpoints)."""
+
+    samples: int = 0  # sample intervals done
+    timeseries: dict[str, list] = field(default_factory=dict)
+    frames: dict[str, list] = field(default_factory=dict)
+    keep_frames: bool = False  # fixed when the run starts, kept on resume
+    profiles: AnalysisBase | None = None
+    streams: dict[str, AnalysisBase] = field(default_factory=dict)  # other stream statistics
+    stress: CollisionalSums | ContactStress | None = None
+    stress_edges: np.ndarray | None = None
+    wall_seconds: float = 0.0
+    last_time: float = 0.0
+    last_impulse: dict[str, np.ndarray] = field(default_factory=dict)
+    servo: ServoController | None = None
+    next_servo: int = 0  # collision count of the next servo update
+    next_servo_time: float = 0.0  # time of the next servo update
+    servo_impulse: dict[str, np.ndarray] = field(default_factory=dict)
+    servo_time: float = 0.0
+    log: dict[str, list] = field(default_factory=dict)
+    logged: int = 0
+    # particle y and momenta where production starts and ends (the unsteady momentum term)
+    momentum_start: dict | None = None
+    momentum_end: dict | None = None
+    in_production: bool = False
+
+    def record(self, key: str, value) -> None:
+        self.timeseries.setdefault(key, []).append(value)
+
+
+class Simulation:
+    """Run ``scene`` in ``backend`` (a backend class) with ``options``; :meth:`run` returns
+    the results file's path (on MPI ranks other than 0, the path it is written to)."""
+
+    def __init__(self, scene: Scene, backend: type[BackendBase], options: RunOptions):
+        self.scene, self.options = scene, options
+        self.out = Path(options.out).resolve()
+        self.workdir = work_folder(self.out, backend.name)
+        check_run(backend, scene, options)
+        self.backend = backend(scene, options, self.workdir)
+        self.schedule = Schedule.of(scene, options, self.backend.time_step)
+        statistics = scene.measure.statistics
+        self.streams = [s for s in statistics if STATISTICS[s].source == "stream"
+                        and s != "profiles"]
+        self.after = [s for s in statistics if STATISTICS[s].source in ("frames", "collisions")]
+        self.measure_stress = "stress" in statistics
+        frames_needed = any(STATISTICS[s].source == "frames" for s in statistics)
+        keep = options.keep_frames
+        self.keep_frames = frames_needed or (scene.measure.keep_frames if keep is None else keep)
+        log_every = int(options.extra.get("log_every", 0))
+        if any(STATISTICS[s].log_every for s in statistics):
+            log_every = log_every or 1
+        self.log_every = log_every
+        self.servo_by_time = has_servo(scene) and (
+            self.backend.capabilities.time_step or servo_settings(scene).interval_unit == "time")
+        self.stop = StopRequest(options.wall_limit)
+
+    # -- set-up ---------------------------------------------------------------------------
+    def _needs(self) -> Needs:
+        bins = None
+        if self.measure_stress:
+            lo, hi, _period = profile_bounds(self.scene)
+            bins = (lo, hi, len(bin_edges(lo, hi, self.scene.measure.bin_width)) - 1)
+        return Needs(stress_bins=bins, log_every=self.log_every, log_capacity=LOG_CAPACITY)
+
+    def _start(self) -> RunState:
+        backend, path = self.backend, self.workdir / CHECKPOINT
+        if self.options.resume:
+            saved = load_checkpoint(path, self.scene, {"run", "backend"}, self._version(),
+                                    backend.name)
+            state = saved["run"]
+            self.keep_frames = frames_on_resume(self.options.keep_frames, state.keep_frames)
+            backend.setup(self._needs(), saved["backend"], state.servo)
+            return state
+        refuse_foreign_checkpoint(path, self.out)
+        servo = ServoController(self.scene) if has_servo(self.scene) else None
+        state = RunState(keep_frames=self.keep_frames, servo=servo)
+        needs = self._needs()
+        backend.setup(needs, None, servo)
+        if servo is None:  # servo: bins between the walls where production starts
+            state.profiles = STATISTICS["profiles"].build(Context(self.scene))
+            if needs.stress_bins is not None:
+                lo, hi, _n = needs.stress_bins
+                self._lay_stress_bins(state, bin_edges(lo, hi, self.scene.measure.bin_width))
+        else:
+            settings = servo_settings(self.scene)
+            if self.servo_by_time:
+                state.next_servo_time = settings.interval_time
+            else:
+                state.next_servo = self._servo_interval(settings)
+            state.servo_impulse = backend.wall_impulse()
+        return state
+
+    def _version(self) -> str:
+        return f"{LOOP_VERSION}; {self.backend.version}"
+
+    # -- servo ----------------------------------------------------------------------------
+    def _servo_interval(self, settings) -> int:
+        return max(1, round(settings.interval_collisions * self.backend.n_particles))
+
+
+    def _servo_update(self, state: RunState) -> None:
+        """Campbell's servo step: the walls' mean normal forces on the particles since the
+        previous update set their new normal velocities (:class:`ServoController`); the
+        engine then moves its walls (and rescales the periodic width when asked)."""
+        backend, servo = self.backend, state.servo
+        t = backend.time
+        impulses = backend.wall_impulse()
+        span = max(t - state.servo_time, 1e-300)
+        force = {side: float(impulses[side][1] - state.servo_impulse[side][1]) / span
+                 for side in impulses}
+        servo.update(t, force, backend.width())
+        backend.move_walls(servo)
+        state.servo_impulse, state.servo_time = impulses, t
+        settings = servo_settings(self.scene)
+        if backend.capabilities.time_step:
+            pass  # at sample ends: counted in ``_sample_servo``
+        elif self.servo_by_time:
+            state.next_servo_time += settings.interval_time
+        else:
+            state.next_servo += self._servo_interval(settings)
+
+    # -- advancing ------------------------------------------------------------------------
+    def _advance_interval(self, state: RunState) -> None:
+        """Advance to sample ``state.samples``: a time, or a collision count with
+        ``run.unit = 'collisions'``; event-driven servo updates happen on the way."""
+        backend, sched = self.backend, self.schedule
+        if sched.by_collisions:
+            t_end, target = 1e300, round(state.samples * sched.interval * backend.n_particles)
+        else:
+            t_end, target = state.samples * sched.interval, 0
+        servo = state.servo is not None and not backend.capabilities.time_step
+        by_time, by_count = servo and self.servo_by_time, servo and not self.servo_by_time
+        while True:
+            stops = [c for c in (target, state.next_servo if by_count else 0) if c > 0]
+            t_stop = min(t_end, state.next_servo_time) if by_time else t_end
+            reached = backend.advance(t_stop, min(stops, default=0), self.stop.check)
+            if reached and target and backend.collisions < target and backend.time >= t_end:
+                raise EngineError(f"run.unit = 'collisions': no events are left after "
+                                  f"{backend.collisions} pair collisions (the particles no "
+                                  f"longer meet), so the count {target} cannot be reached")
+            if reached and by_time and backend.time >= state.next_servo_time:
+                self._servo_update(state)
+                if backend.time >= t_end:
+                    return
+                continue
+            if reached:
+                return
+            if by_count and backend.collisions >= state.next_servo:
+                self._servo_update(state)
+                continue
+            if target and backend.collisions >= target:
+                return
+            if self.stop.reason is not None:
+                raise _StopInInterval
+            raise EngineError(f"the collision count {target} was not reached: the engine's "
+                              f"event budget ran out at t = {backend.time:.6g}, so a run "
+                              "counted in pair collisions cannot go on")
+
+    def _sample_servo(self, state: RunState) -> None:
+        """Time-stepped engines update the servo at the end of every m-th sample interval."""
+        settings = servo_settings(self.scene)
+        every = max(1, round(settings.interval_time / self.scene.run.sample_interval))
+        if state.samples % every == 0:
+            self._servo_update(state)
+
+    # -- sampling -------------------------------------------------------------------------
+    def _sample(self, state: RunState, production: bool) -> None:
+        backend, scene, dim = self.backend, self.scene, self.scene.dimension
+        root = backend.rank == 0
+        t = backend.time
+        state.record("time", t)
+        for key, value in backend.observe(production).items():
+            state.record(key, value)
+        span = t - state.last_time
+        impulses = backend.wall_impulse()
+        for side, impulse in impulses.items():
+            # force of the particles on the wall, averaged over the interval that just ended
+            previous = state.last_impulse.get(side, impulse)
+            force = -(impulse - previous)[:dim] / span if span > 0 else np.full(dim, np.nan)
+            state.record(f"wall_force_{side}", force)
+        state.last_impulse = impulses
+        if scene.shear is not None:
+            state.record("tilt", backend.tilt())  # Lees–Edwards offset of the upper image
+        if state.servo is not None:
+            state.servo.advance(t)
+            for side, y in (backend.wall_positions() or {}).items():
+                state.servo.walls[side].y = y  # the engine's positions are the truth
+            for key, value in state.servo.state().items():
+                state.record(key, value)
+            state.record("width", backend.width())
+        rebinned = production and not state.in_production and self._begin_production(state)
+        if state.stress is not None and (production or isinstance(state.stress,
+                                                                  CollisionalSums)):
+            sums = backend.stress_sums()  # collective on MPI ranks
+            if root:  # cumulative sums count from the bins' first sample
+                state.stress.add(sums, span if production and not rebinned else None,
+                                 self._section() if production else 0.0)
+        if self.log_every:
+            self._keep_log(state, backend.take_collision_log(), production)
+        state.last_time = t
+        snapshot = scene.gravity is not None and state.samples in (self.schedule.n_eq,
+                                                                   self.schedule.n_total)
+        if not (production or snapshot):
+            return
+        frame = backend.frame()  # collective on MPI ranks
+        if snapshot:
+            snap = momentum_snapshot(t, frame.position[:, 1],
+                                     frame_mass(frame)[:, None] * frame.velocity)
+            if state.samples == self.schedule.n_eq:
+                state.momentum_start = snap
+            else:
+                state.momentum_end = snap
+        if production:
+            self._production_frame(state, frame)
+
+    def _begin_production(self, state: RunState) -> bool:
+        """Production starts: lay what is binned from now on; True when the interaction
+        stress got new bins here (servo walls: between the walls where they stand now)."""
+        state.in_production = True
+        walls = None
+        if state.servo is not None:
+            walls = (state.servo.walls["lower"].y, state.servo.walls["upper"].y)
+            if self.backend.rank == 0:
+                state.profiles = STATISTICS["profiles"].build(Context(self.scene, walls=walls))
+        if self.backend.rank == 0:
+            state.streams = {name: STATISTICS[name].build(Context(self.scene, walls=walls))
+                             for name in self.streams}
+        if walls is None or not self.measure_stress:
+            return False
+        edges = bin_edges(*walls, self.scene.measure.bin_width)
+        self.backend.set_stress_bins(*walls, len(edges) - 1)
+        self._lay_stress_bins(state, edges)
+        return True
+
+    def _production_frame(self, state: RunState, frame: Frame) -> None:
+        if self.backend.rank != 0:
+            return
+        state.profiles.feed(frame)
+        for analysis in state.streams.values():
+            analysis.feed(frame)
+        if self.keep_frames:
+            for key in FRAME_ARRAYS:  # copies: engines reuse their buffers
+                state.frames.setdefault(key, []).append(np.array(getattr(frame, key)))
+            state.frames.setdefault("time", []).append(frame.time)
+            state.frames.setdefault("tilt", []).append(frame.tilt)
+
+    def _lay_stress_bins(self, state: RunState, edges: np.ndarray) -> None:
+        """Accumulate the interaction stress in ``edges`` from now on."""
+        state.stress_edges = edges
+        if self.backend.capabilities.stress == "collisional":
+            state.stress = CollisionalSums()
+        else:
+            period = self.scene.box.size[1] if self.scene.y_periodic else 0.0
+            state.stress = ContactStress(edges, self.scene.dimension, period)
+
+    def _section(self) -> float:
+        """The bins' cross-section now: periodic width (× depth in 3D)."""
+        size = list(self.scene.box.size)
+        size[0] = self.backend.width()
+        return float(np.prod([size[i] for i in range(self.scene.dimension) if i != 1]))
+
+    def _keep_log(self, state: RunState, log: dict | None, production: bool) -> None:
+        if production and log and state.logged < LOG_CAPACITY:
+            keep = min(len(log["time"]), LOG_CAPACITY - state.logged)
+            for key, value in log.items():
+                state.log.setdefault(key, []).append(value[:keep])
+            state.logged += keep
+
+    # -- checkpoints ----------------------------------------------------------------------
+    def _checkpoint(self, state: RunState, started: float) -> None:
+        saved = self.backend.get_state()  # collective on MPI ranks
+        if self.backend.rank != 0:
+            return
+        self.workdir.mkdir(parents=True, exist_ok=True)
+        snapshot = dataclasses.replace(
+            state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
+        pickle_atomically(self.workdir / CHECKPOINT,
+                          {"scene": scene_to_toml(self.scene), "version": self._version(),
+                           "engine": self.backend.name, "out": str(self.out),
+                           "units": UNITS_NOTE, "backend": saved, "run": snapshot})
+        self.backend.cleanup(saved)  # committed: the engine's older files go
+
+    # -- main loop ------------------------------------------------------------------------
+    def run(self) -> Path:
+        backend = self.backend
+        try:
+            # Ctrl-C from here on is a stop request, never a traceback: taken between two
+            # event chunks or at the next sample (after a checkpoint); during the set-up the
+            # run stops after its first chunk; during the final write it is ignored
+            with self.stop:
+                state = self._start()
+                started = time.perf_counter()
+                if state.samples == 0 and not state.timeseries:
+                    self._sample(state, production=False)  # the initial state
+                self._loop(state, started)
+                state.wall_seconds += time.perf_counter() - started
+                extra = backend.result_attrs()
+        except KeyboardInterrupt:  # no handler (not the main thread): keep the last checkpoint
+            raise EngineError("interrupted: run again with --resume to continue from the last "
+                              "checkpoint (if any)") from None
+        finally:
+            backend.close()
+        if backend.rank != 0:
+            return self.out
+        return self._write(state, extra)
+
+    def _loop(self, state: RunState, started: float) -> None:
+        sched, backend = self.schedule, self.backend
+        unit = "coll/N" if sched.by_collisions else "τ"
+        bar = tqdm(total=sched.n_total * sched.interval, initial=state.samples * sched.interval,
+                   unit=unit, disable=not self.options.progress or backend.rank != 0,
+                   mininterval=0.5 if sys.stderr.isatty() else 30.0,
+                   bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} " + unit +
+                   " [{elapsed}<{remaining}]", desc=f"{backend.name} {self.scene.meta.name}")
+        with bar:
+            while state.samples < sched.n_total:
+                state.samples += 1
+                try:
+                    self._advance_interval(state)
+                except _StopInInterval:
+                    # a stop asked for between two event chunks: the engine is synchronised
+                    # there, and the resumed run redoes this interval from that point (its
+                    # chunks start where this one ended, so it continues bit-identically)
+                    state.samples -= 1
+                    self._checkpoint(state, started)
+                    raise RunStopped(
+                        f"stopped ({self.stop.reason}) at t = {backend.time:.6g}, inside a "
+                        "sample interval, after a checkpoint: run the same command again "
+                        "with --resume to continue") from None
+                if state.servo is not None and backend.capabilities.time_step:
+                    self._sample_servo(state)
+                self._sample(state, production=state.samples > sched.n_eq)
+                bar.update(sched.interval)
+                stop = backend.agree(self.stop.check())
+                checkpoint = sched.n_ckpt and state.samples % sched.n_ckpt == 0
+                if (stop or checkpoint) and state.samples < sched.n_total:
+                    self._checkpoint(state, started)
+                if stop and state.samples < sched.n_total:
+                    raise RunStopped(
+                        f"stopped ({self.stop.reason or 'on another rank'}) at t = "
+                        f"{backend.time:.6g} after a checkpoint: run the same command again "
+                        "with --resume to continue")
+
+    # -- results --------------------------------------------------------------------------
+    def _write(self, state: RunState, extra: dict[str, Any]) -> Path:
+        scene, backend = self.scene, self.backend
+        profiles = state.profiles.finish()
+        timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
+        frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
+        equilibration_end = float(timeseries["time"][self.schedule.n_eq])
+        attrs = run_attrs(scene, backend.name, backend.version, state.wall_seconds,
+                          equilibration_end, timeseries)
+        attrs.update(extra)
+        results = Results(attrs, timeseries, profiles.results, profiles.attrs, frames)
+        if self.measure_stress:
+            results.groups["stress"], results.group_attrs["stress"] = self._stress_results(
+                state, results, equilibration_end)
+        if state.log:
+            results.groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}
+            results.group_attrs["collisions"] = {
+                "log_every": self.log_every, "capacity": LOG_CAPACITY,
+                "units": "d = 1, m = 1 (g = 1 with gravity); kind 0 pair, 1 lower wall, "
+                         "2 upper wall; normal from i to j (or to the wall); branch r_j - r_i "
+                         "(contact point - r_i for walls); impulse on i; velocity v_i - v_j "
+                         "and spin_velocity (contact-point relative velocity) before"}
+        for name, analysis in state.streams.items():
+            analysis.finish()
+            results.groups[f"statistics/{name}"] = analysis.results
+            results.group_attrs[f"statistics/{name}"] = analysis.attrs
+        if self.after:
+            ctx = Context(scene, results=results,
+                          frames=(lambda: frames_of(results, scene.dimension)) if frames
+                          else None)
+            for name in self.after:
+                data, group_attrs = STATISTICS[name].compute(ctx)
+                results.groups[f"statistics/{name}"] = data
+                results.group_attrs[f"statistics/{name}"] = group_attrs
+        path = write_results(self.out, results)
+        (self.workdir / CHECKPOINT).unlink(missing_ok=True)
+        backend.cleanup(None)
+        if self.workdir.exists() and not any(self.workdir.iterdir()):
+            self.workdir.rmdir()
+        return path
+
+    def _stress_results(self, state: RunState, results: Results,
+                        start: float) -> tuple[dict, dict]:
+        parts: dict[str, Any] = {}
+        stress, edges = state.stress, state.stress_edges
+        if isinstance(stress, CollisionalSums) and stress.chunks:
+            # the bins' cross-section: the (mean production) periodic width × depth
+            size = list(self.scene.box.size)
+            if "width" in results.timeseries:
+                size[0] = float(np.mean(results.timeseries["width"][self.schedule.n_eq:]))
+            section = float(np.prod([size[i] for i in range(self.scene.dimension) if i != 1]))
+            parts["collisional"] = collisional_stress(np.asarray(stress.chunks),
+                                                      np.asarray(stress.durations), edges,
+                                                      section)
+        elif isinstance(stress, ContactStress):
+            parts["contact"] = stress.finish()
+        data, attrs = stress_results(self.scene, results.profiles, results.timeseries, start,
+                                     momentum=(state.momentum_start, state.momentum_end),
+                                     **parts)
+        if self.backend.capabilities.stress == "contact":
+            attrs["contact_samples"] = stress.samples if isinstance(stress, ContactStress) else 0
+        return data, attrs
