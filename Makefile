@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.demstudy-installed
 # the editable install maps every module at install time: reinstall (a few seconds, the C++
 # build is cached in build/) whenever a source file is newer than the stamp
-SOURCES := pyproject.toml CMakeLists.txt $(shell find native -name "*.cpp" -o -name "*.hpp") \
+SOURCES := pyproject.toml CMakeLists.txt $(wildcard inputs/*/*.toml) $(shell find native -name "*.cpp" -o -name "*.hpp") \
            $(shell find demstudy -name '*.py' 2>/dev/null)
 
 .PHONY: run test install lint bench clean

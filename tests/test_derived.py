@@ -300,3 +300,126 @@ def test_integrating_up_from_the_wall(rule):
     up = dv.momentum_balance_stress(prof, g, rule=rule, wall_stress=(0.5 * weight, 0.8 * weight))
     np.testing.assert_allclose(up["tau_xy"], down["tau_xy"], atol=1e-12)
     np.testing.assert_allclose(up["tau_yy"], down["tau_yy"], atol=1e-12)
+
+
+# ------------------------------------------------------------------ derived_results
+def couette_results(a=0.2, b=0.05, nu0=0.5, var=(0.04, 0.02), tau0=0.01, p0=0.03):
+    """A 2D Couette cell (walls at y = 0 and 12, upper at U = 1): u = a + b y, uniform nu and
+    velocity variances, and a measured total stress P_xx = P_yy = p0, P_xy = -tau0."""
+    from demstudy.io.results import Results
+
+    prof = synthetic(np.linspace(0.0, 12.0, 13), lambda y: nu0 * y, u=lambda y: a + b * y,
+                     var=var)
+    n = prof["y"].size
+    for key in ("solid_fraction", "velocity", "temperature_components"):
+        prof[f"{key}_err"] = np.full_like(prof[key], 1e-3)
+    total = np.zeros((n, 2, 2))
+    total[:, 0, 0] = total[:, 1, 1] = p0
+    total[:, 0, 1] = total[:, 1, 0] = -tau0
+    stress = {"y": prof["y"], "edges": prof["edges"], "kinetic": np.zeros((n, 2, 2)),
+              "collisional": total, "total": total, "total_err": np.full((n, 2, 2), 1e-4)}
+    return Results({"equilibration_end": 0.0}, timeseries={"time": np.arange(3.0)},
+                   profiles=prof, profile_attrs={"axis": "y"}, groups={"stress": stress})
+
+
+def test_derived_results_of_an_analytic_couette_flow():
+    a, b, nu0, var, tau0, p0 = 0.2, 0.05, 0.5, (0.04, 0.02), 0.01, 0.03
+    scene = load_scene("campbell1982/couette-rough")
+    data, attrs = dv.derived_results(couette_results(a, b, nu0, var, tau0, p0), scene)
+    rho, radius = RHO[2], 0.5
+    np.testing.assert_allclose(data["shear_rate"], b, rtol=1e-9)
+    np.testing.assert_allclose(data["S_text"], 2 * radius * b / np.sqrt(var[0]), rtol=1e-9)
+    np.testing.assert_allclose(data["S_listing"], 2 * radius * b / np.sqrt(sum(var)),
+                               rtol=1e-9)
+    np.testing.assert_allclose(data["tau_xy"], tau0)
+    np.testing.assert_allclose(data["tau_yy"], p0)
+    np.testing.assert_allclose(data["f_s"], tau0 / (rho * radius**2 * b**2), rtol=1e-9)
+    np.testing.assert_allclose(data["f_N"], p0 / (rho * radius**2 * b**2), rtol=1e-9)
+    np.testing.assert_allclose(data["friction"], tau0 / p0)
+    np.testing.assert_allclose(data["chi"], p0 / (rho * sum(var)), rtol=1e-9)
+    np.testing.assert_allclose(data["chi_theory"], th.campbell_chi(nu0, 2, 0.6), rtol=1e-12)
+    assert data["slip_lower"] == pytest.approx(a)  # straight line: extrapolation exact
+    assert data["slip_upper"] == pytest.approx(a + 12 * b - 1.0)
+    np.testing.assert_allclose(data["knudsen_enskog"], th.mean_free_path(nu0, 2) / 12.0,
+                               rtol=1e-9)
+    assert attrs["knudsen_width_is"] == "wall gap" and attrs["knudsen_width"] == 12.0
+    for key in ("shear_rate", "S_text", "f_s", "f_N", "friction", "chi", "slip_lower"):
+        err = np.asarray(data[f"{key}_err"])
+        assert np.all(np.isfinite(err)) and np.all(err > 0), key
+    assert attrs["skipped"].startswith("balance_tau_xy") and attrs["skipped"].endswith(
+        ": no gravity")
+    assert "f_s" in attrs["computed"].split(",") and "slip_upper" in attrs["computed"]
+
+
+def test_derived_results_of_a_static_chute_column_without_stress():
+    """Gravity, open top, no /stress: the steady momentum balance from the profiles; no
+    measured stress (said so); Kn from Campbell's flow depth."""
+    from demstudy.io.results import Results
+
+    scene = load_scene("campbell1982/chute-30")
+    nu, nu_int = column(h0=10.0, nu0=0.6)
+    prof = synthetic(np.arange(0.0, 12.5, 0.5), nu_int, u=lambda y: 1 + 0.5 * y)
+    data, attrs = dv.derived_results(Results({}, profiles=prof), scene)
+    expected = dv.momentum_balance_stress(prof, scene)
+    np.testing.assert_allclose(data["balance_tau_yy"], expected["tau_yy"])
+    np.testing.assert_allclose(data["balance_tau_xy"], expected["tau_xy"])
+    np.testing.assert_allclose(data["friction_balance"][:10], math.tan(math.radians(30)),
+                               rtol=1e-9)  # every layer of a steady column: tan(alpha)
+    np.testing.assert_allclose(data["f_s_balance"],
+                               expected["tau_xy"] / (RHO[2] * 0.25 * 0.5**2), rtol=1e-9)
+    assert "tau_xy, tau_yy, pressure, f_s, f_N, friction, chi: no /stress" in attrs["skipped"]
+    assert "free surface" in attrs["balance_source"]
+    assert data["slip_lower"] == pytest.approx(1.0)
+    assert attrs["knudsen_width_is"] == "flow depth (campbell_depth)"
+    assert attrs["knudsen_width"] == pytest.approx(dv.campbell_depth(prof, 0.0))
+    assert np.all(np.isnan(data["knudsen_enskog"][prof["solid_fraction"] == 0]))
+
+
+def test_derived_results_skip_what_the_file_lacks():
+    from demstudy.io.results import Results
+
+    scene = load_scene("shear/lees-edwards-2d")
+    data, attrs = dv.derived_results(Results({}), scene)
+    assert attrs["skipped"] == "everything: no /profiles" and attrs["computed"] == ""
+    res = couette_results()
+    res.profile_attrs["axis"] = "x"
+    assert "profiles along x" in dv.derived_results(res, scene)[1]["skipped"]
+    res = couette_results()
+    res.groups["stress"] = {k: v for k, v in res.groups["stress"].items() if k != "collisional"}
+    data, attrs = dv.derived_results(res, scene)  # periodic in y, no walls
+    assert "only the kinetic part" in attrs["skipped"] and "slip: no walls" in attrs["skipped"]
+    assert "f_s" not in data and "slip_lower" not in data
+    assert attrs["knudsen_width_is"] == "periodic height"
+
+
+def test_derived_results_of_a_short_run_stored_as_a_group(tmp_path):
+    """couette-rough in the event-driven engine (5 time units of production, ~1 s): every
+    quantity of a sheared wall-bounded flow comes out, with the servo's mean gap and wall
+    speed; written as /statistics/derived it reads back with units from the table."""
+    from demstudy.cli import main
+    from demstudy.io.fields import UNKNOWN_UNITS
+    from demstudy.io.results import read_results, write_results
+
+    out = tmp_path / "couette.h5"
+    assert main(["run", "campbell1982/couette-rough", "--engine", "edmd", "-q",
+                 "--set", "run.production=5", "--out", str(out)]) == 0
+    res = read_results(out)
+    data, attrs = dv.derived_results(res)  # the scene from the file
+    for key in ("shear_rate", "S_text", "f_s", "f_N", "friction", "chi", "chi_theory",
+                "knudsen_enskog", "slip_lower", "slip_upper"):
+        assert key in data, (key, attrs["skipped"])
+    filled = res.profiles["solid_fraction"] > 0.2
+    assert np.all(np.isfinite(data["f_s"][filled])) and np.all(data["tau_yy"][filled] > 0)
+    np.testing.assert_allclose(data["friction"], data["tau_xy"] / data["tau_yy"])
+    gap = res.timeseries["gap"][res.timeseries["time"] > res.attrs["equilibration_end"]]
+    assert attrs["knudsen_width"] == pytest.approx(gap.mean())
+    assert 0.9 < attrs["slip_upper_wall_velocity"] < 1.1  # the servo holds the shear rate
+    assert attrs["skipped"].endswith("no gravity")
+    res.groups[dv.DERIVED_GROUP], res.group_attrs[dv.DERIVED_GROUP] = data, attrs
+    back = read_results(write_results(out, res))
+    np.testing.assert_array_equal(back.groups[dv.DERIVED_GROUP]["f_s"], data["f_s"])
+    assert back.group_attrs[dv.DERIVED_GROUP]["knudsen_width"] == attrs["knudsen_width"]
+    units = {k: v["units"] for k, v in back.dataset_attrs.items()
+             if k.startswith(dv.DERIVED_GROUP)}
+    assert units and UNKNOWN_UNITS not in units.values()
+    assert units[f"{dv.DERIVED_GROUP}/tau_xy"] == "m/τ^2 (force per length)"

@@ -42,9 +42,11 @@ from scipy.interpolate import CubicSpline
 from demstudy.theory.kinetic import mean_free_path
 
 __all__ = [
+    "DERIVED_GROUP",
     "MATERIAL_DENSITY",
     "bagnold_coefficients",
     "campbell_depth",
+    "derived_results",
     "equation_of_state",
     "friction_coefficient",
     "gravity_of",
@@ -447,3 +449,258 @@ def knudsen_enskog(profiles: dict[str, Any], width: float) -> np.ndarray:
     nu = np.asarray(profiles["solid_fraction"], float)
     with np.errstate(divide="ignore", invalid="ignore"):
         return mean_free_path(nu, dim) / width
+
+
+# -- everything a results file supports, as the group /statistics/derived -----------------
+DERIVED_GROUP = "statistics/derived"
+"""Where :func:`derived_results` belongs in a results file."""
+
+_CONVENTIONS = (
+    "Campbell's signs: tau_yy = P_yy (compressive positive), tau_xy = -P_xy; R = d/2; "
+    "rho = 4/pi (2D, per unit thickness), 6/pi (3D); f = tau / (rho R^2 (du/dy)^2) "
+    "(bagnold_coefficients 'campbell'); chi = p / (rho sum_a <v_a'^2>); slip = u(wall) - "
+    "U_wall; errors propagated linearly from the *_err with the bins independent")
+
+
+def _production(results: Any) -> np.ndarray | None:
+    """Mask of the production samples of /timeseries (time > equilibration_end)."""
+    t = results.timeseries.get("time")
+    if t is None:
+        return None
+    t = np.asarray(t, float)
+    start = results.attrs.get("equilibration_end")
+    if start is None:
+        return np.ones(t.shape, bool)
+    start = float(start)
+    keep = t > start + 1e-9 * max(1.0, abs(start))
+    return keep if keep.any() else np.ones(t.shape, bool)
+
+
+def _production_mean(results: Any, key: str) -> float | None:
+    values = results.timeseries.get(key)
+    keep = _production(results)
+    if values is None or keep is None:
+        return None
+    values = np.asarray(values, float)[keep]
+    values = values[np.isfinite(values)]
+    return float(values.mean()) if values.size else None
+
+
+def _scene_of(results: Any) -> Any:
+    from demstudy.scene import parse_scene_text, validate_scene  # noqa: PLC0415
+
+    text = results.attrs.get("analysis_scene_toml") or results.attrs.get("scene_toml")
+    if not text:
+        raise ValueError("derived_results: give the scene (the results hold no scene_toml)")
+    return validate_scene(parse_scene_text(text, "scene_toml"), "scene_toml")
+
+
+def derived_results(
+    results: Any,
+    scene: Any = None,
+    *,
+    slip_method: str = "extrapolate",
+    n_fit: int = 2,
+) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    """Every derived quantity that ``results`` supports, as the group ``/statistics/derived``
+    (``DERIVED_GROUP``): ``(datasets, attrs)``.
+
+    ``results``: a :class:`demstudy.io.results.Results` (``/profiles`` along y, optional
+    ``/stress`` or ``/statistics/stress``, ``/timeseries``); ``scene``: its Scene (default: the
+    file's ``analysis_scene_toml`` or ``scene_toml``). Computed when the data allow, with
+    ``*_err`` where the functions give errors:
+
+    * ``shear_rate`` du/dy (:func:`shear_rate`), ``S_text``, ``S_listing`` (:func:`s_parameter`);
+    * with a measured stress (``/stress`` holding ``contact`` or ``collisional``):
+      ``tau_xy`` = −P_xy, ``tau_yy`` = P_yy and ``pressure`` = tr P/dim of ``total``, the
+      Bagnold coefficients ``f_s``, ``f_N`` (:func:`bagnold_coefficients`, Campbell's
+      definition), ``friction`` μ and ``chi`` (:func:`equation_of_state` with p = pressure);
+    * with gravity: the momentum balance ``balance_tau_xy``, ``balance_tau_yy`` (those of
+      ``/stress`` when present, with the unsteady term; else steady,
+      :func:`momentum_balance_stress`, from a free surface or the upper wall's stress) and
+      ``f_s_balance``, ``f_N_balance``, ``friction_balance``, ``chi_balance`` (p = τ_yy, the
+      weight above: Campbell's chute reading);
+    * ``chi_theory`` = ν Z/dim (:func:`demstudy.theory.campbell_chi`) for a constant restitution;
+    * per wall ``slip_<side>`` (:func:`wall_slip`, ``slip_method``, ``n_fit``) at the mean
+      production wall position and speed (servo walls move);
+    * ``lambda_enskog`` and ``knudsen_enskog`` (:func:`knudsen_enskog`) with W the wall gap
+      (mean over production with the servo), the periodic height, or Campbell's flow depth
+      (open top); attributes ``knudsen_width``, ``knudsen_width_is``.
+
+    What cannot be computed is left out and said in ``attrs["skipped"]`` (one
+    ``"name: reason"`` per line, ``"none"`` when nothing was skipped); ``attrs["computed"]``
+    lists the datasets (without ``_err``). Empty bins give NaN.
+    """
+    from demstudy import UNITS_NOTE  # noqa: PLC0415
+    from demstudy.analysis.stress import wall_stress  # noqa: PLC0415 (stress imports us)
+    from demstudy.theory import campbell_chi  # noqa: PLC0415
+
+    if scene is None:
+        scene = _scene_of(results)
+    dim = scene.dimension
+    profiles = dict(results.profiles or {})
+    data: dict[str, np.ndarray] = {}
+    skipped: dict[str, str] = {}
+    attrs: dict[str, Any] = {"units": UNITS_NOTE, "dim": dim, "conventions": _CONVENTIONS}
+
+    def finish() -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        attrs["skipped"] = "\n".join(f"{k}: {v}" for k, v in skipped.items()) or "none"
+        attrs["computed"] = ",".join(k for k in data if not k.endswith("_err")
+                                     and k not in ("y", "edges"))
+        return data, attrs
+
+    needed = ("y", "solid_fraction", "velocity", "temperature_components")
+    missing = [k for k in needed if k not in profiles]
+    if missing:
+        why = "no /profiles" if not profiles else f"/profiles lacks {', '.join(missing)}"
+        skipped["everything"] = why
+        return finish()
+    axis = (getattr(results, "profile_attrs", None) or {}).get("axis", scene.measure.axis)
+    if axis != "y":
+        skipped["everything"] = (f"profiles along {axis}: the derived quantities need "
+                                 "profiles along y (the wall-normal, gradient axis)")
+        return finish()
+    y = np.asarray(profiles["y"], float)
+    nu = np.asarray(profiles["solid_fraction"], float)
+    data["y"] = y
+    if "edges" in profiles:
+        data["edges"] = np.asarray(profiles["edges"], float)
+
+    # shear rate and S
+    rate = shear_rate(profiles)
+    if np.isfinite(rate[0]).any():
+        data["shear_rate"], data["shear_rate_err"] = rate
+        for variant in ("text", "listing"):
+            data[f"S_{variant}"], data[f"S_{variant}_err"] = s_parameter(profiles, variant,
+                                                                         rate=rate)
+    else:
+        skipped["shear_rate, S_text, S_listing, f_*"] = "fewer than two bins hold particles"
+
+    def coefficients(suffix: str, txy, txy_e, tyy, tyy_e) -> None:
+        if "shear_rate" not in data:
+            return
+        for name, tau, err in (("f_s", txy, txy_e), ("f_N", tyy, tyy_e)):
+            data[f"{name}{suffix}"], data[f"{name}{suffix}_err"] = bagnold_coefficients(
+                tau, rate[0], dim, "campbell", err, rate[1])
+
+    # the measured stress
+    stress = results.groups.get("stress") or results.groups.get("statistics/stress") or {}
+    measured = [p for p in ("contact", "collisional") if p in stress]
+    n = y.size
+    if not stress or "total" not in stress:
+        skipped["tau_xy, tau_yy, pressure, f_s, f_N, friction, chi"] = "no /stress"
+    elif not measured:
+        skipped["tau_xy, tau_yy, pressure, f_s, f_N, friction, chi"] = (
+            "/stress holds only the kinetic part (no contact or collisional stress)")
+    elif np.asarray(stress["total"]).shape[0] != n:
+        skipped["tau_xy, tau_yy, pressure, f_s, f_N, friction, chi"] = (
+            "/stress bins differ from the /profiles bins")
+    else:
+        total = np.asarray(stress["total"], float)
+        total_err = np.asarray(stress.get("total_err", np.zeros_like(total)), float)
+        txy, txy_e = -total[:, 0, 1], total_err[:, 0, 1]
+        tyy, tyy_e = total[:, 1, 1], total_err[:, 1, 1]
+        diag = np.arange(dim)
+        p = total[:, diag, diag].sum(1) / dim
+        p_e = np.sqrt((total_err[:, diag, diag] ** 2).sum(1)) / dim
+        data.update(tau_xy=txy, tau_xy_err=txy_e, tau_yy=tyy, tau_yy_err=tyy_e,
+                    pressure=p, pressure_err=p_e)
+        coefficients("", txy, txy_e, tyy, tyy_e)
+        data["friction"], data["friction_err"] = friction_coefficient(txy, tyy, txy_e, tyy_e)
+        data["chi"], data["chi_err"] = equation_of_state(profiles, p, p_e)
+        attrs["stress_parts"] = "kinetic + " + " + ".join(measured)
+
+    # the momentum balance
+    balance_names = ("balance_tau_xy, balance_tau_yy, f_s_balance, f_N_balance, "
+                     "friction_balance, chi_balance")
+    if scene.gravity_vector is None:
+        skipped[balance_names] = "no gravity"
+    else:
+        bal = None
+        if "balance_tau_xy" in stress and np.asarray(stress["balance_tau_xy"]).shape == (n,):
+            bal = {k: np.asarray(stress[f"balance_{k}"], float)
+                   for k in ("tau_xy", "tau_yy", "tau_xy_err", "tau_yy_err")
+                   if f"balance_{k}" in stress}
+            attrs["balance_source"] = "/stress (" + str(
+                (results.group_attrs.get("stress") or {}).get("balance", "as stored")) + ")"
+        else:
+            top = (0.0, 0.0)
+            upper = scene.wall("upper")
+            why = None
+            if upper is not None:
+                if "wall_force_upper" in results.timeseries:
+                    section = float(np.prod([scene.box.size[i] for i in range(dim) if i != 1]))
+                    area = (results.timeseries.get("width", section) if dim == 2 else section)
+                    start = float(results.attrs.get("equilibration_end", 0.0))
+                    column, _ = wall_stress(results.timeseries, "upper", area, start)
+                    top = (-float(column[0]), float(column[1]))
+                else:
+                    why = "an upper wall whose force is not in /timeseries"
+            if why is None:
+                bal = momentum_balance_stress(profiles, scene, top_stress=top)
+                attrs["balance_source"] = ("steady momentum balance from the profiles, "
+                                           + ("the upper wall's stress" if upper is not None
+                                              else "a free surface"))
+            else:
+                skipped[balance_names] = why
+        if bal is not None:
+            zero = np.zeros(n)
+            bxy, byy = bal["tau_xy"], bal["tau_yy"]
+            bxy_e, byy_e = bal.get("tau_xy_err", zero), bal.get("tau_yy_err", zero)
+            data.update(balance_tau_xy=bxy, balance_tau_xy_err=bxy_e,
+                        balance_tau_yy=byy, balance_tau_yy_err=byy_e)
+            coefficients("_balance", bxy, bxy_e, byy, byy_e)
+            data["friction_balance"], data["friction_balance_err"] = friction_coefficient(
+                bxy, byy, bxy_e, byy_e)
+            data["chi_balance"], data["chi_balance_err"] = equation_of_state(profiles, byy,
+                                                                             byy_e)
+
+    # kinetic theory's chi
+    law = scene.contact.law.model
+    if law == "constant":
+        with np.errstate(divide="ignore", invalid="ignore"):
+            chi = np.asarray(campbell_chi(np.nan_to_num(nu), dim, scene.contact.restitution),
+                             float)
+        data["chi_theory"] = np.where(np.isfinite(nu) & (nu > 0), chi, np.nan)
+    else:
+        skipped["chi_theory"] = f"restitution law {law!r} is not constant"
+
+    # wall slip
+    if not scene.walls:
+        skipped["slip"] = "no walls"
+    for wall in scene.walls:
+        side = wall.side
+        position = _production_mean(results, f"wall_position_{side}")
+        position = scene.wall_position(side) if position is None else position
+        speed = _production_mean(results, f"wall_velocity_{side}")
+        speed = float(wall.velocity) if speed is None else speed
+        try:
+            slip, err = wall_slip(profiles, position, side, speed, slip_method, n_fit)
+        except ValueError as exc:
+            skipped[f"slip_{side}"] = str(exc)
+            continue
+        data[f"slip_{side}"], data[f"slip_{side}_err"] = np.float64(slip), np.float64(err)
+        attrs[f"slip_{side}_wall_position"] = position
+        attrs[f"slip_{side}_wall_velocity"] = speed
+    if scene.walls:
+        attrs["slip_method"] = slip_method if slip_method != "extrapolate" else \
+            f"extrapolate: straight line through the {n_fit} finite bins nearest the wall"
+
+    # Enskog Knudsen number
+    if scene.y_periodic:
+        width, what = float(scene.box.size[1]), "periodic height"
+    elif scene.has_open_top:
+        width = campbell_depth(profiles, scene.wall_position("lower"))
+        what = "flow depth (campbell_depth)"
+    else:
+        gap = _production_mean(results, "gap")
+        width = (scene.wall_position("upper") - scene.wall_position("lower")
+                 if gap is None else gap)
+        what = "wall gap" + (" (mean over production)" if gap is not None else "")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = np.asarray(mean_free_path(nu, dim), float)
+    lam = np.where(np.isfinite(lam) & (nu > 0), lam, np.nan)
+    data["lambda_enskog"] = lam
+    data["knudsen_enskog"] = lam / width
+    attrs["knudsen_width"], attrs["knudsen_width_is"] = width, what
+    return finish()

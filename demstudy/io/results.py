@@ -1,17 +1,31 @@
 """The results file: one HDF5 layout for every engine (see docs/results-format.md).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
-or the shear rate sets the time scale); the root attribute ``units`` says so in every file.
+or the shear rate sets the time scale); the root attribute ``units`` says so in every file and
+``time_unit`` says what the time unit τ of this scene is. Every dataset carries the attributes
+``units`` and ``description`` (:mod:`demstudy.io.fields`).
 Writes are atomic: the file is built in memory, written under a temporary name, flushed
 and renamed into place.
+
+Attributes keep their Python types: int, float, bool and str are stored as HDF5 scalars and
+read back as int, float, bool and str (numpy scalars come back as the Python type); numpy
+arrays as arrays (read back as arrays). ``None``, dicts, lists and tuples are stored as JSON
+text and their names listed in the attribute ``json_attributes`` (a JSON list) of the same
+object; they read back as None, dict (string keys) and list (a tuple becomes a list).
+Anything else is stored as its ``str()``.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
 import io
+import json
 import os
-from collections.abc import Iterator, Mapping
+import platform
+import shlex
+import sys
+import tomllib
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,14 +34,28 @@ import h5py
 import numpy as np
 
 from .. import UNITS_NOTE, __version__
+from .fields import field_info, time_unit
 from .frames import Frame
 
 FORMAT_VERSION = 1
 
 
+JSON_ATTRIBUTES = "json_attributes"
+"""Attribute listing (as a JSON list) the attributes of the same object stored as JSON."""
+
+COMMAND_LINE_ENV = "DEMSTUDY_COMMAND_LINE"
+"""Environment variable carrying the user's command line into engine child processes
+(:func:`set_command_line`)."""
+
+
 @dataclass
 class Results:
-    """In-memory content of a results file."""
+    """In-memory content of a results file.
+
+    ``dataset_attrs``: extra attributes of single datasets, keyed by their path without the
+    leading slash (``"timeseries/time"``), over the ``units`` and ``description`` the writer
+    takes from :mod:`demstudy.io.fields`; :func:`read_results` fills it with every dataset's
+    attributes."""
 
     attrs: dict[str, Any]
     timeseries: dict[str, np.ndarray] = field(default_factory=dict)
@@ -36,43 +64,177 @@ class Results:
     frames: dict[str, np.ndarray] | None = None
     groups: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     group_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
+    dataset_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
-def _write_group(group: h5py.Group, data: Mapping[str, Any], attrs: Mapping[str, Any] = {}) -> None:
+# -- attributes ------------------------------------------------------------------------
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def encode_attr(value: Any) -> tuple[Any, bool]:
+    """(value to store, stored as JSON?) for one attribute (conventions: module doc)."""
+    if value is None or isinstance(value, dict | list | tuple):
+        return json.dumps(value, default=_json_default), True
+    if isinstance(value, np.ndarray) and value.dtype.kind in "UO":
+        return json.dumps(value.tolist(), default=_json_default), True
+    if isinstance(value, str | bytes | bool | int | float | np.generic | np.ndarray):
+        return value, False
+    return str(value), False
+
+
+def decode_attr(value: Any, is_json: bool = False) -> Any:
+    """The Python value of a stored attribute (inverse of :func:`encode_attr`)."""
+    if isinstance(value, bytes):
+        value = value.decode()
+    if isinstance(value, h5py.Empty):
+        return None
+    if is_json and isinstance(value, str):
+        return json.loads(value)
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def write_attrs(obj: h5py.HLObject, attrs: Mapping[str, Any]) -> None:
+    """Store ``attrs`` on an HDF5 group, dataset or file keeping their types (module doc)."""
+    as_json = []
+    for key, value in attrs.items():
+        if key == JSON_ATTRIBUTES:
+            continue
+        stored, is_json = encode_attr(value)
+        obj.attrs[key] = stored
+        if is_json:
+            as_json.append(key)
+    if as_json:
+        obj.attrs[JSON_ATTRIBUTES] = json.dumps(as_json)
+
+
+def read_attrs(obj: h5py.HLObject) -> dict[str, Any]:
+    """The attributes of an HDF5 object as written by :func:`write_attrs`."""
+    listed = obj.attrs.get(JSON_ATTRIBUTES)
+    as_json = set(json.loads(decode_attr(listed))) if listed is not None else set()
+    return {k: decode_attr(v, k in as_json) for k, v in obj.attrs.items()
+            if k != JSON_ATTRIBUTES}
+
+
+# -- provenance ------------------------------------------------------------------------
+def set_command_line(argv: Sequence[str]) -> None:
+    """Record the user's command line (e.g. ``["demstudy", *sys.argv[1:]]``) for every
+    results file written by this process and its children (engine child processes and MPI
+    ranks inherit the environment)."""
+    os.environ[COMMAND_LINE_ENV] = shlex.join(str(a) for a in argv)
+
+
+def current_command_line() -> str:
+    """The command line a results file records: :func:`set_command_line`'s, else this
+    process's ``sys.argv``."""
+    return os.environ.get(COMMAND_LINE_ENV) or shlex.join(sys.argv)
+
+
+def software_versions() -> dict[str, str]:
+    return {"demstudy_version": __version__, "python_version": platform.python_version(),
+            "numpy_version": np.__version__, "h5py_version": h5py.__version__,
+            "hdf5_version": h5py.version.hdf5_version}
+
+
+def _scene_data(attrs: Mapping[str, Any]) -> dict | None:
+    text = attrs.get("scene_toml")
+    if not isinstance(text, str):
+        return None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        return None
+
+
+def root_attrs(results: Results, command_line: str | None = None) -> dict[str, Any]:
+    """The root attributes written: the defaults below, then ``results.attrs`` (a file read
+    back and written again keeps its run's ``created``, ``command_line`` and versions, and
+    records the latest writer in ``last_written_by``)."""
+    now = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+    command = command_line or current_command_line()
+    scene = _scene_data(results.attrs)
+    attrs: dict[str, Any] = {
+        "format_version": FORMAT_VERSION,
+        **software_versions(),
+        "units": UNITS_NOTE,
+        "created": now,
+        "command_line": command,
+    }
+    if scene is not None:
+        try:
+            attrs["time_unit"] = time_unit(scene)
+        except (TypeError, ValueError, AttributeError):
+            pass
+    attrs.setdefault("time_unit", "not recorded: the file holds no readable scene_toml "
+                                  "(see docs/scenes.md, 'Units and axes')")
+    rewrite = "created" in results.attrs
+    attrs.update(results.attrs)
+    if command_line is not None:
+        attrs["command_line"] = command_line
+    if rewrite:
+        versions = ", ".join(f"{k.removesuffix('_version')} {v}"
+                             for k, v in software_versions().items())
+        attrs["last_written_by"] = f"{command} ({versions}; {now})"
+    return attrs
+
+
+def _dim(attrs: Mapping[str, Any]) -> int | None:
+    scene = _scene_data(attrs)
+    dim = scene.get("dimension") if scene else None
+    return dim if dim in (2, 3) else None
+
+
+# -- writing and reading ---------------------------------------------------------------
+def _write_group(group: h5py.Group, data: Mapping[str, Any], attrs: Mapping[str, Any] = {},
+                 dataset_attrs: Mapping[str, Mapping[str, Any]] = {},
+                 dim: int | None = None) -> None:
+    key = group.name.lstrip("/")
     for name, value in data.items():
         arr = np.asarray(value)
         kwargs = {"compression": "gzip", "compression_opts": 4} if arr.size > 4096 else {}
-        group.create_dataset(name, data=arr, **kwargs)
-    for key, value in attrs.items():
-        group.attrs[key] = value
+        dataset = group.create_dataset(name, data=arr, **kwargs)
+        write_attrs(dataset, {**field_info(key, name, dim),
+                              **dataset_attrs.get(f"{key}/{name}", {})})
+    write_attrs(group, attrs)
 
 
-def write_results(path: str | os.PathLike, results: Results) -> Path:
+def write_results(path: str | os.PathLike, results: Results,
+                  command_line: str | None = None) -> Path:
     """Write ``results`` to ``path`` atomically: the HDF5 image is built in memory, written
     to a temporary file in the same folder, flushed to disk, then renamed into place. A full
     disk or another I/O error raises a plain ``OSError`` and leaves neither a partial file nor
     the temporary one (HDF5 itself is never asked to write to a failing disk: a library
-    error there can crash the process)."""
+    error there can crash the process).
+
+    ``command_line``: what the root attribute ``command_line`` records (default: the one
+    given to :func:`set_command_line`, else ``sys.argv``; a file read back keeps its own).
+    Every dataset gets ``units`` and ``description`` (:func:`demstudy.io.fields.field_info`,
+    overridden by ``results.dataset_attrs``)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     image = io.BytesIO()
+    attrs = root_attrs(results, command_line)
+    dim = _dim(attrs)
+    extra = results.dataset_attrs
     with h5py.File(image, "w") as f:
-        attrs = {
-            "format_version": FORMAT_VERSION,
-            "demstudy_version": __version__,
-            "units": UNITS_NOTE,
-            "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
-            **results.attrs,
-        }
-        for key, value in attrs.items():
-            f.attrs[key] = value
-        _write_group(f.create_group("timeseries"), results.timeseries)
+        write_attrs(f, attrs)
+        _write_group(f.create_group("timeseries"), results.timeseries, {}, extra, dim)
         if results.profiles:
-            _write_group(f.create_group("profiles"), results.profiles, results.profile_attrs)
+            _write_group(f.create_group("profiles"), results.profiles, results.profile_attrs,
+                         extra, dim)
         if results.frames:
-            _write_group(f.create_group("frames"), results.frames)
+            _write_group(f.create_group("frames"), results.frames, {}, extra, dim)
         for name, data in results.groups.items():
-            _write_group(f.require_group(name), data, results.group_attrs.get(name, {}))
+            _write_group(f.require_group(name), data, results.group_attrs.get(name, {}),
+                         extra, dim)
     write_atomically(path, image.getbuffer())
     return path
 
@@ -96,28 +258,35 @@ def write_atomically(path: Path, data: bytes | memoryview) -> None:
 
 def read_results(path: str | os.PathLike, skip: tuple[str, ...] = ()) -> Results:
     """Read a results file written by any engine; ``skip``: top-level groups not to read
-    (e.g. ``("frames", "collisions")``, the large ones, when only the figures are wanted)."""
-    def decode(value: Any) -> Any:
-        return value.decode() if isinstance(value, bytes) else value
-
+    (e.g. ``("frames", "collisions")``, the large ones, when only the figures are wanted).
+    Attributes come back with the types they were written with (module doc)."""
     with h5py.File(path, "r") as f:
+        res = Results(attrs=read_attrs(f))
+
+        def datasets(group: h5py.Group) -> dict[str, np.ndarray]:
+            out = {}
+            for k, v in group.items():
+                if isinstance(v, h5py.Dataset):
+                    out[k] = v[()]
+                    res.dataset_attrs[v.name.lstrip("/")] = read_attrs(v)
+            return out
+
         def load(name: str) -> dict[str, np.ndarray]:
             if name not in f or name in skip:
                 return {}
-            return {k: v[()] for k, v in f[name].items() if isinstance(v, h5py.Dataset)}
+            return datasets(f[name])
 
-        res = Results(attrs={k: decode(v) for k, v in f.attrs.items()},
-                      timeseries=load("timeseries"), profiles=load("profiles"),
-                      frames=load("frames") or None)
+        res.timeseries, res.profiles = load("timeseries"), load("profiles")
+        res.frames = load("frames") or None
         if "profiles" in f:
-            res.profile_attrs = {k: decode(v) for k, v in f["profiles"].attrs.items()}
+            res.profile_attrs = read_attrs(f["profiles"])
 
         def collect(group: h5py.Group) -> None:
-            datasets = {k: v[()] for k, v in group.items() if isinstance(v, h5py.Dataset)}
-            if datasets:
+            found = datasets(group)
+            if found:
                 key = group.name.lstrip("/")
-                res.groups[key] = datasets
-                res.group_attrs[key] = {k: decode(v) for k, v in group.attrs.items()}
+                res.groups[key] = found
+                res.group_attrs[key] = read_attrs(group)
             for item in group.values():
                 if isinstance(item, h5py.Group):
                     collect(item)

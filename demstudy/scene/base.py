@@ -8,6 +8,16 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, model_validator
 
 
+class SceneError(ValueError):
+    """Invalid scene: the message names each field, its value and what is allowed."""
+
+    def __init__(self, source: str, problems: list[str]):
+        self.source = source
+        self.problems = problems
+        lines = "\n".join(f"  - {p}" for p in problems)
+        super().__init__(f"invalid scene {source}:\n{lines}")
+
+
 def nearest(name: str, allowed: list[str]) -> str | None:
     """The allowed name closest to ``name`` (None when nothing is close)."""
     found = difflib.get_close_matches(name, allowed, n=1, cutoff=0.5)

@@ -3,27 +3,19 @@
 from __future__ import annotations
 
 import copy
+import os
 import re
 import tomllib
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from pydantic import ValidationError
 
-from .base import nearest
+from . import presets
+from .base import SceneError, nearest
 from .scene import Scene
-
-
-class SceneError(ValueError):
-    """Invalid scene: the message names each field, its value and what is allowed."""
-
-    def __init__(self, source: str, problems: list[str]):
-        self.source = source
-        self.problems = problems
-        lines = "\n".join(f"  - {p}" for p in problems)
-        super().__init__(f"invalid scene {source}:\n{lines}")
-
 
 _TANGENTIAL_TAGS = ("smooth", "beta", "rough", "coulomb", "campbell-noslip")
 
@@ -152,10 +144,116 @@ def parse_scene_text(text: str, source: str = "<scene>") -> dict:
         raise SceneError(source, [f"not valid TOML: {exc}"]) from None
 
 
-def load_scene(path: str | Path, overrides: Iterable[str] = ()) -> Scene:
-    """Read a TOML scene, apply ``--set`` overrides, validate; raise ``SceneError`` if invalid."""
-    data = apply_overrides(read_scene_data(path), overrides, source=str(path))
-    return validate_scene(data, str(path))
+def resolve_scene(source: str | os.PathLike) -> tuple[Path, str]:
+    """The file of ``source`` and the name errors give it: an existing file (it wins), else
+    the preset of that name (:mod:`demstudy.scene.presets`). Neither: ``SceneError`` saying
+    why the file cannot be read and which presets are close."""
+    path = Path(source)
+    if path.is_file():
+        return path, str(path)
+    found = presets.find_preset(str(source))
+    if found is not None:
+        return found, f"{presets.normalise(str(source))} (preset {found})"
+    try:
+        path.read_bytes()
+        reason = "not a file"
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+    problem = f"cannot read the file: {reason}"
+    if not path.is_absolute():  # a relative name may have meant a preset
+        problem += "; " + presets.unknown_preset_problem(str(source))
+    raise SceneError(str(source), [problem])
+
+
+def _plain(value: Any) -> Any:
+    """numpy scalars and arrays as Python numbers and lists; tuples as lists (TOML types)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def apply_sections(data: dict, sections: Mapping[str, Any], source: str = "keywords") -> dict:
+    """Return a copy of ``data`` with keyword sections merged in (``load_scene(…, run={…})``).
+
+    Each key is a top-level section (``run``, ``walls``, ``dimension``, …); its value is
+    merged into the scene data before validation:
+
+    * a dict merges into a table key by key, recursively (like one ``--set`` per leaf);
+    * a dict with integer keys merges into a list item by index
+      (``walls={0: {"restitution": 0.9}}``); a list replaces the whole list;
+    * any other value replaces the key; ``None`` removes it (the schema default applies).
+
+    Unknown sections and bad indices raise ``SceneError`` naming the field; keys inside a
+    section are checked by the validation (``run: unknown key 'prodution'; did you mean
+    'production'?``).
+    """
+    data = copy.deepcopy(data)
+    problems: list[str] = []
+
+    def merge(node: dict | list, key: Any, value: Any, where: str) -> None:
+        value = _plain(value)
+        if isinstance(node, list):
+            if isinstance(key, str) and key.isdigit():
+                key = int(key)
+            if isinstance(key, bool) or not isinstance(key, int) or not 0 <= key < len(node):
+                problems.append(f"{where}: {key!r} is not an index of a list of {len(node)} "
+                                "(give a whole list to replace it)")
+                return
+        elif not isinstance(key, str):
+            problems.append(f"{where}: a table's keys are strings, got {key!r}")
+            return
+        if value is None:
+            if isinstance(node, list):
+                problems.append(f"{where}: None cannot remove a list item (give the whole list)")
+            else:
+                node.pop(key, None)
+            return
+        current = node[key] if isinstance(node, list) else node.get(key)
+        if isinstance(value, Mapping) and isinstance(current, dict | list):
+            for sub, item in value.items():
+                label = f"{where}[{sub}]" if isinstance(current, list) else f"{where}.{sub}"
+                merge(current, sub, item, label)
+        elif isinstance(value, Mapping):
+            fresh: dict = {}
+            for sub, item in value.items():
+                merge(fresh, sub, item, f"{where}.{sub}")
+            node[key] = fresh
+        else:
+            node[key] = copy.deepcopy(value)
+
+    for name, value in sections.items():
+        if name not in Scene.model_fields:
+            hint = nearest(name, sorted(Scene.model_fields))
+            problems.append(f"{name}: unknown section {name!r}"
+                            + (f"; did you mean {hint!r}?" if hint else "")
+                            + f" (sections: {', '.join(sorted(Scene.model_fields))})")
+            continue
+        merge(data, name, value, name)
+    if problems:
+        raise SceneError(source, problems)
+    return data
+
+
+def load_scene(source: str | os.PathLike, overrides: Iterable[str] = (),
+               **sections: Any) -> Scene:
+    """Read a scene, apply overrides, validate; raise ``SceneError`` if anything is invalid.
+
+    ``source``: a TOML file, or a preset name such as ``"campbell1982/chute-30"`` (see
+    :func:`demstudy.scene.presets.list_presets`; an existing file of that name wins).
+    ``sections``: typed values merged in first (:func:`apply_sections`), e.g.
+    ``load_scene("campbell1982/couette-noslip", run={"production": 50})``;
+    ``overrides``: ``--set`` strings ``key.path=value`` applied after them.
+    """
+    path, name = resolve_scene(source)
+    data = read_scene_data(path)
+    if sections:
+        data = apply_sections(data, sections, source=f"{name} (keyword overrides)")
+    data = apply_overrides(data, overrides, source=name)
+    return validate_scene(data, name)
 
 
 def scene_to_toml(scene: Scene) -> str:
