@@ -7,6 +7,7 @@ All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gra
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -243,8 +244,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     from .errors import EngineError, RunRefused, RunStopped, UnsupportedByEngine
+    from .io.results import COMMAND_LINE_ENV, set_command_line
 
     args = build_parser().parse_args(argv)
+    previous = os.environ.get(COMMAND_LINE_ENV)
+    set_command_line(["demstudy", *(sys.argv[1:] if argv is None else argv)])
     try:
         return args.func(args)
     except (SceneError, UnsupportedByEngine, EngineError, ValueError, OSError) as exc:
@@ -255,6 +259,11 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:  # outside a run loop (which checkpoints and stops by itself)
         print("error: interrupted", file=sys.stderr)
         return 130
+    finally:  # the results files written by this call (and its children) record it
+        if previous is None:
+            os.environ.pop(COMMAND_LINE_ENV, None)
+        else:
+            os.environ[COMMAND_LINE_ENV] = previous
 
 
 if __name__ == "__main__":

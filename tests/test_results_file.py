@@ -192,7 +192,8 @@ def test_every_dataset_of_real_runs_is_in_the_units_table(tmp_path):
 
     couette, shear = tmp_path / "couette.h5", tmp_path / "shear.h5"
     assert main(["run", "campbell1982/couette-rough", "--engine", "edmd", "-q",
-                 "--keep-frames", "--set", "run.production=5", "--out", str(couette)]) == 0
+                 "--keep-frames", "--set", "run.production=5",
+                 "--set", 'measure.statistics=["profiles", "stress"]', "--out", str(couette)]) == 0
     assert main(["analyze", str(couette), "--what",
                  "profiles,vdf,gr,vcorr,waves,cgprofiles,stress,structure"]) == 0
     assert main(["run", "shear/lees-edwards-3d", "--engine", "edmd", "-q",

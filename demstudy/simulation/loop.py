@@ -211,7 +211,10 @@ class Simulation:
         statistics = scene.measure.statistics
         self.streams = [s for s in statistics if STATISTICS[s].source == "stream"
                         and s != "profiles"]
+        # computed at the end: from the kept frames or log, then from the results so far
         self.after = [s for s in statistics if STATISTICS[s].source in ("frames", "collisions")]
+        self.after += [s for s, stat in STATISTICS.items() if stat.source == "results"
+                       and s != "stress" and (stat.every_run or s in statistics)]
         self.measure_stress = "stress" in statistics
         frames_needed = any(STATISTICS[s].source == "frames" for s in statistics)
         keep = options.keep_frames
