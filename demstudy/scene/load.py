@@ -182,7 +182,10 @@ def apply_sections(data: dict, sections: Mapping[str, Any], source: str = "keywo
     Each key is a top-level section (``run``, ``walls``, ``dimension``, …); its value is
     merged into the scene data before validation:
 
-    * a dict merges into a table key by key, recursively (like one ``--set`` per leaf);
+    * a dict merges into a table key by key, recursively (like one ``--set`` per leaf),
+      except that a dict naming another ``model`` than the table's replaces the table (a
+      tangential rule or restitution law of another model keeps none of the old one's
+      parameters);
     * a dict with integer keys merges into a list item by index
       (``walls={0: {"restitution": 0.9}}``); a list replaces the whole list;
     * any other value replaces the key; ``None`` removes it (the schema default applies).
@@ -213,6 +216,9 @@ def apply_sections(data: dict, sections: Mapping[str, Any], source: str = "keywo
                 node.pop(key, None)
             return
         current = node[key] if isinstance(node, list) else node.get(key)
+        if (isinstance(value, Mapping) and isinstance(current, dict)
+                and "model" in value and value["model"] != current.get("model")):
+            current = None  # another model: a fresh table
         if isinstance(value, Mapping) and isinstance(current, dict | list):
             for sub, item in value.items():
                 label = f"{where}[{sub}]" if isinstance(current, list) else f"{where}.{sub}"

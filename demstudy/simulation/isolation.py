@@ -40,6 +40,8 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     payload = {
         "units": UNITS_NOTE,
         "engine": backend.name,
+        # by import path: a backend registered in this process runs in the child too
+        "backend": f"{backend.__module__}:{backend.__qualname__}",
         "scene": scene.model_dump(mode="json"),
         "out": str(Path(options.out).resolve()),
         "dump": str(Path(options.dump).resolve()) if options.dump else None,
@@ -98,13 +100,14 @@ def _die_with_parent() -> None:
 
 
 def worker(job: str) -> int:
-    from ..engines import get_backend
+    from ..engines import get_backend, register_backend
     from ..errors import UnsupportedByEngine
     from ..scene import validate_scene
     from ..scene.load import SceneError
     from .loop import Simulation
 
     payload = json.loads(Path(job).read_text())
+    register_backend(payload["backend"], payload["engine"])
     scene = validate_scene(payload["scene"], source=job)
     options = RunOptions(out=Path(payload["out"]), np=payload["np"],
                          dump=Path(payload["dump"]) if payload["dump"] else None,

