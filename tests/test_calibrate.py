@@ -20,6 +20,7 @@ from demstudy.contact.mapping import (
     walton_beta,
 )
 from demstudy.engines.lammps.calibrate import calibrate, collide, rolling_acceleration
+from demstudy.engines.lammps.deck.contact import granular_args
 from demstudy.engines.lammps.library import open_lammps
 
 DIMS_KINDS = [(2, "pair"), (2, "wall"), (3, "pair"), (3, "wall")]
@@ -76,7 +77,7 @@ def test_smooth_deck_holds_no_history():
         lmp.commands_string("\n".join([
             "units lj", "dimension 2", "atom_style sphere", "region box block -2 2 -2 2 -1 1",
             "create_box 1 box", "create_atoms 1 single 0 0 0", "comm_modify vel yes",
-            "pair_style granular", f"pair_coeff * * {p.granular_args()}",
+            "pair_style granular", f"pair_coeff * * {granular_args(p)}",
             "fix 1 all nve/sphere disc", "fix 2 all enforce2d", "run 0"]))
         assert "NEIGH_HISTORY_GRANULAR" not in lmp.available_ids("fix")
     finally:

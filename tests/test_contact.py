@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from demstudy.contact import mapping as cm
+from demstudy.engines.lammps.deck.contact import granular_args
 
 
 def _oscillator(kn: float, gamma: float, m: float, v: float) -> tuple[float, float, float]:
@@ -116,21 +117,21 @@ def test_walton_rule():
 def test_granular_args():
     smooth = cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.5)
     assert smooth.tangential == "none"
-    assert smooth.granular_args() == (
+    assert granular_args(smooth) == (
         "hooke 100000 0.9 damping coeff_restitution tangential linear_nohistory 0.0 0.0")
-    assert "linear_history" not in smooth.granular_args()
+    assert "linear_history" not in granular_args(smooth)
     assert cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.5, beta=-1.0).tangential == "none"
     spring = cm.make_contact(kn=1e5, e=0.6, m_eff=0.5, K=0.5, beta=0.4)
-    args = spring.granular_args().split()
+    args = granular_args(spring).split()
     assert args[:7] == ["hooke", "100000", "0.6", "damping", "coeff_restitution",
                         "tangential", "linear_history"]
     assert float(args[7]) == pytest.approx(spring.kt) and args[8:] == ["0.0", "1e+20"]
     coul = cm.make_contact(kn=1e5, e=0.6, m_eff=0.5, K=0.5, mu=0.3, beta0=0.4)
     assert coul.tangential == "coulomb" and coul.kt == pytest.approx(spring.kt)
-    assert coul.granular_args().endswith(" 0.0 0.3")
+    assert granular_args(coul).endswith(" 0.0 0.3")
     hz = cm.make_contact(kn=1e6, e=0.6, m_eff=0.5, K=0.4, beta=0.0, model="hertz",
                          r_eff=0.25, speed=1.0)
-    assert hz.granular_args().startswith("hertz 1000000 0.6 damping coeff_restitution")
+    assert granular_args(hz).startswith("hertz 1000000 0.6 damping coeff_restitution")
 
 
 def test_contact_parameter_validation():

@@ -1,7 +1,10 @@
-"""Contact models: hard-particle collision rules (e, beta, mu) <-> LAMMPS granular parameters.
+"""Contact models: hard-particle collision rules (e, beta, mu) <-> soft-contact parameters.
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. ``mapping`` is pure
-Python; ``calibrate`` runs isolated LAMMPS collisions to measure what the mapping promises.
+Python (Hooke and Hertz contacts with restitution damping and tangential springs);
+``stiffness`` chooses a scene's stiffness and time step; ``calibration`` holds the rows and
+table of binary-collision calibrations, which each soft-contact engine measures in its own
+collisions (``demstudy calibrate``).
 """
 
 from demstudy.contact.mapping import (

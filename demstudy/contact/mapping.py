@@ -31,9 +31,6 @@ from scipy.integrate import solve_ivp
 Model = Literal["hooke", "hertz"]
 Tangential = Literal["none", "spring", "coulomb"]
 
-UNCAPPED_MU = 1e20
-"""Friction coefficient written to LAMMPS for an uncapped ('spring') tangential contact."""
-
 
 # ---------------------------------------------------------------- masses, radii, inertia
 def pair_mass(m1: float, m2: float) -> float:
@@ -226,10 +223,12 @@ def walton_beta(mu: float, beta0: float, e: float, K: float, ratio: float) -> fl
     return min(beta0, -1.0 + mu * (1.0 + e) * (1.0 + 1.0 / K) / ratio)
 
 
-# ---------------------------------------------------------------- the LAMMPS parameter set
+# ---------------------------------------------------------------- the soft-contact parameter set
 @dataclass(frozen=True)
 class ContactParameters:
-    """One LAMMPS ``granular`` contact (pair or wall), dimensionless particle units.
+    """One soft contact (pair or wall), dimensionless particle units: Hooke or Hertz normal
+    force with the restitution damping model (LAMMPS's ``damping coeff_restitution``) and a
+    tangential spring, uncapped or Coulomb-capped.
 
     ``mu`` None means no Coulomb cap; ``contact_time`` is the damped normal contact time (for
     hertz at the impact speed the parameters were made for).
@@ -259,14 +258,6 @@ class ContactParameters:
 
     def timestep(self, steps_per_contact: float) -> float:
         return timestep(self.contact_time, steps_per_contact)
-
-    def granular_args(self) -> str:
-        """Model string after ``pair_coeff * *`` or after ``fix ID group wall/gran granular``."""
-        normal = f"{self.model} {self.kn:.12g} {self.restitution:.12g} damping coeff_restitution"
-        if self.tangential == "none":
-            return f"{normal} tangential linear_nohistory 0.0 0.0"
-        mu = UNCAPPED_MU if self.mu is None else self.mu
-        return f"{normal} tangential linear_history {self.kt:.12g} 0.0 {mu:.12g}"
 
 
 def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | None = None,

@@ -33,6 +33,7 @@ from ...contact.mapping import (
     spring_beta,
     walton_beta,
 )
+from .deck.contact import granular_args
 from .library import open_lammps
 
 Kind = Literal["pair", "wall"]
@@ -59,11 +60,11 @@ def _open(dim: int, wall: bool, params: ContactParameters, dt: float, d: float, 
     cmds += [f"set type 1 diameter {_f(d)}", f"set type 1 mass {_f(m)}"]
     cmds += [f"set atom {i + 1} vx {_f(a[3])} vy {_f(a[4])} vz {_f(a[5])} omega 0 0 0"
              for i, a in enumerate(atoms)]
-    cmds += ["pair_style granular", f"pair_coeff * * {params.granular_args()}",
+    cmds += ["pair_style granular", f"pair_coeff * * {granular_args(params)}",
              "neighbor 0.2 bin", "neigh_modify every 1 delay 0 check yes",
              f"fix integrate all nve/sphere{' disc' if dim == 2 else ''}"]
     if wall:
-        cmds.append(f"fix wall all wall/gran granular {params.granular_args()} yplane 0.0 NULL")
+        cmds.append(f"fix wall all wall/gran granular {granular_args(params)} yplane 0.0 NULL")
     if gravity is not None:
         cmds.append(f"fix grav all gravity 1.0 vector {_f(gravity[0])} {_f(gravity[1])} 0.0")
     if dim == 2:
