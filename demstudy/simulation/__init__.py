@@ -12,8 +12,9 @@ from pathlib import Path
 from typing import Any
 
 from ..scene import Scene
-from .loop import RunState, Simulation, check_run
-from .options import RunOptions, check_run_options, work_folder
+from .loop import Simulation
+from .options import RunOptions, check_run, check_run_options, work_folder
+from .state import RunState
 
 __all__ = ["RunOptions", "RunState", "Simulation", "check_run", "check_run_options",
            "run_scene", "work_folder"]

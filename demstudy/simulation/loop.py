@@ -20,12 +20,8 @@ rank runs this loop with identical bookkeeping; rank 0 alone analyses and writes
 from __future__ import annotations
 
 import dataclasses
-import math
-import signal
 import sys
-import threading
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -33,22 +29,15 @@ import numpy as np
 from tqdm import tqdm
 
 from .. import UNITS_NOTE, __version__
-from ..analysis.base import AnalysisBase, bin_edges
-from ..analysis.registry import STATISTICS, Context, engine_problems
-from ..analysis.steady import energy_trend, is_steady
-from ..analysis.stress import (
-    CollisionalSums,
-    ContactStress,
-    collisional_stress,
-    momentum_snapshot,
-    stress_results,
-)
+from ..analysis.base import bin_edges
+from ..analysis.registry import STATISTICS, Context
+from ..analysis.stress import CollisionalSums, ContactStress, momentum_snapshot
 from ..analysis.suite import profile_bounds
 from ..effects.servo import ServoController, has_servo, servo_settings
 from ..engines.backend import BackendBase, Needs, frame_mass
-from ..errors import EngineError, RunStopped, UnsupportedByEngine
+from ..errors import EngineError, RunStopped
 from ..io.frames import Frame
-from ..io.results import Results, frames_of, write_results
+from ..io.results import write_results
 from ..scene import Scene, scene_to_toml
 from .checkpoint import (
     CHECKPOINT,
@@ -56,145 +45,17 @@ from .checkpoint import (
     pickle_atomically,
     refuse_foreign_checkpoint,
 )
-from .options import RunOptions, check_run_options, frames_on_resume, work_folder
+from .options import RunOptions, check_run, frames_on_resume, work_folder
+from .results import run_results
+from .schedule import Schedule, StopInInterval, StopRequest
+from .state import RunState
 
-__all__ = ["RunState", "Simulation", "StopRequest", "check_run", "run_attrs"]
+__all__ = ["Simulation"]
 
 LOOP_VERSION = f"demstudy {__version__} (simulation loop 1)"
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 #: collision-log records kept per run (sampled every ``log_every`` collisions)
 LOG_CAPACITY = 200_000
-
-
-def check_run(backend: type[BackendBase], scene: Scene, options: RunOptions) -> None:
-    """Everything refused before any engine starts: the run options, the effects and the
-    statistics the engine cannot supply (``UnsupportedByEngine``)."""
-    check_run_options(backend, options)
-    backend.check(scene, options)
-    for field_name, value, reason in engine_problems(scene, backend.capabilities):
-        raise UnsupportedByEngine(backend.name, field_name, value, reason)
-    log_every = int(options.extra.get("log_every", 1))
-    for name in scene.measure.statistics:
-        if STATISTICS[name].log_every and log_every != 1:
-            raise UnsupportedByEngine(backend.name, "--log-every", log_every,
-                                      f"{name!r} needs every collision logged (1)")
-
-
-def run_attrs(scene: Scene, engine: str, version: str, wall_seconds: float,
-              equilibration_end: float, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
-    """Root attributes every results file carries, with Campbell's steadiness verdict over the
-    production samples (those after ``equilibration_end``)."""
-    t = timeseries["time"]
-    production = t > equilibration_end + 1e-9 * max(1.0, abs(equilibration_end))
-    trend = energy_trend(t[production], timeseries["kinetic_energy"][production])
-    return {
-        "engine": engine,
-        "engine_version": version,
-        "scene_toml": scene_to_toml(scene),
-        "scene_name": scene.meta.name,
-        "seed": scene.run.seed,
-        "run_unit": scene.run.unit,
-        "wall_seconds": wall_seconds,
-        "equilibration_end": equilibration_end,
-        "kinetic_energy_trend": trend,
-        "steady": is_steady(trend),
-    }
-
-
-class StopRequest:
-    """Ctrl-C (SIGINT, main thread only) or a wall-clock limit asks the run loop to stop at
-    the end of its current segment; ``with StopRequest(limit) as stop: … stop.reason``."""
-
-    def __init__(self, wall_limit: float | None):
-        self.wall_limit = wall_limit
-        self.reason: str | None = None
-        self.started = time.perf_counter()
-        self._previous = None
-
-    def request(self, _signum=None, _frame=None) -> None:
-        self.reason = self.reason or "interrupted"
-
-    def check(self) -> bool:
-        """True once a stop was asked for (checks the wall-clock limit too)."""
-        elapsed = time.perf_counter() - self.started
-        if self.wall_limit is not None and elapsed > self.wall_limit:
-            self.reason = self.reason or "wall-clock limit"
-        return self.reason is not None
-
-    def __enter__(self) -> StopRequest:
-        if threading.current_thread() is threading.main_thread():
-            self._previous = signal.signal(signal.SIGINT, self.request)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
-
-
-class _StopInInterval(Exception):
-    """A stop request honoured between two event chunks, inside a sample interval."""
-
-
-@dataclass(frozen=True)
-class Schedule:
-    """Samples every ``interval`` (time, or collisions per particle); ``n_eq`` of them in
-    equilibration, ``n_total`` in all, a checkpoint every ``n_ckpt`` (0: none)."""
-
-    interval: float
-    n_eq: int
-    n_total: int
-    n_ckpt: int
-    by_collisions: bool
-
-    @classmethod
-    def of(cls, scene: Scene, options: RunOptions, time_step: float | None) -> Schedule:
-        run = scene.run
-        ckpt = options.checkpoint_interval or run.checkpoint_interval
-        if time_step:  # whole steps: the interval and both phases rounded to them
-            n_sample = max(1, round(run.sample_interval / time_step))
-
-            def steps(duration: float) -> int:
-                return max(0, math.ceil(duration / time_step - 1e-9))
-
-            n_eq = round(steps(run.equilibration) / n_sample)
-            n_prod = max(1, round(steps(run.production) / n_sample))
-            n_ckpt = max(1, round(ckpt / time_step / n_sample)) if ckpt else 0
-            return cls(n_sample * time_step, n_eq, n_eq + n_prod, n_ckpt, False)
-        dt = run.sample_interval
-        n_eq = round(run.equilibration / dt)
-        return cls(dt, n_eq, n_eq + max(1, round(run.production / dt)),
-                   max(1, round(ckpt / dt)) if ckpt else 0, run.unit == "collisions")
-
-
-@dataclass
-class RunState:
-    """Everything the loop needs to continue a run (pickled into checkpoints)."""
-
-    samples: int = 0  # sample intervals done
-    timeseries: dict[str, list] = field(default_factory=dict)
-    frames: dict[str, list] = field(default_factory=dict)
-    keep_frames: bool = False  # fixed when the run starts, kept on resume
-    profiles: AnalysisBase | None = None
-    streams: dict[str, AnalysisBase] = field(default_factory=dict)  # other stream statistics
-    stress: CollisionalSums | ContactStress | None = None
-    stress_edges: np.ndarray | None = None
-    wall_seconds: float = 0.0
-    last_time: float = 0.0
-    last_impulse: dict[str, np.ndarray] = field(default_factory=dict)
-    servo: ServoController | None = None
-    next_servo: int = 0  # collision count of the next servo update
-    next_servo_time: float = 0.0  # time of the next servo update
-    servo_impulse: dict[str, np.ndarray] = field(default_factory=dict)
-    servo_time: float = 0.0
-    log: dict[str, list] = field(default_factory=dict)
-    logged: int = 0
-    # particle y and momenta where production starts and ends (the unsteady momentum term)
-    momentum_start: dict | None = None
-    momentum_end: dict | None = None
-    in_production: bool = False
-
-    def record(self, key: str, value) -> None:
-        self.timeseries.setdefault(key, []).append(value)
 
 
 class Simulation:
@@ -222,7 +83,7 @@ class Simulation:
         log_every = int(options.extra.get("log_every", 0))
         if any(STATISTICS[s].log_every for s in statistics):
             log_every = log_every or 1
-        self.log_every = log_every
+        self.log_every, self.log_capacity = log_every, LOG_CAPACITY
         self.servo_by_time = has_servo(scene) and (
             self.backend.capabilities.time_step or servo_settings(scene).interval_unit == "time")
         self.stop = StopRequest(options.wall_limit)
@@ -233,7 +94,7 @@ class Simulation:
         if self.measure_stress:
             lo, hi, _period = profile_bounds(self.scene)
             bins = (lo, hi, len(bin_edges(lo, hi, self.scene.measure.bin_width)) - 1)
-        return Needs(stress_bins=bins, log_every=self.log_every, log_capacity=LOG_CAPACITY)
+        return Needs(stress_bins=bins, log_every=self.log_every, log_capacity=self.log_capacity)
 
     def _start(self) -> RunState:
         backend, path = self.backend, self.workdir / CHECKPOINT
@@ -268,8 +129,8 @@ class Simulation:
 
     # -- servo ----------------------------------------------------------------------------
     def _servo_interval(self, settings) -> int:
+        """Pair collisions between two updates (Campbell: interval_collisions × N)."""
         return max(1, round(settings.interval_collisions * self.backend.n_particles))
-
 
     def _servo_update(self, state: RunState) -> None:
         """Campbell's servo step: the walls' mean normal forces on the particles since the
@@ -285,9 +146,9 @@ class Simulation:
         backend.move_walls(servo)
         state.servo_impulse, state.servo_time = impulses, t
         settings = servo_settings(self.scene)
-        if backend.capabilities.time_step:
-            pass  # at sample ends: counted in ``_sample_servo``
-        elif self.servo_by_time:
+        if backend.capabilities.time_step:  # at sample ends (``_sample_servo``)
+            return
+        if self.servo_by_time:
             state.next_servo_time += settings.interval_time
         else:
             state.next_servo += self._servo_interval(settings)
@@ -324,7 +185,7 @@ class Simulation:
             if target and backend.collisions >= target:
                 return
             if self.stop.reason is not None:
-                raise _StopInInterval
+                raise StopInInterval
             raise EngineError(f"the collision count {target} was not reached: the engine's "
                               f"event budget ran out at t = {backend.time:.6g}, so a run "
                               "counted in pair collisions cannot go on")
@@ -433,8 +294,8 @@ class Simulation:
         return float(np.prod([size[i] for i in range(self.scene.dimension) if i != 1]))
 
     def _keep_log(self, state: RunState, log: dict | None, production: bool) -> None:
-        if production and log and state.logged < LOG_CAPACITY:
-            keep = min(len(log["time"]), LOG_CAPACITY - state.logged)
+        if production and log and state.logged < self.log_capacity:
+            keep = min(len(log["time"]), self.log_capacity - state.logged)
             for key, value in log.items():
                 state.log.setdefault(key, []).append(value[:keep])
             state.logged += keep
@@ -490,7 +351,7 @@ class Simulation:
                 state.samples += 1
                 try:
                     self._advance_interval(state)
-                except _StopInInterval:
+                except StopInInterval:
                     # a stop asked for between two event chunks: the engine is synchronised
                     # there, and the resumed run redoes this interval from that point (its
                     # chunks start where this one ended, so it continues bit-identically)
@@ -514,65 +375,11 @@ class Simulation:
                         f"{backend.time:.6g} after a checkpoint: run the same command again "
                         "with --resume to continue")
 
-    # -- results --------------------------------------------------------------------------
+    # -- results ------------------------------------------------------------------------------
     def _write(self, state: RunState, extra: dict[str, Any]) -> Path:
-        scene, backend = self.scene, self.backend
-        profiles = state.profiles.finish()
-        timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
-        frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
-        equilibration_end = float(timeseries["time"][self.schedule.n_eq])
-        attrs = run_attrs(scene, backend.name, backend.version, state.wall_seconds,
-                          equilibration_end, timeseries)
-        attrs.update(extra)
-        results = Results(attrs, timeseries, profiles.results, profiles.attrs, frames)
-        if self.measure_stress:
-            results.groups["stress"], results.group_attrs["stress"] = self._stress_results(
-                state, results, equilibration_end)
-        if state.log:
-            results.groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}
-            results.group_attrs["collisions"] = {
-                "log_every": self.log_every, "capacity": LOG_CAPACITY,
-                "units": "d = 1, m = 1 (g = 1 with gravity); kind 0 pair, 1 lower wall, "
-                         "2 upper wall; normal from i to j (or to the wall); branch r_j - r_i "
-                         "(contact point - r_i for walls); impulse on i; velocity v_i - v_j "
-                         "and spin_velocity (contact-point relative velocity) before"}
-        for name, analysis in state.streams.items():
-            analysis.finish()
-            results.groups[f"statistics/{name}"] = analysis.results
-            results.group_attrs[f"statistics/{name}"] = analysis.attrs
-        if self.after:
-            ctx = Context(scene, results=results,
-                          frames=(lambda: frames_of(results, scene.dimension)) if frames
-                          else None)
-            for name in self.after:
-                data, group_attrs = STATISTICS[name].compute(ctx)
-                results.groups[f"statistics/{name}"] = data
-                results.group_attrs[f"statistics/{name}"] = group_attrs
-        path = write_results(self.out, results)
+        path = write_results(self.out, run_results(self, state, extra))
         (self.workdir / CHECKPOINT).unlink(missing_ok=True)
-        backend.cleanup(None)
+        self.backend.cleanup(None)
         if self.workdir.exists() and not any(self.workdir.iterdir()):
             self.workdir.rmdir()
         return path
-
-    def _stress_results(self, state: RunState, results: Results,
-                        start: float) -> tuple[dict, dict]:
-        parts: dict[str, Any] = {}
-        stress, edges = state.stress, state.stress_edges
-        if isinstance(stress, CollisionalSums) and stress.chunks:
-            # the bins' cross-section: the (mean production) periodic width × depth
-            size = list(self.scene.box.size)
-            if "width" in results.timeseries:
-                size[0] = float(np.mean(results.timeseries["width"][self.schedule.n_eq:]))
-            section = float(np.prod([size[i] for i in range(self.scene.dimension) if i != 1]))
-            parts["collisional"] = collisional_stress(np.asarray(stress.chunks),
-                                                      np.asarray(stress.durations), edges,
-                                                      section)
-        elif isinstance(stress, ContactStress):
-            parts["contact"] = stress.finish()
-        data, attrs = stress_results(self.scene, results.profiles, results.timeseries, start,
-                                     momentum=(state.momentum_start, state.momentum_end),
-                                     **parts)
-        if self.backend.capabilities.stress == "contact":
-            attrs["contact_samples"] = stress.samples if isinstance(stress, ContactStress) else 0
-        return data, attrs

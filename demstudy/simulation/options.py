@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..analysis.registry import STATISTICS, engine_problems
 from ..errors import EngineError, UnsupportedByEngine
 
 
@@ -89,3 +90,17 @@ def check_run_options(backend: Any, options: RunOptions) -> None:
     blocking = next((p for p in out.resolve().parents if p.exists() and not p.is_dir()), None)
     if blocking is not None:
         raise UnsupportedByEngine(engine, "--out", str(out), f"{blocking} is a file, not a folder")
+
+
+def check_run(backend: Any, scene: Any, options: RunOptions) -> None:
+    """Everything refused before any engine starts: the run options, the effects and the
+    statistics the engine cannot supply (``UnsupportedByEngine``)."""
+    check_run_options(backend, options)
+    backend.check(scene, options)
+    for field_name, value, reason in engine_problems(scene, backend.capabilities):
+        raise UnsupportedByEngine(backend.name, field_name, value, reason)
+    log_every = int(options.extra.get("log_every", 1))
+    for name in scene.measure.statistics:
+        if STATISTICS[name].log_every and log_every != 1:
+            raise UnsupportedByEngine(backend.name, "--log-every", log_every,
+                                      f"{name!r} needs every collision logged (1)")

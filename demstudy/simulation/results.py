@@ -1,0 +1,104 @@
+"""The results file of a run: root attributes, profiles, timeseries, stress, collision log
+and every statistic the scene names.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..analysis.registry import STATISTICS, Context
+from ..analysis.steady import energy_trend, is_steady
+from ..analysis.stress import CollisionalSums, ContactStress, collisional_stress, stress_results
+from ..io.results import Results, frames_of
+from ..scene import Scene, scene_to_toml
+from .state import RunState
+
+__all__ = ["run_attrs", "run_results"]
+
+
+def run_attrs(scene: Scene, engine: str, version: str, wall_seconds: float,
+              equilibration_end: float, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
+    """Root attributes every results file carries, with Campbell's steadiness verdict over the
+    production samples (those after ``equilibration_end``)."""
+    t = timeseries["time"]
+    production = t > equilibration_end + 1e-9 * max(1.0, abs(equilibration_end))
+    trend = energy_trend(t[production], timeseries["kinetic_energy"][production])
+    return {
+        "engine": engine,
+        "engine_version": version,
+        "scene_toml": scene_to_toml(scene),
+        "scene_name": scene.meta.name,
+        "seed": scene.run.seed,
+        "run_unit": scene.run.unit,
+        "wall_seconds": wall_seconds,
+        "equilibration_end": equilibration_end,
+        "kinetic_energy_trend": trend,
+        "steady": is_steady(trend),
+    }
+
+
+# -- results --------------------------------------------------------------------------
+def run_results(sim: Any, state: RunState, extra: dict[str, Any]) -> Results:
+    """The results of a finished run of ``sim`` (a Simulation): what the loop accumulated,
+    the stress, the collision log, the streaming statistics, and those computed now from the
+    kept frames, the log or the results themselves; ``extra``: the engine's attributes."""
+    scene, backend = sim.scene, sim.backend
+    profiles = state.profiles.finish()
+    timeseries = {k: np.asarray(v) for k, v in state.timeseries.items()}
+    frames = {k: np.asarray(v) for k, v in state.frames.items()} or None
+    equilibration_end = float(timeseries["time"][sim.schedule.n_eq])
+    attrs = run_attrs(scene, backend.name, backend.version, state.wall_seconds,
+                      equilibration_end, timeseries)
+    attrs.update(extra)
+    results = Results(attrs, timeseries, profiles.results, profiles.attrs, frames)
+    if sim.measure_stress:
+        results.groups["stress"], results.group_attrs["stress"] = _stress(
+            sim, state, results, equilibration_end)
+    if state.log:
+        results.groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}
+        results.group_attrs["collisions"] = {
+            "log_every": sim.log_every, "capacity": sim.log_capacity,
+            "units": "d = 1, m = 1 (g = 1 with gravity); kind 0 pair, 1 lower wall, "
+                     "2 upper wall; normal from i to j (or to the wall); branch r_j - r_i "
+                     "(contact point - r_i for walls); impulse on i; velocity v_i - v_j "
+                     "and spin_velocity (contact-point relative velocity) before"}
+    for name, analysis in state.streams.items():
+        analysis.finish()
+        results.groups[f"statistics/{name}"] = analysis.results
+        results.group_attrs[f"statistics/{name}"] = analysis.attrs
+    ctx = Context(scene, results=results,
+                  frames=(lambda: frames_of(results, scene.dimension)) if frames else None)
+    for name in sim.after:
+        data, group_attrs = STATISTICS[name].compute(ctx)
+        results.groups[f"statistics/{name}"] = data
+        results.group_attrs[f"statistics/{name}"] = group_attrs
+    return results
+
+
+def _stress(sim: Any, state: RunState, results: Results, start: float) -> tuple[dict, dict]:
+    """The ``/stress`` group: kinetic (profiles), walls, momentum balance, and the engine's
+    interaction stress (collisional: increments over the production intervals; contact:
+    samples)."""
+    parts: dict[str, Any] = {}
+    stress, edges = state.stress, state.stress_edges
+    if isinstance(stress, CollisionalSums) and stress.chunks:
+        # the bins' cross-section: the (mean production) periodic width × depth
+        size = list(sim.scene.box.size)
+        if "width" in results.timeseries:
+            size[0] = float(np.mean(results.timeseries["width"][sim.schedule.n_eq:]))
+        section = float(np.prod([size[i] for i in range(sim.scene.dimension) if i != 1]))
+        parts["collisional"] = collisional_stress(np.asarray(stress.chunks),
+                                                  np.asarray(stress.durations), edges,
+                                                  section)
+    elif isinstance(stress, ContactStress):
+        parts["contact"] = stress.finish()
+    data, attrs = stress_results(sim.scene, results.profiles, results.timeseries, start,
+                                 momentum=(state.momentum_start, state.momentum_end),
+                                 **parts)
+    if sim.backend.capabilities.stress == "contact":
+        attrs["contact_samples"] = stress.samples if isinstance(stress, ContactStress) else 0
+    return data, attrs
