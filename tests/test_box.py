@@ -183,9 +183,9 @@ def test_pairs_match_brute_force(name, spec):
     r_max = 0.9 * min(box.image_limit, 3.0)
     pts = random_points(box, 300, seed=5, outside=0.05)
     of = np.arange(0, 300, 3)
+    bi, bj, br = brute_distances(box.wrap(pts).position, box)
     for chosen, chunk in ((None, 4096), (None, 17), (of, 7)):
         i, j, r = NeighbourQuery(box, pts).pairs(r_max, of=chosen, chunk=chunk)
-        bi, bj, br = brute_distances(box.wrap(pts).position, box)
         near = br <= r_max
         if chosen is not None:
             near &= np.isin(bi, chosen)
@@ -209,6 +209,19 @@ def test_bounded_y_sees_no_partner_across_the_boundary_and_walls_none_either():
                                               walls=(0.0, 8.0))):
         assert NeighbourQuery(box, pts).pairs(0.5).i.size == 0
         assert NeighbourQuery(box, pts).count(edges).tolist() == [0, 2]  # 0-2 at 3.07
+
+
+def test_a_bounded_y_takes_centres_far_outside_the_box():
+    # an open boundary: box_lo / box_hi need not bound the centres along y
+    box = Box([0.0, 2.0, 0.0], [7.0, 5.0, 6.0], (True, False, True))
+    rng = np.random.default_rng(2)
+    pts = rng.uniform([0.0, -20.0, 0.0], [7.0, 30.0, 6.0], (600, 3))
+    r_edges = np.linspace(0.0, 2.9, 30)
+    _, _, r = brute_distances(pts, box)
+    expected = np.bincount(np.searchsorted(r_edges, r[r <= r_edges[-1]], side="left") - 1,
+                           minlength=r_edges.size - 1)
+    assert expected.sum() > 500
+    assert np.array_equal(NeighbourQuery(box, pts).count(r_edges), expected)
 
 
 def test_planar_projection_drops_y_and_the_tilt():
