@@ -281,9 +281,9 @@ class NeighbourQuery:
         for a in range(box.dim):
             if box.periodic[a] and not (a == 1 and box.sheared):
                 continue
-            low = float(rel[:, a].min(initial=0.0))  # <= 0: centres below lo too
-            pts[:, a] += pad - low if low else pad
-            size[a] = max(box.lengths[a], float(rel[:, a].max(initial=0.0)) - low) \
+            bottom = float(rel[:, a].min(initial=0.0))  # <= 0: centres below lo too
+            pts[:, a] += (pad - bottom) if bottom else pad
+            size[a] = max(box.lengths[a], float(rel[:, a].max(initial=0.0)) - bottom) \
                 + 2 * pad + r_max
         if not box.sheared:
             return pts, pts, owner, size
