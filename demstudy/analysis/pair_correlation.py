@@ -30,11 +30,12 @@ the separation projected on the periodic directions (x, z; x alone in 2D) and th
 (dim-1)-D shell ``2 pi r dr`` (3D) or ``2 dr`` (2D) with ``V_R`` replaced by the area of the
 periodic plane.
 
-Periodic images: minimum image along x and z (and y when ``periodic_y``) with
-``scipy.spatial.cKDTree`` (``boxsize``); with a Lees-Edwards tilt (``frame.tilt != 0``, y
-periodic) the images across y are added explicitly, shifted by -/+ tilt along x. Shells
-beyond half the shortest periodic length see more than one image of a partner: they are
-flagged in ``results["image_artefact"]`` (and ``attrs["r_image_limit"]``), not removed.
+Periodic images: each frame's :class:`~demstudy.analysis.box.Box` (x, z periodic, y when
+``periodic_y``, Lees-Edwards images from ``frame.tilt``) wraps the centres and its
+:class:`~demstudy.analysis.box.NeighbourQuery` counts the pairs (minimum image; pairs inside
+one bin never across y). Shells beyond half the shortest periodic length see more than one
+image of a partner: they are flagged in ``results["image_artefact"]`` (and
+``attrs["r_image_limit"]``), not removed.
 
 Errors: the per-frame pair counts and ``N(N-1)/V`` are block-averaged
 (:class:`~demstudy.analysis.blocking.BlockAccumulator`) and g's standard error is the
@@ -49,21 +50,15 @@ import warnings
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.spatial import cKDTree
 
 from demstudy import UNITS_NOTE
 from demstudy.analysis.base import AnalysisBase
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.analysis.box import Box, NeighbourQuery
 from demstudy.io.frames import Frame
 
 __all__ = ["PairCorrelation", "slab_shell_volume"]
 
-
-def _wrap(x: np.ndarray, length: float) -> np.ndarray:
-    """x mod length in [0, length) (np.mod can round up to length itself)."""
-    x = np.mod(x, length)
-    x[x >= length] = 0.0
-    return x
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
 
@@ -161,9 +156,7 @@ class PairCorrelation(AnalysisBase):
                 slab_shell_volume(self.r_edges, np.inf if whole_period else w, self.dim)
                 for w in widths
             ])
-        lengths = hi - lo
-        periodic = [0] + ([2] if self.dim == 3 else []) + ([1] if self.periodic_y else [])
-        self.r_image_limit = 0.5 * float(min(lengths[periodic]))
+        self.r_image_limit = Box.from_frame(frame, periodic_y=self.periodic_y).image_limit
         if self.r_edges[-1] > self.r_image_limit:
             warnings.warn(
                 f"g(r) beyond r = {self.r_image_limit:g} (half the shortest periodic length) "
@@ -174,24 +167,19 @@ class PairCorrelation(AnalysisBase):
         self._acc = BlockAccumulator(self._n_values, self.max_blocks)
 
     def _single_frame(self, frame: Frame) -> None:
-        pos = np.asarray(frame.position, float)
-        lo, hi = np.asarray(frame.box_lo, float), np.asarray(frame.box_hi, float)
-        lengths = hi - lo
-        pos = pos - lo
-        if self.periodic_y:
-            # centres outside [0, L_y) (engines wrap lazily) move to the image in the box:
-            # the image at y + k L_y sits at x + k tilt (Lees-Edwards)
-            turns = np.floor(pos[:, 1] / lengths[1])
-            pos[:, 1] = _wrap(pos[:, 1] - turns * lengths[1], lengths[1])
-            pos[:, 0] -= turns * float(frame.tilt)
-        pos[:, 0] = _wrap(pos[:, 0], lengths[0])
-        if self.dim == 3:
-            pos[:, 2] = _wrap(pos[:, 2], lengths[2])
-        y = pos[:, 1] + lo[1]
+        box = Box.from_frame(frame, periodic_y=self.periodic_y)
+        # centres outside the box (engines wrap lazily) move to their image inside it
+        pos = box.wrap(frame.position).position
+        lengths = box.lengths
         section = lengths[0] * (lengths[2] if self.dim == 3 else 1.0)
         sample = np.zeros((self.n_bins, self.n_r + 2))
-        bins = np.searchsorted(self.edges_y, y, side="right") - 1
+        bins = np.searchsorted(self.edges_y, pos[:, 1], side="right") - 1
         whole = self._edges_y is None
+        # pairs inside one bin are never seen across y; the planar distance ignores y
+        pair_box = box if whole else box.with_bounded_y()
+        plane = [0, 2] if self.dim == 3 else [0]
+        if self.distance == "planar":
+            pair_box, pos = pair_box.project(plane), pos[:, plane]
         for b in range(self.n_bins):
             sel = pos if whole else pos[bins == b]
             n = sel.shape[0]
@@ -201,47 +189,10 @@ class PairCorrelation(AnalysisBase):
             sample[b, 0] = n
             sample[b, 1] = n * (n - 1) / volume
             if n >= 2:
-                sample[b, 2:] = self._count_pairs(sel, lengths, float(frame.tilt), whole)
+                # ordered pairs i != j per shell (r_k, r_k+1]: the same as [r_k, r_k+1)
+                # except on a measure-zero set
+                sample[b, 2:] = NeighbourQuery(pair_box, sel).count(self.r_edges)
         self._acc.add(sample)
-
-    def _count_pairs(self, pos: np.ndarray, lengths: np.ndarray, tilt: float,
-                     whole: bool) -> np.ndarray:
-        """Ordered pair counts (i != j) per shell, minimum image in the periodic axes."""
-        r_max = self.r_edges[-1]
-        if self.distance == "planar":
-            keep = [0, 2] if self.dim == 3 else [0]
-            pts, box = pos[:, keep], lengths[keep]
-            others = pts
-        else:
-            pts = pos.copy()
-            box = lengths.copy()
-            others = pts
-            images = self.periodic_y and whole and tilt != 0.0
-            if images or not (self.periodic_y and whole):
-                # y not periodic for the tree (walls, pairs inside one bin, or explicit
-                # Lees-Edwards images): shift into a box large enough never to wrap
-                pad = r_max + 1.0
-                pts[:, 1] += pad
-                box[1] = lengths[1] + 2 * pad + r_max
-                others = pts
-            if images:
-                ly = lengths[1]
-                low = pts[:, 1] - pad < r_max  # near y = 0: image at y + L_y, x + tilt
-                high = pts[:, 1] - pad > ly - r_max  # near y = L_y: image at y - L_y, x - tilt
-                up, down = pts[low].copy(), pts[high].copy()
-                up[:, 1] += ly
-                up[:, 0] = _wrap(up[:, 0] + tilt, lengths[0])
-                down[:, 1] -= ly
-                down[:, 0] = _wrap(down[:, 0] - tilt, lengths[0])
-                others = np.concatenate([pts, up, down])
-        # cKDTree wants coordinates in [0, boxsize)
-        tree = cKDTree(pts, boxsize=box)
-        other = tree if others is pts else cKDTree(others, boxsize=box)
-        counts = tree.count_neighbors(other, self.r_edges, cumulative=False)
-        counts = np.asarray(counts, float)
-        shells = counts[1:].copy()  # counts[0]: pairs at r <= 0 (self pairs)
-        # shells are (r_k, r_k+1]: the same as [r_k, r_k+1) except on a measure-zero set
-        return shells
 
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:
         s = mean.reshape(self.n_bins, self.n_r + 2)

@@ -21,16 +21,21 @@ is not corrected for the walls (it falls where a slice leaves the channel, as in
 The listing's variant (range [0, INT(WL)], ±1 periodic images) is the same estimator on another
 range. Errors: jackknife over time blocks. Periodic-image artefact: partners farther than W/2
 along x are images of nearer ones; ``r_max`` must stay below W/2 (checked).
+
+Geometry: a :class:`~demstudy.analysis.box.Box` with x (and z) periodic and y always bounded
+(Campbell's distributions never look across y, whatever the boundary) wraps the centres; the
+parallel partners come from its :class:`~demstudy.analysis.box.NeighbourQuery` and their
+separations from :meth:`~demstudy.analysis.box.Box.minimum_image`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..io.frames import Frame
 from .base import AnalysisBase
 from .blocking import BlockAccumulator, jackknife
+from .box import Box, NeighbourQuery
 
 __all__ = ["StructureDistributions"]
 
@@ -57,36 +62,19 @@ class StructureDistributions(AnalysisBase):
         self.max_blocks = max_blocks
 
     def _prepare(self) -> None:
-        frame = self.first_frame
-        lengths = np.asarray(frame.box_hi, float) - np.asarray(frame.box_lo, float)
-        periodic = [lengths[0]] + ([lengths[2]] if self.dim == 3 else [])
-        if self.r_max > 0.5 * min(periodic):
+        limit = Box.from_frame(self.first_frame, periodic_y=False).image_limit
+        if self.r_max > limit:
             raise ValueError(f"r_max = {self.r_max:g} exceeds half the periodic length "
-                             f"{0.5 * min(periodic):g}: partners would be counted twice")
+                             f"{limit:g}: partners would be counted twice")
         self._acc = BlockAccumulator(2 * self.n_r + 1, self.max_blocks)
 
     def _single_frame(self, frame: Frame) -> None:
-        pos = np.asarray(frame.position, float)
-        lo, hi = np.asarray(frame.box_lo, float), np.asarray(frame.box_hi, float)
-        lengths = hi - lo
+        box = Box.from_frame(frame, periodic_y=False)  # never across y (see the module doc)
+        pos = box.wrap(frame.position).position
+        lo, hi = box.lo, box.hi
         y_mid = 0.5 * (lo[1] + hi[1]) if self.y_mid is None else self.y_mid
-        # no minimum image along y: a "period" longer than the extent plus twice the reach
-        # keeps cKDTree from ever wrapping there
-        reach = float(np.hypot(self.r_max, self.half_width)) + 1.0
-        box = lengths.copy()
-        shifted = pos - lo
-        shifted[:, 1] = pos[:, 1] - pos[:, 1].min() + reach
-        box[1] = float(shifted[:, 1].max()) + 2 * reach
-        for a in range(self.dim):
-            if a != 1:
-                shifted[:, a] %= box[a]
-        tree = cKDTree(shifted, boxsize=box)
         test = np.flatnonzero(np.abs(pos[:, 1] - y_mid) < self.half_width)
-        # parallel: partners within r_max in the plane and half_width across it
-        pairs = tree.query_ball_point(shifted[test],
-                                      r=float(np.hypot(self.r_max, self.half_width)))
         normal = np.zeros(self.n_r)
-        parallel = np.zeros(self.n_r)
         # normal: every partner within r_max along y, whatever its x (z): a sorted sweep
         order = np.argsort(pos[:, 1], kind="stable")
         ys = pos[order, 1]
@@ -96,18 +84,15 @@ class StructureDistributions(AnalysisBase):
             k = (dy / self.dr).astype(np.intp)
             normal += np.bincount(k[k < self.n_r], minlength=self.n_r)
             normal[0] -= 1  # the test particle itself (dy = 0)
-        for t, partners in zip(test, pairs, strict=True):
-            p = np.asarray([j for j in partners if j != t], dtype=np.intp)
-            if p.size == 0:
-                continue
-            d = shifted[p] - shifted[t]
-            d -= box * np.round(d / box)  # minimum image (never along y: see above)
-            dy = np.abs(d[:, 1])
-            inplane = np.abs(d[:, 0]) if self.dim == 2 else np.hypot(d[:, 0], d[:, 2])
-            near = dy < self.half_width
-            parallel += np.bincount(np.minimum((inplane[near] / self.dr).astype(np.intp),
-                                               self.n_r), minlength=self.n_r + 1)[: self.n_r]
-        self._cross = float(np.prod([lengths[a] for a in range(self.dim) if a != 1]))
+        # parallel: partners within r_max in the plane and half_width across it
+        reach = float(np.hypot(self.r_max, self.half_width))
+        i, j, _ = NeighbourQuery(box, pos).pairs(reach, of=test)
+        d = box.minimum_image(pos[j] - pos[i])
+        inplane = np.abs(d[:, 0]) if self.dim == 2 else np.hypot(d[:, 0], d[:, 2])
+        near = np.abs(d[:, 1]) < self.half_width
+        parallel = np.bincount(np.minimum((inplane[near] / self.dr).astype(np.intp), self.n_r),
+                               minlength=self.n_r + 1)[: self.n_r].astype(float)
+        self._cross = float(np.prod([box.lengths[a] for a in range(self.dim) if a != 1]))
         self._acc.add(np.concatenate([normal, parallel, [float(test.size)]]))
 
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:

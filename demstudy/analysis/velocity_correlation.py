@@ -15,11 +15,14 @@ cell, without saying whether the mean is instantaneous or time-averaged. Both re
   u'_i = c_i - U(b_i) (number-weighted, like :mod:`demstudy.analysis.vdf`). The first-pass
   mean is treated as exact (its error is not propagated).
 
-Lees-Edwards (y periodic, ``frame.tilt`` != 0): a centre outside ``[lo, lo + L_y)`` is wrapped
-into the box with x shifted by -turns * tilt and u by -turns * ``image_velocity_shift``
-(= shear rate * L_y). A partner seen through the y boundary is the explicit image shifted by
-+-tilt along x; its *fluctuation* is that of the particle itself, because the image velocity
-and the image's local mean velocity differ by the same shear rate * L_y.
+Geometry: each frame's :class:`~demstudy.analysis.box.Box` (x, z periodic; y periodic over
+``[edges[0], edges[0] + period)`` when ``period`` > 0) wraps the centres and velocities and
+its :class:`~demstudy.analysis.box.NeighbourQuery` finds the pairs. Lees-Edwards (y periodic,
+``frame.tilt`` != 0): a centre moved across y by k periods gets x -= k tilt and
+u -= k ``image_velocity_shift`` (= shear rate * L_y). A partner seen through the y boundary is
+the explicit image shifted by +-tilt along x; its *fluctuation* is that of the particle itself,
+because the image velocity and the image's local mean velocity differ by the same shear
+rate * L_y.
 
 VelocityCorrelation (Malik §4.9, eq. 4.1, on fluctuations). For particle i in bin b and each
 partner j != i at distance r_ij in shell k = [k dr, (k+1) dr) (partners anywhere, or with
@@ -80,11 +83,11 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.spatial import cKDTree
 
 from demstudy import UNITS_NOTE
 from demstudy.analysis.base import AnalysisBase, default_y_edges, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.analysis.box import Box, NeighbourQuery
 from demstudy.io.frames import Frame
 
 __all__ = [
@@ -94,13 +97,6 @@ __all__ = [
     "orientational_correlation",
     "velocity_correlations",
 ]
-
-
-def _wrap(x: np.ndarray, length: float) -> np.ndarray:
-    """x mod length in [0, length) (np.mod can round up to length itself)."""
-    x = np.mod(x, length)
-    x[x >= length] = 0.0
-    return x
 
 
 def _check_edges(edges: ArrayLike | None) -> np.ndarray | None:
@@ -144,27 +140,34 @@ class _Binned(AnalysisBase):
         self.edges = self._edges
         self.n_bins = self.edges.size - 1
 
-    def _assign(self, frame: Frame) -> dict[str, np.ndarray]:
-        """Wrapped positions, LE-shifted velocities, spins and bin index of every particle
-        (bin -1: outside the bins)."""
-        pos = np.array(frame.position, float)
-        vel = np.array(frame.velocity, float)
+    def _box(self, frame: Frame) -> Box:
+        """The frame's box with y periodic over ``[edges[0], edges[0] + period)`` when
+        ``period`` > 0 (images offset by the tilt, moving with ``image_velocity_shift``)."""
+        lo, lengths = np.array(frame.box_lo, float), frame.lengths
+        if self.period:
+            lo[1], lengths[1] = self.edges[0], self.period
+        periodic = tuple(a != 1 or bool(self.period) for a in range(self.dim))
+        return Box(lo, lengths, periodic, tilt=float(frame.tilt) if self.period else 0.0,
+                   shear_velocity=self.image_velocity_shift)
+
+    def _assign(self, frame: Frame) -> dict[str, Any]:
+        """The frame's box, wrapped positions, LE-shifted velocities, spins and bin index of
+        every particle (bin -1: outside the bins)."""
+        pos, vel = np.asarray(frame.position, float), np.asarray(frame.velocity, float)
         omega = np.asarray(frame.angular_velocity, float)
         omega = omega[:, None] if omega.ndim == 1 else omega
         if vel.shape != pos.shape or omega.shape != (pos.shape[0], self.n_rot):
             raise ValueError("velocity / angular_velocity do not match the positions")
-        if self.period:
-            turns = np.floor((pos[:, 1] - self.edges[0]) / self.period)
-            pos[:, 1] -= turns * self.period
-            pos[:, 0] -= turns * float(frame.tilt)
-            vel[:, 0] -= turns * self.image_velocity_shift
+        box = self._box(frame)
+        pos, vel, _ = box.wrap(pos, vel)
         bins = np.searchsorted(self.edges, pos[:, 1], side="right") - 1
         bins[(bins < 0) | (bins >= self.n_bins)] = -1
         cells = bins
         if self.z_cells > 1:  # Malik's cells: y-bin × z-slab
             cells = np.where(bins >= 0, bins * self.z_cells + z_slab(frame, pos[:, 2],
                                                                      self.z_cells), -1)
-        return {"pos": pos, "vel": vel, "omega": omega, "bins": bins, "cells": cells}
+        return {"box": box, "pos": pos, "vel": vel, "omega": omega, "bins": bins,
+                "cells": cells}
 
     def _bin_mean(self, bins: np.ndarray, values: np.ndarray,
                   size: int | None = None) -> np.ndarray:
@@ -316,9 +319,7 @@ class VelocityCorrelation(_Binned):
         frame = self.first_frame
         self._set_edges(frame)
         self._reference_means(self._reference)
-        lengths = frame.lengths
-        periodic = [0] + ([2] if self.dim == 3 else []) + ([1] if self.period else [])
-        self.r_image_limit = 0.5 * float(min(lengths[periodic]))
+        self.r_image_limit = self._box(frame).image_limit
         # ordered off-diagonal (a, b), a != b: the pair (a, b) then its reverse (b, a)
         pairs = [(a, b) for a in range(self.dim) for b in range(a + 1, self.dim)]
         self._off = [ab for a, b in pairs for ab in ((a, b), (b, a))]
@@ -326,65 +327,11 @@ class VelocityCorrelation(_Binned):
         self._nv = 1 + self.dim + self.n_r * (1 + self.dim + len(self._off))
         self._acc = BlockAccumulator(self.n_bins * self._nv, self.max_blocks)
 
-    # -- pair search -------------------------------------------------------------------
-    def _pairs(self, pos: np.ndarray, lengths: np.ndarray, tilt: float,
-               y_periodic: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Ordered pairs (i, j, r) with i != j and r < r_max; ``pos`` relative to box_lo,
-        x(z) wrapped; y periodic (with LE images when tilt != 0) or open."""
-        r_max = self.r_edges[-1]
-        if self.distance == "planar":
-            keep = [0, 2] if self.dim == 3 else [0]
-            pts, box, owner = pos[:, keep].copy(), lengths[keep].copy(), np.arange(len(pos))
-            others = pts
-        else:
-            pts, box = pos.copy(), lengths.copy()
-            owner = np.arange(len(pos))
-            others = pts
-            images = y_periodic and tilt != 0.0
-            if images or not y_periodic:
-                pad = r_max + 1.0
-                pts[:, 1] += pad
-                box[1] = lengths[1] + 2 * pad + r_max
-                others = pts
-            if images:
-                ly = lengths[1]
-                low = np.flatnonzero(pts[:, 1] - pad < r_max)
-                high = np.flatnonzero(pts[:, 1] - pad > ly - r_max)
-                up, down = pts[low].copy(), pts[high].copy()
-                up[:, 1] += ly
-                up[:, 0] = _wrap(up[:, 0] + tilt, lengths[0])
-                down[:, 1] -= ly
-                down[:, 0] = _wrap(down[:, 0] - tilt, lengths[0])
-                others = np.concatenate([pts, up, down])
-                owner = np.concatenate([owner, low, high])
-        other_tree = cKDTree(others, boxsize=box)
-        out_i, out_j, out_r = [], [], []
-        for start in range(0, len(pts), self.chunk):
-            sub = cKDTree(pts[start : start + self.chunk], boxsize=box)
-            res = sub.sparse_distance_matrix(other_tree, r_max, output_type="ndarray")
-            i = res["i"].astype(np.int64) + start
-            j = owner[res["j"]]
-            ok = i != j
-            out_i.append(i[ok])
-            out_j.append(j[ok])
-            out_r.append(res["v"][ok])
-        return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_r)
-
     def _single_frame(self, frame: Frame) -> None:
         a = self._assign(frame)
         u, _ = self._fluctuations(a)
         keep = a["bins"] >= 0
         pos, u, bins = a["pos"][keep], u[keep], a["bins"][keep]
-        lo = np.asarray(frame.box_lo, float)
-        lengths = frame.lengths
-        pos = pos - lo
-        pos[:, 0] = _wrap(pos[:, 0], lengths[0])
-        if self.dim == 3:
-            pos[:, 2] = _wrap(pos[:, 2], lengths[2])
-        if self.period:
-            pos[:, 1] = _wrap(pos[:, 1] - (self.edges[0] - lo[1]), self.period)
-            lengths = lengths.copy()
-            lengths[1] = self.period
         nb, nr, dim = self.n_bins, self.n_r, self.dim
         sample = np.zeros((nb, self._nv))
         sample[:, 0] = np.bincount(bins, minlength=nb)
@@ -396,20 +343,24 @@ class VelocityCorrelation(_Binned):
             groups = [np.flatnonzero(bins == b) for b in range(nb)]
         else:
             groups = [np.arange(len(bins))]
-        y_periodic = bool(self.period) and (whole_period or not self.in_bin)
+        # partners across y only when y is periodic and pairs may leave a bin
+        box = a["box"] if whole_period or not self.in_bin else a["box"].with_bounded_y()
+        plane = [0, 2] if dim == 3 else [0]
+        if self.distance == "planar":
+            box, pos = box.project(plane), pos[:, plane]
         for sel in groups:
             if sel.size < 2:
                 continue
-            i, j, r = self._pairs(pos[sel], lengths, float(frame.tilt), y_periodic)
+            i, j, r = NeighbourQuery(box, pos[sel]).pairs(self.r_edges[-1], chunk=self.chunk)
             i, j = sel[i], sel[j]
             k = np.minimum((r / self.dr).astype(np.int64), nr - 1)
             idx = bins[i] * nr + k
             sample[:, 1 + dim : 1 + dim + nr] += np.bincount(
                 idx, minlength=nb * nr).reshape(nb, nr)
-            for c, (a, b) in enumerate([(c, c) for c in range(dim)] + self._off):
+            for c, (ca, cb) in enumerate([(c, c) for c in range(dim)] + self._off):
                 col = 1 + dim + nr * (1 + c)
                 sample[:, col : col + nr] += np.bincount(
-                    idx, weights=u[i, a] * u[j, b], minlength=nb * nr).reshape(nb, nr)
+                    idx, weights=u[i, ca] * u[j, cb], minlength=nb * nr).reshape(nb, nr)
         self._acc.add(sample)
 
     def _estimate(self, mean: np.ndarray) -> dict[str, np.ndarray]:

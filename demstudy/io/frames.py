@@ -8,8 +8,12 @@ direction (3D only). ``dim`` is 2 for discs and 3 for spheres.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from demstudy.analysis.box import Box
 
 
 @dataclass
@@ -25,6 +29,13 @@ class Frame:
     angular_velocity: (N, n_rot) with n_rot = 1 in 2D (the z component) and 3 in 3D.
     radius: (N,).
     tilt: Lees-Edwards shift of the upper periodic image along x (0 without shear).
+    extra: engine-specific additions.
+    periodic_y: y is periodic (Lees-Edwards and homogeneous boxes); False: bounded (walls).
+        x and z are always periodic. Engines and readers leave the default; the analyses
+        take the periodicity from their own arguments (``periodic_y``, ``period``), which
+        override this field (see :meth:`demstudy.analysis.box.Box.from_frame`).
+    shear_velocity: x velocity of the upper periodic image relative to the original,
+        shear rate * L_y (Lees-Edwards; 0 without shear or when unknown).
     """
 
     time: float
@@ -36,6 +47,8 @@ class Frame:
     radius: np.ndarray
     tilt: float = 0.0
     extra: dict = field(default_factory=dict)
+    periodic_y: bool = False
+    shear_velocity: float = 0.0
 
     @property
     def dim(self) -> int:
@@ -48,3 +61,15 @@ class Frame:
     @property
     def lengths(self) -> np.ndarray:
         return np.asarray(self.box_hi, float) - np.asarray(self.box_lo, float)
+
+    @property
+    def box(self) -> Box:
+        """The :class:`~demstudy.analysis.box.Box` of this frame (x, z periodic; y periodic
+        when ``periodic_y``, with the tilt and ``shear_velocity`` of its images). A tilt
+        without ``periodic_y`` is refused: the frame is sheared but does not say so."""
+        from demstudy.analysis.box import Box  # noqa: PLC0415 (analysis imports io)
+
+        if self.tilt and not self.periodic_y:
+            raise ValueError("a Lees-Edwards tilt with periodic_y=False: set periodic_y (and "
+                             "shear_velocity), or build Box.from_frame(frame, periodic_y=...)")
+        return Box.from_frame(self)
