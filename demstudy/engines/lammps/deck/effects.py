@@ -18,8 +18,8 @@ from ....errors import UnsupportedByEngine
 from ....scene import Scene
 from ....scene.schema import Wall
 from .base import Block, fmt
-from .system import bump_group, bump_type
 from .contact import granular_args
+from .system import bump_group, bump_type
 
 #: moments of inertia LAMMPS's nve/sphere integrates: K = 4I/(m d²) (disc, sphere)
 LAMMPS_K = {2: (0.5, 0.4), 3: (0.4,)}
