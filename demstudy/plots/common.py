@@ -113,8 +113,10 @@ class Run:
 
     @property
     def engine(self) -> str:
+        """The engine and its version, without the version's feature list (the footer must
+        fit; the whole string is in the file's ``engine_version``)."""
         name = str(self.attrs.get("engine", "unknown engine"))
-        version = self.attrs.get("engine_version")
+        version = str(self.attrs.get("engine_version") or "").split(" (")[0]
         return f"{name} ({version})" if version else name
 
     @property
@@ -175,13 +177,14 @@ def new_figure(n_rows: int, n_cols: int, width: float = 4.0, height: float = 3.6
     return fig, axes
 
 
-def finish(fig: Figure, runs: Sequence[Run], title: str) -> Figure:
-    """Title, the units and engine footer, tight layout (applied when the figure is drawn)."""
+def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03) -> Figure:
+    """Title, the units and engine footer, tight layout (applied when the figure is drawn)
+    above ``bottom`` (a figure fraction: room for a legend below the panels)."""
     engines = ", ".join(dict.fromkeys(run.engine for run in runs))
     fig.suptitle(title, fontsize=10)
     fig.text(0.005, 0.005, f"{units_text(runs)}  |  engine: {engines}", fontsize=7,
              ha="left", va="bottom")
-    fig.set_layout_engine("tight", rect=(0, 0.03, 1, 0.96))  # applied when drawn (saved)
+    fig.set_layout_engine("tight", rect=(0, bottom, 1, 0.96))  # applied when drawn (saved)
     return fig
 
 

@@ -131,9 +131,14 @@ def draw_angles(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figur
             ax.set_xlim(0, 180)
             ax.set_xticks(np.arange(0, 181, 30))
             ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7, loc="upper right")
+    # below the panels: the distributions fill the whole θ range, so no corner is free
+    handles, labels = axes[0].get_legend_handles_labels()
+    rows = -(-len(labels) // 4)
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=min(len(labels), 4),
+               bbox_to_anchor=(0.5, 0.035), frameon=False)
     return finish(fig, runs, "collision-angle distributions (pair collisions, contact point "
-                             "binned in y); dashed/dotted: Savage–Jeffrey with R / C")
+                             "binned in y); dashed/dotted: Savage–Jeffrey with R / C",
+                  bottom=0.05 + 0.035 * rows)
 
 
 def _fmt(data: dict, key: str, b: int) -> str:
