@@ -71,6 +71,31 @@ def chute(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
+def couette(tmp_path_factory):
+    """A 2D Couette cell (walls at y = 0, 12, width 4.8) holding an uncorrelated gas: 40
+    points uniform in x over the period and in y ∈ [0.5, 11.5], 400 frames, u_x = y/12 plus
+    noise; `demstudy analyze --what profiles,structure,cgprofiles`. Its structure
+    distributions tend to the test region's number density 40/(4.8 × 11)."""
+    path = tmp_path_factory.mktemp("couette") / "couette.h5"
+    scene = load_scene(COUETTE)
+    rng = np.random.default_rng(11)
+    n, n_frames = 40, 400
+    pos = np.stack([rng.uniform(0.0, 4.8, (n_frames, n)),
+                    rng.uniform(0.5, 11.5, (n_frames, n))], axis=2)
+    vel = rng.normal(scale=0.05, size=(n_frames, n, 2))
+    vel[..., 0] += pos[..., 1] / 12.0
+    frames = {"time": np.arange(n_frames, dtype=float), "position": pos, "velocity": vel,
+              "angular_velocity": rng.normal(size=(n_frames, n, 1)),
+              "radius": np.full((n_frames, n), 0.5), "box_lo": np.zeros((n_frames, 2)),
+              "box_hi": np.tile([4.8, 12.0], (n_frames, 1)), "tilt": np.zeros(n_frames)}
+    write_results(path, Results(
+        attrs={**ATTRS, "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name},
+        timeseries={"time": frames["time"]}, frames=frames))
+    assert main(["analyze", str(path), "--what", "profiles,structure,cgprofiles"]) == 0
+    return path
+
+
+@pytest.fixture(scope="module")
 def cooling(tmp_path_factory):
     """A real homogeneous cooling run: 1000 smooth spheres, φ = 0.1, e = 0.8, T0 = 1 in a
     periodic cube, `demstudy run --engine edmd` up to t = 30 ≈ 3 t0 (about 2 s)."""
@@ -146,7 +171,8 @@ def test_all_kinds_write_pngs_and_skip_the_absent_one(chute, tmp_path, capsys):
     out = tmp_path / "fig.png"
     assert main(["plot", str(chute), "--kind", "all", "-o", str(out)]) == 0
     cap = capsys.readouterr()
-    drawn = [k for k in KINDS if k not in ("freepath", "lambda", "cooling")]
+    absent = ("structure", "freepath", "lambda", "cgprofiles", "cooling")  # KINDS order
+    drawn = [k for k in KINDS if k not in absent]
     for kind in drawn:
         png = tmp_path / f"fig-{kind}.png"
         assert f"figure: {png}" in cap.out
@@ -154,11 +180,15 @@ def test_all_kinds_write_pngs_and_skip_the_absent_one(chute, tmp_path, capsys):
     assert not (tmp_path / "fig-lambda.png").exists()
     assert not (tmp_path / "fig-cooling.png").exists()  # a chute is not a cooling run
     assert not (tmp_path / "fig-freepath.png").exists()  # its log has no particle indices
+    assert not (tmp_path / "fig-structure.png").exists()
+    assert not (tmp_path / "fig-cgprofiles.png").exists()
     notices = [ln for ln in cap.err.splitlines() if ln]
-    assert len(notices) == 3 and "freepath skipped" in notices[0]
-    assert "--what freepath" in notices[0]
-    assert "lambda skipped" in notices[1] and "--what lambda" in notices[1]
-    assert "cooling skipped" in notices[2] and "homogeneous cooling" in notices[2]
+    assert [ln.split(": ")[3].split(" skipped")[0] for ln in notices] == list(absent)
+    assert "no /statistics/structure" in notices[0] and "--what structure" in notices[0]
+    assert "--what freepath" in notices[1]
+    assert "lambda skipped" in notices[2] and "--what lambda" in notices[2]
+    assert "no /statistics/cgprofiles" in notices[3] and "--what cgprofiles" in notices[3]
+    assert "cooling skipped" in notices[4] and "homogeneous cooling" in notices[4]
     assert "Traceback" not in cap.err
 
 
@@ -454,3 +484,156 @@ def test_profiles_draw_malik_cell_temperatures_dashed(channel, tmp_path):
     assert main(["analyze", str(channel), "--what", "profiles", "--out", str(strip_only)]) == 0
     fig = draw("profiles", [Run.load(strip_only)])
     assert not any("cell_" in str(ln.get_gid()) for ax in fig.axes for ln in ax.lines)
+
+
+def _errorbars(fig, gid):
+    """(x, y, half-length) of the vertical error bars of the errorbar drawn with ``gid``."""
+    found = [c for ax in fig.axes for c in ax.containers
+             if c.lines[0] is not None and c.lines[0].get_gid() == gid]
+    assert found, f"no error bars {gid!r}"
+    seg = np.asarray(found[0].lines[2][0].get_segments(), float)  # (n, 2 ends, xy)
+    return seg[:, 0, 0], seg.mean(axis=1)[:, 1], 0.5 * (seg[:, 1, 1] - seg[:, 0, 1])
+
+
+def test_structure_plots_the_stored_distributions_and_campbells_mean_density(couette):
+    """Normal and parallel distributions (and their error bars) equal the stored rows; the
+    dashed reference is the run's mean number density from /profiles (Σ n_b w_b / H, which
+    for 40 discs between walls 12 apart in a 4.8 wide cell is 40/(4.8 × 12) exactly), the
+    dotted one the test region's density; the uncorrelated gas lies on the dotted line (the
+    bins near the walls hold fewer centres, so not on the dashed one)."""
+    res = read_results(couette)
+    st, prof = res.groups["statistics/structure"], res.profiles
+    fig = draw("structure", [Run.load(couette)])
+    name = couette.name
+    for key in ("normal", "parallel"):
+        same(line(fig, f"{name}:{key}"), st["r"], st[key])
+        x, y, half = _errorbars(fig, f"{name}:{key}")
+        np.testing.assert_allclose(x, st["r"])
+        np.testing.assert_allclose(y, st[key], rtol=1e-12)
+        np.testing.assert_allclose(half, st[f"{key}_err"], rtol=1e-9, atol=1e-15)
+        assert np.all(st[f"{key}_err"] > 0)
+    widths = np.diff(prof["edges"])
+    n_mean = np.sum(np.nan_to_num(prof["number_density"]) * widths) / widths.sum()
+    assert n_mean == pytest.approx(40 / (4.8 * 12.0), rel=1e-9)
+    n_test = 40 / (4.8 * 11.0)  # the gas fills y ∈ [0.5, 11.5]: uniform in the middle
+    for key in ("normal", "parallel"):
+        mean_line = line(fig, f"{name}:n_mean:{key}")
+        np.testing.assert_allclose(mean_line.get_ydata(), [n_mean, n_mean], rtol=1e-12)
+        assert mean_line.get_linestyle() == "--"
+        assert mean_line.get_color() == line(fig, f"{name}:{key}").get_color()
+        test_line = line(fig, f"{name}:n_test:{key}")
+        assert test_line.get_ydata()[0] == pytest.approx(n_test, rel=0.03)
+        # an uncorrelated gas: Campbell's normalisation gives the local number density
+        assert np.mean(st[key]) == pytest.approx(n_test, rel=0.04), key
+        assert np.mean(st[key]) > 1.04 * n_mean
+    labels = fig.axes[-1].get_legend().get_texts()
+    assert any(f"n̄ = {n_mean:.3g}" in t.get_text() for t in labels)
+    assert fig.axes[0].get_ylabel() == "number density of partners (d⁻²)"
+    assert fig.axes[0].get_xlabel() == "|Δy| (d)" and fig.axes[1].get_xlabel() == "|Δx| (d)"
+    assert "no gravity here" in footer(fig) and "synthetic (test 1)" in footer(fig)
+
+
+def test_cgprofiles_overlay_the_binned_profiles_of_the_same_file(couette):
+    """The coarse-grained ν, u_x, T (lines) and their bands equal the stored arrays, the
+    binned /profiles of the same file are drawn as markers with error bars in the same
+    colour; both agree in the bulk; ``scaled`` divides both by the wall gap."""
+    res = read_results(couette)
+    cg, prof = res.groups["statistics/cgprofiles"], res.profiles
+    name = couette.name
+    fig = draw("cgprofiles", [Run.load(couette)])
+    seen = cg["solid_fraction"] > 1e-3
+    occupied = prof["solid_fraction"] > 1e-3
+    for key in ("solid_fraction", "velocity", "temperature"):
+        val, err = cg[key], cg[f"{key}_err"]
+        bval, berr = prof[key], prof[f"{key}_err"]
+        if val.ndim == 2:
+            val, err, bval, berr = val[:, 0], err[:, 0], bval[:, 0], berr[:, 0]
+        mask = np.isfinite(val) & (seen if key != "solid_fraction" else True)
+        cg_line = line(fig, f"{name}:cg:{key}")
+        same(cg_line, val[mask], cg["y"][mask])
+        band = [c for ax in fig.axes for c in ax.collections
+                if c.get_gid() == f"{name}:cg:{key}_err"]
+        xs = band[0].get_paths()[0].vertices[:, 0]
+        assert np.all(np.isin(val[mask] - err[mask], xs))
+        assert np.all(np.isin(val[mask] + err[mask], xs))
+        bmask = occupied if key != "solid_fraction" else np.ones_like(occupied)
+        binned = line(fig, f"{name}:{key}")
+        same(binned, bval[bmask], prof["y"][bmask])
+        assert binned.get_linestyle() == "None" and binned.get_color() == cg_line.get_color()
+        _x, _y, half = _errorbars_x(fig, f"{name}:{key}")
+        np.testing.assert_allclose(half, berr[bmask], rtol=1e-9, atol=1e-15)
+        # the same field: CG at the strip centres agrees in the bulk (2 < y < 10) ...
+        bulk = (prof["y"] > 2) & (prof["y"] < 10)
+        at_centres = np.interp(prof["y"][bulk], cg["y"], val)
+        if key != "temperature":
+            scale = np.max(np.abs(bval[bulk]))
+            assert np.max(np.abs(at_centres - bval[bulk])) < 0.1 * scale, key
+            continue
+        # ... T once the gradient u' = 1/12 is taken out: u'² ⟨s²⟩/dim with ⟨s²⟩ the kernel's
+        # variance (CG, point particles) or the strip's h²/12 plus a disc's R²/4 (binned)
+        # (0.00034 apart, 11 % of T = 0.0025)
+        grad2 = (1 / 12) ** 2
+        kernel = float(res.group_attrs["statistics/cgprofiles"]["truncated_variance"])
+        cg_t = np.mean(at_centres) - grad2 * kernel / 2
+        bin_t = np.mean(bval[bulk]) - grad2 * (1 / 12 + 0.25 / 4) / 2
+        assert cg_t == pytest.approx(0.05**2, rel=0.03)
+        assert bin_t == pytest.approx(0.05**2, rel=0.03)
+        assert cg_t == pytest.approx(bin_t, rel=0.01)
+    assert fig.axes[1].get_xlabel() == "mean velocity u_x (d/τ)"
+    assert "m d²/τ²" in fig.axes[2].get_xlabel() and fig.axes[0].get_ylabel() == "y (d)"
+
+    scaled = draw("cgprofiles", [Run.load(couette)], scaled=True)
+    same(line(scaled, f"{name}:cg:solid_fraction"), cg["solid_fraction"], cg["y"] / 12.0)
+    same(line(scaled, f"{name}:solid_fraction"), prof["solid_fraction"], prof["y"] / 12.0)
+    assert "gap between the walls" in scaled.axes[0].get_ylabel()
+
+
+def _errorbars_x(fig, gid):
+    """(x, y, half-length) of the horizontal error bars of the errorbar drawn with ``gid``."""
+    found = [c for ax in fig.axes for c in ax.containers
+             if c.lines[0] is not None and c.lines[0].get_gid() == gid]
+    assert found, f"no error bars {gid!r}"
+    seg = np.asarray(found[0].lines[2][0].get_segments(), float)
+    return seg.mean(axis=1)[:, 0], seg[:, 0, 1], 0.5 * (seg[:, 1, 0] - seg[:, 0, 0])
+
+
+def test_all_draws_structure_and_cgprofiles_where_present_and_overlays(couette, chute, channel,
+                                                                        tmp_path, capsys):
+    """`--kind all` on a file holding them writes both figures (no notice for them); on one
+    without them it skips both with a notice; overlays: one curve per file, a 2D and a 3D
+    structure file together, a file without /profiles (no reference line, CG only)."""
+    out = tmp_path / "all.png"
+    assert main(["plot", str(couette), "--kind", "all", "-o", str(out)]) == 0
+    cap = capsys.readouterr()
+    for kind in ("structure", "cgprofiles", "profiles"):
+        png = tmp_path / f"all-{kind}.png"
+        assert f"figure: {png}" in cap.out and png.stat().st_size > 20_000, kind
+    assert "structure skipped" not in cap.err and "cgprofiles skipped" not in cap.err
+
+    assert main(["plot", str(chute), str(couette), "--kind", "structure,cgprofiles",
+                 "-o", str(tmp_path / "two.png")]) == 0
+    cap = capsys.readouterr()
+    assert (tmp_path / "two-structure.png").exists() and (tmp_path / "two-cgprofiles.png").exists()
+    assert "chute.h5: no /statistics/structure: structure skipped" in cap.err
+    assert "chute.h5: no /statistics/cgprofiles: cgprofiles skipped" in cap.err
+
+    path3 = tmp_path / "channel3d.h5"  # 3D, no /profiles
+    assert main(["analyze", str(channel), "--what", "structure,cgprofiles",
+                 "--out", str(path3)]) == 0
+    st3 = read_results(path3).groups["statistics/structure"]
+    fig = draw("structure", [Run.load(couette), Run.load(path3)])
+    same(line(fig, "channel3d.h5:parallel"), st3["r"], st3["parallel"])
+    st2 = read_results(couette).groups["statistics/structure"]
+    same(line(fig, "couette.h5:parallel"), st2["r"], st2["parallel"])
+    colours = {line(fig, f"{f}:normal").get_color() for f in ("couette.h5", "channel3d.h5")}
+    assert len(colours) == 2
+    gids = {ln.get_gid() for ax in fig.axes for ln in ax.lines}
+    assert "couette.h5:n_mean:normal" in gids and not any(
+        g and g.startswith("channel3d.h5:n_") for g in gids)
+    assert "3D" in fig.axes[1].get_xlabel() and "d⁻³ in 3D" in fig.axes[0].get_ylabel()
+    fig = draw("cgprofiles", [Run.load(path3)])
+    cg3 = read_results(path3).groups["statistics/cgprofiles"]
+    same(line(fig, "channel3d.h5:cg:solid_fraction"), cg3["solid_fraction"], cg3["y"])
+    assert not any(ln.get_gid() == "channel3d.h5:solid_fraction" for ax in fig.axes
+                   for ln in ax.lines)
+    assert "Traceback" not in cap.err

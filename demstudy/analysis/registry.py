@@ -181,7 +181,7 @@ def _gr(ctx: Context):
 
 
 @statistic("structure", "Campbell's normal and parallel structure distributions", "stream",
-           plots=())
+           plots=("structure",))
 def _structure(ctx: Context):
     from .structure import StructureDistributions
     from .suite import profile_bounds
@@ -254,7 +254,7 @@ def _waves(ctx: Context):
 
 
 @statistic("cgprofiles", "coarse-grained (Gaussian-kernel) profiles", "stream",
-           plots=())
+           plots=("cgprofiles",))
 def _cgprofiles(ctx: Context):
     from .suite import correlation_analysis
 

@@ -4,12 +4,16 @@ Malik 2008). Dimensionless particle units: d = 1, m = 1, g = 1 with gravity.
 Kinds (``demstudy plot RUN.h5 … --kind``; see docs/plots.md):
 
 * ``profiles``: ν, u_x, T, rotational T against y, or (y − y_0)/H with ``scaled``;
+* ``cgprofiles``: coarse-grained (Gaussian kernel) ν, u_x, T over the binned profiles
+  (``scaled`` too);
 * ``stress``: kinetic, contact / collisional and total P_xy, P_yy against y, wall stresses,
   momentum balance;
 * ``vdf``: Campbell's P(X1…X5) with folded Maxwellians, Malik's P(C/σ) with the Gaussian;
 * ``angles``: P(θ) in both conventions with Savage–Jeffrey;
 * ``freepath``: P(λ), P(τ) per y-bin with the exponential of the bin's mean;
 * ``gr``: g(r) (whole box, in-bin when stored);
+* ``structure``: Campbell's normal and parallel structure distributions with the mean
+  number density;
 * ``vcorr``: C_αα(r) per component and the off-diagonal C_αβ(r);
 * ``lambda``: Λ(y) with 1/3;
 * ``waves``: power spectrum of the dominant plane, its density contour, mode amplitudes;
@@ -31,9 +35,16 @@ from matplotlib.figure import Figure
 
 from ..analysis.registry import STATISTICS
 from .common import HOW_PLOT_ONLY, Run, missing_notice, save
-from .correlations import draw_gr, draw_lambda, draw_vcorr
+from .correlations import draw_gr, draw_lambda, draw_structure, draw_vcorr
 from .distributions import draw_angles, draw_freepath, draw_vdf
-from .profiles import draw_cooling, draw_eos, draw_profiles, draw_stress, reference_height
+from .profiles import (
+    draw_cgprofiles,
+    draw_cooling,
+    draw_eos,
+    draw_profiles,
+    draw_stress,
+    reference_height,
+)
 from .waves import draw_waves
 
 #: the drawing function of every kind; ``bins``: it takes the bins to draw
@@ -42,8 +53,11 @@ DRAW: dict[str, tuple[Callable[..., Figure], bool]] = {
     "eos": (draw_eos, False), "vdf": (draw_vdf, True), "angles": (draw_angles, True),
     "freepath": (draw_freepath, True), "gr": (draw_gr, True), "vcorr": (draw_vcorr, True),
     "lambda": (draw_lambda, False), "waves": (draw_waves, False),
-    "cooling": (draw_cooling, False),
+    "cooling": (draw_cooling, False), "structure": (draw_structure, False),
+    "cgprofiles": (draw_cgprofiles, False),
 }
+#: the kinds that take ``scaled`` (against (y − y_0)/H)
+SCALED = ("profiles", "cgprofiles")
 #: the kinds, in the order ``--kind all`` draws them: each registered statistic's figures
 #: (``demstudy.analysis.registry``), then those drawn from the time series
 KINDS = tuple(dict.fromkeys([k for s in STATISTICS.values() for k in s.plots] +
@@ -52,9 +66,9 @@ if set(KINDS) != set(DRAW):  # a statistic declares a figure nobody draws, or vi
     raise ImportError(f"plot kinds out of step: registered {sorted(KINDS)}, drawn "
                       f"{sorted(DRAW)}")
 
-__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_cooling", "draw_eos", "draw_freepath",
-           "draw_gr",
-           "draw_lambda", "draw_profiles", "draw_stress", "draw_vcorr", "draw_vdf", "draw_waves",
+__all__ = ["KINDS", "Run", "draw", "draw_angles", "draw_cgprofiles", "draw_cooling", "draw_eos",
+           "draw_freepath", "draw_gr", "draw_lambda", "draw_profiles", "draw_stress",
+           "draw_structure", "draw_vcorr", "draw_vdf", "draw_waves",
            "output_path", "parse_kinds", "plot_files", "plot_profiles", "reference_height"]
 
 
@@ -81,7 +95,7 @@ def draw(kind: str, runs: Sequence[Run], *, scaled: bool = False,
     if kind not in KINDS:
         raise ValueError(f"unknown plot kind {kind!r} (allowed: {', '.join(KINDS)})")
     fn, takes_bins = DRAW[kind]
-    if kind == "profiles":
+    if kind in SCALED:
         return fn(runs, scaled=scaled)
     return fn(runs, bins=bins) if takes_bins else fn(runs)
 

@@ -8,6 +8,7 @@ plotted data.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,7 +23,8 @@ from ..io.results import Results, read_results
 #: a dataset that must be present for the kind to be drawable
 REQUIRED = {"stress": "total", "eos": "total", "vdf": "X", "angles": "p_text",
             "freepath": "p_lambda", "gr": "g",
-            "vcorr": "C", "lambda": "lambda", "waves": "series_time"}
+            "vcorr": "C", "lambda": "lambda", "waves": "series_time",
+            "structure": "normal", "cgprofiles": "solid_fraction"}
 #: figures drawn from a run's time series and scene rather than from a statistic
 HOW_PLOT_ONLY = {"cooling": "Haff's law needs every axis periodic, no walls, gravity or "
                             "shear, equal particles and a constant e < 1"}
@@ -182,8 +184,14 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03) -
     above ``bottom`` (a figure fraction: room for a legend below the panels)."""
     engines = ", ".join(dict.fromkeys(run.engine for run in runs))
     fig.suptitle(title, fontsize=10)
-    fig.text(0.005, 0.005, f"{units_text(runs)}  |  engine: {engines}", fontsize=7,
-             ha="left", va="bottom")
+    footer = f"{units_text(runs)}  |  engine: {engines}"
+    chars = int(fig.get_figwidth() * 72 / (7 * 0.56))  # 7 pt characters across the figure
+    if len(footer) > chars:  # units on one line, the engines (long version strings) below
+        footer = "\n".join([units_text(runs)] + textwrap.wrap(
+            f"engine: {engines}", chars, break_on_hyphens=False))
+    fig.text(0.005, 0.005, footer, fontsize=7, ha="left", va="bottom")
+    lines = footer.count("\n") + 1
+    bottom = max(bottom, (lines * 7 * 1.25 / 72 + 0.04) / fig.get_figheight())
     fig.set_layout_engine("tight", rect=(0, bottom, 1, 0.96))  # applied when drawn (saved)
     return fig
 

@@ -1,4 +1,5 @@
-"""Pair correlation g(r), velocity correlations C_αα(r), C_αβ(r) and Malik's Λ(y).
+"""Pair correlation g(r), Campbell's structure distributions, velocity correlations C_αα(r),
+C_αβ(r) and Malik's Λ(y).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 with gravity (r in particle diameters).
 """
@@ -6,11 +7,14 @@ Dimensionless particle units: d = 1, m = 1, g = 1 with gravity (r in particle di
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
-from .common import LINESTYLES, Run, bin_label, finish, new_figure, pick_bins
+from .common import LINESTYLES, MARKERS, Run, bin_label, finish, new_figure, pick_bins
+from .profiles import _edges, panels_with_legend_row
 
 
 def _artefact(ax, r_edges: np.ndarray, flags: np.ndarray | None) -> None:
@@ -133,3 +137,114 @@ def draw_lambda(runs: Sequence[Run]) -> Figure:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper right")
     return finish(fig, runs, "orientational correlation Λ(y)")
+
+
+def _bin_overlap(edges: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Length of each bin [e_b, e_b+1) inside [lo, hi]."""
+    return np.clip(np.minimum(edges[1:], hi) - np.maximum(edges[:-1], lo), 0.0, None)
+
+
+def structure_references(run: Run) -> dict[str, float]:
+    """Campbell's dilute-limit densities of a run from its ``/profiles``: ``n_mean``, the mean
+    number density between the profile bounds (Σ n_b w_b / Σ w_b over the bins, empty bins
+    counting 0: N/V, Campbell's n = ν/(πR²) with the run's mean ν), ``nu_mean`` the mean solid
+    fraction, and ``n_test`` the number density of the test region (bins within
+    ``half_width`` of the structure's mid-plane, overlap-weighted; profiles along y only).
+    Empty without ``/profiles``."""
+    prof = run.results.profiles
+    if not prof or "number_density" not in prof or "y" not in prof:
+        return {}
+    edges = _edges(prof)
+    widths = np.diff(edges)
+    n = np.asarray(prof["number_density"], float)
+    n = np.where(np.isfinite(n), n, 0.0)  # an empty bin holds no particle
+    out = {"n_mean": float(np.sum(n * widths) / np.sum(widths))}
+    if "solid_fraction" in prof:
+        out["nu_mean"] = float(np.sum(np.asarray(prof["solid_fraction"], float) * widths)
+                               / np.sum(widths))
+    _data, attrs = run.group("structure")
+    if run.results.profile_attrs.get("axis", "y") == "y" and "half_width" in attrs:
+        if run.scene is not None:  # the mid-plane the analysis used (registry: _structure)
+            from ..analysis.suite import profile_bounds
+
+            lo, hi, _period = profile_bounds(run.scene)
+        else:
+            lo, hi = float(edges[0]), float(edges[-1])
+        h = float(attrs["half_width"])
+        overlap = _bin_overlap(edges, 0.5 * (lo + hi) - h, 0.5 * (lo + hi) + h)
+        if overlap.sum() > 0:
+            out["n_test"] = float(np.sum(n * overlap) / overlap.sum())
+    return out
+
+
+def draw_structure(runs: Sequence[Run]) -> Figure:
+    """Campbell's (1982) structure distributions, in his figures' form: left the normal
+    distribution (number density of partners at a distance |Δy| from a test particle, over
+    the whole periodic cross-section), right the parallel one (against |Δx| in 2D,
+    √(Δx² + Δz²) in 3D, for partners with |Δy| < h), test particles within h of the
+    mid-plane, with error bars; dashed in the run's colour the dilute, uncorrelated limit
+    n̄ = the run's mean number density (Campbell's normalisation, n = ν/(πR²) in 2D), dotted
+    the number density of the test region (the limit the estimator tends to when the density
+    varies across the channel). Top axis: Campbell's unit R = d/2."""
+    refs = [structure_references(run) for run in runs]
+    empty = [ref.get("n_test") == 0.0
+             or not np.any(np.asarray(run.group("structure")[0]["normal"], float))
+             for run, ref in zip(runs, refs, strict=True)]
+    fig, axes, legend_row = panels_with_legend_row(2, len(runs) + sum(empty), width=5.2,
+                                                   height=4.4, sharey="row")
+    dims, widths = set(), set()
+    # legend below the panels, one row per run: the data, n̄, the test region's n
+    columns: list[list[tuple[Any, str]]] = [[], [], []]
+    blank = (Line2D([], [], alpha=0), "")
+    for r, run in enumerate(runs):
+        data, attrs = run.group("structure")
+        name, colour = run.path.name, f"C{r}"
+        dims.add(int(attrs.get("dim", 2)))
+        widths.add(f"{float(attrs.get('half_width', 1.0)):.3g}")
+        ref = refs[r]
+        rr = np.asarray(data["r"], float)
+        label = run.label + (f", ν̄ = {ref['nu_mean']:.3g}" if "nu_mean" in ref else "")
+        if empty[r]:  # e.g. an open-top chute: the box's mid-plane lies above the flow
+            label += "\nNO PARTICLES AT THE MID-PLANE: the distributions are empty"
+        labels = (label,
+                  f"n̄ = {ref.get('n_mean', 0):.3g}: mean number density (dilute limit, "
+                  "Campbell)", f"n = {ref.get('n_test', 0):.3g} in the test region")
+        row: list[tuple[Any, str]] = []
+        for ax, key in zip(axes, ("normal", "parallel"), strict=True):
+            err = data.get(f"{key}_err")
+            row = [(ax.errorbar(rr, np.asarray(data[key], float), yerr=err,
+                                marker=MARKERS[r % len(MARKERS)], ms=3, lw=1, capsize=1.5,
+                                color=colour, label=labels[0], gid=f"{name}:{key}"),
+                    labels[0])]
+            for ref_key, style, text in (("n_mean", "--", labels[1]),
+                                         ("n_test", ":", labels[2])):
+                if ref_key in ref:
+                    row.append((ax.axhline(ref[ref_key], color=colour, ls=style, lw=1.2,
+                                           label=text, gid=f"{name}:{ref_key}:{key}"), text))
+                else:
+                    row.append(blank)
+        for column, entry in zip(columns, row, strict=True):
+            column.append(entry)
+    inplane = {frozenset({2}): "|Δx|", frozenset({3}): "√(Δx² + Δz²)"}.get(
+        frozenset(dims), "|Δx| (2D), √(Δx² + Δz²) (3D)")
+    unit = {frozenset({2}): "d⁻²", frozenset({3}): "d⁻³"}.get(frozenset(dims),
+                                                               "d⁻² in 2D, d⁻³ in 3D")
+    h = widths.pop() if len(widths) == 1 else "(see the files)"
+    titles = ("normal: partners at |Δy| (whole cross-section)",
+              f"parallel: partners at {inplane}, |Δy| < h")
+    xlabels = ("|Δy| (d)", f"{inplane} (d)")
+    for ax, title, xlabel in zip(axes, titles, xlabels, strict=True):
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel(xlabel)
+        ax.set_xlim(left=0)
+        ax.set_ylim(bottom=0)
+        ax.grid(alpha=0.3)
+        top = ax.secondary_xaxis("top", functions=(lambda x: 2 * x, lambda x: 0.5 * x))
+        top.set_xlabel("in Campbell's R = d/2", fontsize=8)
+        top.tick_params(labelsize=7)
+    axes[0].set_ylabel(f"number density of partners ({unit})")
+    entries = [e for column in columns for e in column]  # the legend fills column by column
+    legend_row.legend(*zip(*entries, strict=True), fontsize=7, ncol=3, loc="center",
+                      frameon=False)
+    return finish(fig, runs, "Campbell's structure distributions about test particles within "
+                             f"h = {h} d of the mid-plane")

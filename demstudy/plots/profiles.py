@@ -7,11 +7,13 @@ positive, P = −σ (Campbell: τ_yy = P_yy, τ_xy = −P_xy), force per length 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from .common import MARKERS, Run, finish, new_figure
 
@@ -114,6 +116,124 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
         if pairs:
             ax.legend(*zip(*pairs, strict=True), fontsize=7, loc="upper right")
     return finish(fig, runs, "profiles: solid fraction, mean velocity, temperatures")
+
+
+def panels_with_legend_row(n_cols: int, legend_lines: int, width: float, height: float,
+                           **kwargs: Any) -> tuple[Figure, np.ndarray, Axes]:
+    """A Figure with one row of ``n_cols`` panels (``height`` inches) and below them an axes
+    without frame spanning the width, for a legend of ``legend_lines`` lines (keeps the
+    legend off the data and inside the tight layout)."""
+    legend_height = 0.25 + 0.17 * legend_lines
+    fig, grid = new_figure(2, n_cols, width=width, height=0.5 * (height + legend_height),
+                           height_ratios=[height, legend_height], **kwargs)
+    for ax in grid[1, 1:]:
+        ax.remove()
+    legend_row = grid[1, 0]
+    legend_row.set_subplotspec(legend_row.get_subplotspec().get_gridspec()[1, :])
+    legend_row.axis("off")
+    return fig, grid[0], legend_row
+
+
+CG_PANELS = (
+    ("solid_fraction", "solid fraction ν"),
+    ("velocity", "mean velocity u_x (d/τ)"),
+    ("temperature", "temperature T (m d²/τ², per d.o.f.)"),
+)
+
+
+def _cg_reference_height(run: Run) -> tuple[float, float, str]:
+    """(y_0, H, what H is) for the scaled coarse-grained profiles: the binned profiles' H
+    (:func:`reference_height`), else the span of the evaluation points' cells."""
+    if run.results.profiles and "y" in run.results.profiles:
+        return reference_height(run)
+    data, attrs = run.group("cgprofiles")
+    y = np.asarray(data["y"], float)
+    h = float(attrs.get("spacing", y[1] - y[0] if y.size > 1 else 1.0))
+    return float(y[0] - 0.5 * h), float(y[-1] - y[0] + h), "span of the CG points"
+
+
+def draw_cgprofiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
+    """Gaussian coarse-grained ν, u_x and T (MercuryCG kernel, ``/statistics/cgprofiles``)
+    against the profile axis, lines with their error bands, over the binned profiles of the
+    same file (``/profiles``, markers with error bars) so that the two can be compared: they
+    agree where the fields vary slowly on the kernel width w; within 3 w of a wall the CG ν
+    falls (the kernel mass beyond the wall is lost), and a velocity gradient u' adds
+    u'² s²/dim to the CG temperature (s² = 0.973 w², attrs ``truncated_variance``) against
+    u'² (h²/12 + the particle's own spread)/dim to a strip's (width h; the strips share each
+    particle by its volume overlap). ``scaled``: against (y − y_0)/H
+    (:func:`reference_height`)."""
+    fig, axes, legend_row = panels_with_legend_row(len(CG_PANELS), len(runs), width=4.2,
+                                                   height=4.6, sharey="row")
+    what: set[str] = set()
+    spans: list[float] = []  # where either profile holds particles (open tops: not above)
+    for r, run in enumerate(runs):
+        name, colour = run.path.name, f"C{r}"
+        data, attrs = run.group("cgprofiles")
+        prof = run.results.profiles if run.results.profiles and "y" in run.results.profiles \
+            else {}
+        y_cg = np.asarray(data["y"], float)
+        y_bin = np.asarray(prof["y"], float) if prof else None
+        if scaled:
+            y0, height, kind = _cg_reference_height(run)
+            what.add(kind)
+            y_cg = (y_cg - y0) / height
+            y_bin = None if y_bin is None else (y_bin - y0) / height
+        prefix = f"{run.label}: " if len(runs) > 1 else ""
+        if scaled:
+            prefix = f"{run.label}, H = {height:.3g}: " if len(runs) > 1 else \
+                f"H = {height:.3g}: "
+        width = float(attrs.get("width", np.nan))
+        # where the kernel sees particles (velocity is NaN beyond every particle's reach)
+        cg_seen = np.asarray(data["solid_fraction"], float) > 1e-3
+        occupied = np.asarray(prof["solid_fraction"], float) > 1e-3 if prof else None
+        spans += list(y_cg[cg_seen]) + ([] if y_bin is None else list(y_bin[occupied]))
+        for ax, (key, title) in zip(axes, CG_PANELS, strict=True):
+            if prof and key in prof:
+                val, err = np.asarray(prof[key], float), prof.get(f"{key}_err")
+                err = None if err is None else np.asarray(err, float)
+                if val.ndim == 2:  # vectors: the flow (x) component
+                    val, err = val[:, 0], None if err is None else err[:, 0]
+                mask = occupied if key != "solid_fraction" else np.ones_like(occupied)
+                bin_width = float(run.results.profile_attrs.get(
+                    "bin_width", np.diff(_edges(prof)).mean()))
+                ax.errorbar(val[mask], y_bin[mask], xerr=None if err is None else err[mask],
+                            ls="none", marker=MARKERS[r % len(MARKERS)], ms=4, mfc="none",
+                            capsize=2, color=colour, zorder=3,
+                            label=f"{prefix}binned (strips {bin_width:.3g} d wide)",
+                            gid=f"{name}:{key}")
+            if key not in data:
+                continue
+            val, err = np.asarray(data[key], float), data.get(f"{key}_err")
+            err = np.zeros_like(val) if err is None else np.asarray(err, float)
+            if val.ndim == 2:
+                val, err = val[:, 0], err[:, 0]
+            mask = (cg_seen if key != "solid_fraction" else np.ones_like(cg_seen)) \
+                & np.isfinite(val)
+            ax.plot(val[mask], y_cg[mask], color=colour, lw=1.5,
+                    label=f"{prefix}coarse-grained, w = {width:.3g} d (± error band)",
+                    gid=f"{name}:cg:{key}")
+            ax.fill_betweenx(y_cg[mask], (val - err)[mask], (val + err)[mask], color=colour,
+                             alpha=0.25, lw=0, gid=f"{name}:cg:{key}_err")
+            ax.set_xlabel(title)
+            ax.xaxis.set_major_locator(MaxNLocator(5))
+            ax.grid(alpha=0.3)
+    lo, hi = axes[0].get_ylim()
+    if spans:  # empty space above an open top's flow is left out (1 d or 5 % margin)
+        margin = 0.05 if scaled else 1.0
+        axes[0].set_ylim(max(lo, min(spans) - margin), min(hi, max(spans) + margin))
+    axis = runs[0].group("cgprofiles")[1].get("axis", "y")
+    if scaled:
+        kind = what.pop() if len(what) == 1 else "see the legend"
+        axes[0].set_ylabel(f"({axis} − {axis}_0)/H,  H = {kind}")
+    else:
+        axes[0].set_ylabel(f"{axis} (d)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    legend_row.legend(handles, labels, fontsize=7, loc="center", ncol=2, frameon=False)
+    taus = ", ".join(dict.fromkeys(str(run.attrs["time_unit"]) for run in runs
+                                   if "time_unit" in run.attrs))
+    return finish(fig, runs, "coarse-grained profiles (Gaussian kernel of width w, cut off at "
+                             "3w; lines, bands: ± error) over the binned profiles (markers)"
+                             + (f"\ntime unit {taus}" if taus else ""))
 
 
 STRESS_PARTS = ("kinetic", "contact", "collisional", "total")
