@@ -180,6 +180,8 @@ def _gr(ctx: Context):
                            periodic_y=scene.y_periodic)
 
 
+# test particles within a bin width of the mid-plane: the channel's middle (between servo
+# walls: where they stand when production starts), or with an open top the initial bed's
 @statistic("structure", "Campbell's normal and parallel structure distributions", "stream",
            plots=("structure",))
 def _structure(ctx: Context):
@@ -188,6 +190,13 @@ def _structure(ctx: Context):
 
     scene = ctx.scene
     lo, hi, _period = profile_bounds(scene)
+    if ctx.walls is not None:  # servo walls: where they stand when production starts
+        lo, hi = ctx.walls
+    if scene.has_open_top:  # the middle of the bed, not of the empty box above it
+        from ..scene.initial import build_initial_state
+
+        lo = scene.wall_surface("lower")
+        hi = float(build_initial_state(scene).position[:, 1].max())
     across = [scene.box.size[i] for i, a in enumerate("xyz"[:scene.dimension]) if a != "y"]
     return StructureDistributions(dim=scene.dimension, r_max=min(4.0, 0.5 * min(across) - 0.05),
                                   dr=0.08, half_width=scene.measure.bin_width,

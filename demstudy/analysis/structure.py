@@ -73,6 +73,7 @@ class StructureDistributions(AnalysisBase):
         pos = box.wrap(frame.position).position
         lo, hi = box.lo, box.hi
         y_mid = 0.5 * (lo[1] + hi[1]) if self.y_mid is None else self.y_mid
+        self._y_mid_used = float(y_mid)
         test = np.flatnonzero(np.abs(pos[:, 1] - y_mid) < self.half_width)
         normal = np.zeros(self.n_r)
         # normal: every partner within r_max along y, whatever its x (z): a sorted sweep
@@ -113,7 +114,7 @@ class StructureDistributions(AnalysisBase):
         self.results = {"r": r, "normal": est["normal"], "normal_err": err["normal"],
                         "parallel": est["parallel"], "parallel_err": err["parallel"]}
         self.attrs = {"frames": self.n_frames, "dim": self.dim, "dr": self.dr,
-                      "half_width": self.half_width,
+                      "half_width": self.half_width, "y_mid": self._y_mid_used,
                       "units": "number density (per area in 2D, per volume in 3D), d = 1",
                       "convention": "Campbell (1982): test particles within half_width of "
                                     "the mid-plane; normal vs |dy| over the whole section, "

@@ -164,14 +164,11 @@ def structure_references(run: Run) -> dict[str, float]:
                                / np.sum(widths))
     _data, attrs = run.group("structure")
     if run.results.profile_attrs.get("axis", "y") == "y" and "half_width" in attrs:
-        if run.scene is not None:  # the mid-plane the analysis used (registry: _structure)
-            from ..analysis.suite import profile_bounds
-
-            lo, hi, _period = profile_bounds(run.scene)
-        else:
-            lo, hi = float(edges[0]), float(edges[-1])
+        # the mid-plane the analysis used (files written before it was stored: the middle
+        # of the profile range)
+        y_mid = float(attrs.get("y_mid", 0.5 * (edges[0] + edges[-1])))
         h = float(attrs["half_width"])
-        overlap = _bin_overlap(edges, 0.5 * (lo + hi) - h, 0.5 * (lo + hi) + h)
+        overlap = _bin_overlap(edges, y_mid - h, y_mid + h)
         if overlap.sum() > 0:
             out["n_test"] = float(np.sum(n * overlap) / overlap.sum())
     return out
