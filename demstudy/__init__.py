@@ -43,6 +43,10 @@ _LAZY = {
 }
 
 
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY) | {"testing"})
+
+
 def __getattr__(name: str) -> Any:
     import importlib
 

@@ -24,7 +24,7 @@ from .scene import Scene, load_scene
 __all__ = ["load", "run"]
 
 
-def run(scene: Scene | str | os.PathLike, engine: str | None = None,
+def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
         out: str | os.PathLike | None = None, *, isolate: bool = True, np: int = 1,
         resume: bool = False, keep_frames: bool | None = None,
         wall_limit: float | None = None, checkpoint_interval: float | None = None,
@@ -32,7 +32,7 @@ def run(scene: Scene | str | os.PathLike, engine: str | None = None,
         **engine_options: Any) -> Results:
     """Run ``scene`` (a Scene, a scene file or a preset name) in ``engine`` (default: the
     CLI's default, ``demstudy.engines.DEFAULT_ENGINE``; see ``demstudy.engines.backend_names``)
-    and return its :class:`Results`, also written to ``out`` (default
+    (or a backend class) and return its :class:`Results`, also written to ``out`` (default
     ``results/<scene name>-<engine>.h5``).
 
     ``isolate`` (default True) runs the engine in a child process, so that a crash in
@@ -43,20 +43,20 @@ def run(scene: Scene | str | os.PathLike, engine: str | None = None,
     shows a progress bar (default: when stderr is a terminal). Engine options go as keywords,
     e.g. ``tc=1e-4`` for the event-driven engine. Everything the engine cannot do is
     refused before it starts (``UnsupportedByEngine``)."""
-    from .engines import DEFAULT_ENGINE
+    from .engines import DEFAULT_ENGINE, get_backend
     from .simulation import RunOptions, run_scene
 
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
-    engine = engine or DEFAULT_ENGINE
+    backend = get_backend(engine or DEFAULT_ENGINE) if not isinstance(engine, type) else engine
     if out is None:
-        out = Path("results") / f"{scene.meta.name}-{engine}.h5"
+        out = Path("results") / f"{scene.meta.name}-{backend.name}.h5"
     options = RunOptions(out=Path(out), np=np, dump=Path(dump) if dump else None,
                          resume=resume, keep_frames=keep_frames,
                          checkpoint_interval=checkpoint_interval, isolate=isolate,
                          wall_limit=wall_limit, extra=engine_options,
                          progress=sys.stderr.isatty() if progress is None else progress)
-    return read_results(run_scene(scene, engine, options))
+    return read_results(run_scene(scene, backend, options))
 
 
 def load(path: str | os.PathLike) -> Results:

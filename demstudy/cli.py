@@ -40,15 +40,9 @@ def _cmd_deck(args: argparse.Namespace) -> int:
 
 def _engine_options(args: argparse.Namespace) -> dict:
     """The engine options given on the command line (``--tc`` …), by name."""
-    from .engines import backend_names, get_backend
-
-    given = {}
-    for engine in backend_names():
-        for name in get_backend(engine).options:
-            value = getattr(args, f"engine_option_{name}", None)
-            if value is not None:
-                given[name] = value
-    return given
+    prefix = "engine_option_"
+    return {key.removeprefix(prefix): value for key, value in vars(args).items()
+            if key.startswith(prefix) and value is not None}
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -108,6 +102,9 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
         def frames():
             return (f for f in frames_of(results, scene.dimension) if f.time >= args.start)
+
+        if not results.frames:
+            frames = None  # statistics from frames are refused, naming themselves
     else:
         from .io.dump import dump_source
 
@@ -182,11 +179,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wall-limit", type=float, metavar="SECONDS",
                    help="checkpoint and stop after this much wall-clock time (then --resume)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
-    for engine in engines:  # each engine's own options, checked against --engine
+    owners: dict[str, list] = {}  # each engine option once, whichever engines have it
+    for engine in engines:
         for name, option in get_backend(engine).options.items():
-            p.add_argument(f"--{name.replace('_', '-')}", type=option.kind,
-                           dest=f"engine_option_{name}", metavar=option.metavar,
-                           help=f"{engine} only: {option.help}")
+            owners.setdefault(name, []).append((engine, option))
+    for name, declared in owners.items():  # checked against --engine when the run starts
+        option = declared[0][1]
+        p.add_argument(f"--{name.replace('_', '-')}", type=option.kind,
+                       dest=f"engine_option_{name}", metavar=option.metavar,
+                       help="; ".join(f"{engine} only: {o.help}" for engine, o in declared))
     p.set_defaults(func=_cmd_run)
 
     p = sub.add_parser("plot", help="figures of results files: profiles, stress, statistics",
@@ -243,7 +244,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .errors import EngineError, RunRefused, RunStopped, UnsupportedByEngine
+    from .errors import (
+        EngineError,
+        RunRefused,
+        RunStopped,
+        StatisticUnavailable,
+        UnsupportedByEngine,
+    )
     from .io.results import COMMAND_LINE_ENV, set_command_line
 
     args = build_parser().parse_args(argv)
@@ -255,7 +262,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         if isinstance(exc, RunStopped):
             return 3  # checkpoint written: run again with --resume
-        return 2 if isinstance(exc, SceneError | UnsupportedByEngine | RunRefused) else 1
+        refused = SceneError | UnsupportedByEngine | RunRefused | StatisticUnavailable
+        return 2 if isinstance(exc, refused) else 1  # 2: nothing ran or was computed
     except KeyboardInterrupt:  # outside a run loop (which checkpoints and stops by itself)
         print("error: interrupted", file=sys.stderr)
         return 130

@@ -28,8 +28,14 @@ class RunStopped(EngineError):
     """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint."""
 
 
+class StatisticUnavailable(ValueError):
+    """A statistic cannot be computed from what it is given (no frames, no collision log, the
+    wrong dimension): nothing was computed (exit 2 on the command line)."""
+
+
 class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["EngineError", "RunRefused", "RunStopped", "UnsupportedByEngine"]
+__all__ = ["EngineError", "RunRefused", "RunStopped", "StatisticUnavailable",
+           "UnsupportedByEngine"]

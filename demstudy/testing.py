@@ -13,10 +13,16 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 Each bin's difference is divided by its combined standard error √(σ_a² + σ_b²). The
 comparison as a whole fails with the probability of a two-sided ``sigma``-σ event (0.27 % at
 3σ) when the two runs sample the same state: with n compared values each one is held to the
-Šidák-corrected level, so a profile of 40 bins does not fail by chance one time in ten.
-Bins whose values or errors are not finite (empty bins) are left out and counted. On failure
-the ``AssertionError`` carries a table of every disagreeing bin. The errors are the profiles'
-own (blocking over time); they are only as good as those (docs/results-format.md).
+Šidák-corrected level, so a profile of 40 bins does not fail by chance one time in ten. The
+errors are estimates (jackknife over the profiles' ``n_blocks`` time blocks), so each
+difference is judged against Student's t with the Welch–Satterthwaite degrees of freedom
+(n_blocks − 1 per run), not the normal distribution: with 20 blocks a 3σ-normal test would
+fail several times too often. Bins with nothing to compare are left out and counted: values
+or errors not finite, or both errors zero with equal values (an empty bin: ν = 0 ± 0 in both).
+On failure the ``AssertionError`` carries a table of every disagreeing bin. The errors are
+the profiles' own; they are only as good as the blocking behind them (docs/results-format.md).
+Runs must share their bins: servo runs lay them where the walls stand when production
+starts, so two servo runs are compared on their own bins only when those coincide.
 """
 
 from __future__ import annotations
@@ -25,43 +31,67 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
-from scipy.special import erfcinv
+from scipy.stats import t as student_t
 
 from .io.results import Results, read_results
 
-__all__ = ["ProfileComparison", "assert_profiles_agree", "compare_profiles"]
+__all__ = ["ProfileComparison", "Row", "assert_profiles_agree", "compare_profiles"]
 
 DEFAULT_FIELDS = ("solid_fraction", "velocity", "temperature")
+
+
+class Row(NamedTuple):
+    """One compared value: field (component), bin (0-based), y, both runs' values and
+    errors, z = Δ/√(σ_a² + σ_b²), the degrees of freedom of that ratio and its two-sided
+    p-value."""
+
+    field: str
+    bin: int
+    y: float
+    a: float
+    err_a: float
+    b: float
+    err_b: float
+    z: float
+    dof: float
+    p: float
 
 
 @dataclass
 class ProfileComparison:
     """The outcome of :func:`compare_profiles`: one row per compared value."""
 
-    sigma: float  # the requested significance, in σ of one two-sided test
-    threshold: float  # what each |z| is held to after the multiple-comparison correction
-    rows: list[tuple] = field(default_factory=list)  # (field, bin, y, a, err_a, b, err_b, z)
-    skipped: int = 0  # values left out (not finite in either run)
+    sigma: float  # the requested significance, in σ of one two-sided normal test
+    each: float  # the p-value each row is held to after the multiple-comparison correction
+    rows: list[Row] = field(default_factory=list)
+    skipped: int = 0  # values left out (nothing to compare)
 
     @property
     def worst(self) -> float:
-        return max((abs(r[-1]) for r in self.rows), default=0.0)
+        """The largest |z|."""
+        return max((abs(r.z) for r in self.rows), default=0.0)
+
+    @property
+    def smallest_p(self) -> float:
+        return min((r.p for r in self.rows), default=1.0)
 
     @property
     def ok(self) -> bool:
-        return self.worst <= self.threshold
+        return self.smallest_p >= self.each
 
     def table(self, only_failing: bool = True) -> str:
         head = (f"{'field':<26} {'bin':>4} {'y':>8} {'a':>12} {'±':>9} {'b':>12} {'±':>9} "
-                f"{'z':>7}")
+                f"{'z':>7} {'p':>9}")
         lines = [head, "-" * len(head)]
-        for name, b, y, a, ea, bv, eb, z in self.rows:
-            if only_failing and abs(z) <= self.threshold:
+        for r in self.rows:
+            if only_failing and r.p >= self.each:
                 continue
-            lines.append(f"{name:<26} {b + 1:>4} {y:>8.3g} {a:>12.5g} {ea:>9.2g} {bv:>12.5g} "
-                         f"{eb:>9.2g} {z:>7.2f}")
+            lines.append(f"{r.field:<26} {r.bin + 1:>4} {r.y:>8.3g} {r.a:>12.5g} "
+                         f"{r.err_a:>9.2g} {r.b:>12.5g} {r.err_b:>9.2g} {r.z:>7.2f} "
+                         f"{r.p:>9.2g}")
         return "\n".join(lines)
 
 
@@ -97,6 +127,9 @@ def compare_profiles(a: Results | str | os.PathLike, b: Results | str | os.PathL
         dense = (pa["solid_fraction"] >= min_solid_fraction) & \
                 (pb["solid_fraction"] >= min_solid_fraction)
     y = pa.get("y", 0.5 * (pa["edges"][1:] + pa["edges"][:-1]))
+    # degrees of freedom of each run's errors: jackknife over n_blocks blocks
+    dof_a, dof_b = (max(1, int(r.profile_attrs.get("n_blocks", 0)) - 1)
+                    if r.profile_attrs.get("n_blocks") else math.inf for r in (ra, rb))
     rows, skipped = [], 0
     for name in fields:
         missing = [_label(r) for r, p in ((ra, pa), (rb, pb))
@@ -110,20 +143,34 @@ def compare_profiles(a: Results | str | os.PathLike, b: Results | str | os.PathL
         for k in range(va.shape[1]):
             label = name if va.shape[1] == 1 else f"{name}[{'xyz'[k]}]"
             for i in range(len(y)):
-                values = (va[i, k], ea[i, k], vb[i, k], eb[i, k])
-                if not dense[i] or not all(map(math.isfinite, values)):
+                a, sa, b, sb = va[i, k], ea[i, k], vb[i, k], eb[i, k]
+                empty = sa == 0 and sb == 0 and a == b
+                if not dense[i] or not all(map(math.isfinite, (a, sa, b, sb))) or empty:
                     skipped += 1
                     continue
-                combined = math.hypot(ea[i, k], eb[i, k])
-                diff = va[i, k] - vb[i, k]
-                z = diff / combined if combined > 0 else (0.0 if diff == 0 else math.inf)
-                rows.append((label, i, float(y[i]), va[i, k], ea[i, k], vb[i, k], eb[i, k], z))
+                rows.append(_row(label, i, float(y[i]), a, sa, b, sb, dof_a, dof_b))
     # Šidák: each of n tests at 1 − (1 − p)^(1/n) keeps the family's false alarms at p
-    p = math.erfc(sigma / math.sqrt(2.0))
-    n = max(1, len(rows))
-    each = -math.expm1(math.log1p(-p) / n)
-    threshold = float(math.sqrt(2.0) * erfcinv(each))
-    return ProfileComparison(sigma, threshold, rows, skipped)
+    family = math.erfc(sigma / math.sqrt(2.0))
+    each = -math.expm1(math.log1p(-family) / max(1, len(rows)))
+    return ProfileComparison(sigma, each, rows, skipped)
+
+
+def _row(label: str, i: int, y: float, a: float, sa: float, b: float, sb: float,
+         dof_a: float, dof_b: float) -> Row:
+    """One compared value, its z-score and two-sided p-value (Student's t with the
+    Welch–Satterthwaite degrees of freedom; normal when both errors are exact)."""
+    var = sa * sa + sb * sb
+    diff = a - b
+    if var == 0:
+        z = 0.0 if diff == 0 else math.copysign(math.inf, diff)
+        return Row(label, i, y, a, sa, b, sb, z, math.inf, 1.0 if diff == 0 else 0.0)
+    z = diff / math.sqrt(var)
+    parts = (sa**4 / dof_a if math.isfinite(dof_a) else 0.0) + \
+            (sb**4 / dof_b if math.isfinite(dof_b) else 0.0)
+    dof = var * var / parts if parts > 0 else math.inf
+    p = math.erfc(abs(z) / math.sqrt(2.0)) if math.isinf(dof) else \
+        float(2.0 * student_t.sf(abs(z), dof))
+    return Row(label, i, y, a, sa, b, sb, z, dof, p)
 
 
 def assert_profiles_agree(a: Results | str | os.PathLike, b: Results | str | os.PathLike,
@@ -137,7 +184,7 @@ def assert_profiles_agree(a: Results | str | os.PathLike, b: Results | str | os.
     if not result.ok:
         ra, rb = _results(a), _results(b)
         raise AssertionError(
-            f"profiles disagree: |z| up to {result.worst:.2f} > {result.threshold:.2f} "
-            f"({sigma:g}σ over {len(result.rows)} values, Šidák-corrected)\n"
-            f"a = {_label(ra)}, b = {_label(rb)}\n{result.table()}")
+            f"profiles disagree: p = {result.smallest_p:.2g} < {result.each:.2g} (|z| up to "
+            f"{result.worst:.2f}; {sigma:g}σ over {len(result.rows)} values, Šidák-corrected, "
+            f"Student's t)\na = {_label(ra)}, b = {_label(rb)}\n{result.table()}")
     return result

@@ -75,3 +75,59 @@ def test_a_native_crash_in_an_isolated_run_is_an_exception(tmp_path, monkeypatch
     ballistic = ds.run(scene, engine="crashing", out=tmp_path / "y.h5", isolate=False,
                        crash=False)  # the same backend, not crashing, in this process
     assert ballistic.attrs["engine"] == "crashing"
+
+
+def test_an_interrupt_of_the_caller_alone_stops_the_isolated_run_after_a_checkpoint(tmp_path):
+    """A notebook's interrupt reaches only the kernel, not the engine's child: the caller
+    passes it on, the child checkpoints and stops, the caller gets RunStopped."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    code = ("import demstudy as ds\n"
+            "from demstudy.errors import RunStopped\n"
+            "try:\n"
+            "    ds.run('shear/lees-edwards-3d', engine='edmd', out='s.h5')\n"
+            "except RunStopped:\n"
+            "    print('stopped')\n")
+    proc = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)  # no terminal: signals reach it alone
+    time.sleep(4.0)  # the child is running (set-up takes about a second)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert out.strip() == "stopped", err[-2000:]
+    assert (tmp_path / "s.edmd" / "checkpoint.pkl").exists()
+
+
+def test_what_the_api_refuses_and_how(tmp_path, monkeypatch):
+    """A backend class a child process cannot import is refused before anything starts;
+    an engine given as a class names the results file; an unknown plot kind lists the
+    allowed ones; a single override string is one override; a partly read file keeps what
+    was not read when analysed."""
+    import pytest
+    from ballistic_backend import BallisticBackend
+
+    import demstudy as ds
+    from demstudy.errors import UnsupportedByEngine
+    from demstudy.io.results import read_results, write_results
+
+    class Local(BallisticBackend):
+        name = "local"
+
+    scene = ds.load_scene("cooling/hcs-3d", "run.production=1.0")  # one string
+    assert scene.run.production == 1.0
+    with pytest.raises(UnsupportedByEngine, match="cannot be imported by a child process"):
+        ds.run(scene, engine=Local, out=tmp_path / "x.h5")
+    monkeypatch.chdir(tmp_path)
+    res = ds.run(scene, engine=BallisticBackend, isolate=False, keep_frames=True)
+    assert res.path == tmp_path / "results" / f"{scene.meta.name}-ballistic.h5"
+    with pytest.raises(ValueError, match="unknown plot kind 'nope'.*profiles"):
+        res.plot("nope")
+    partial = read_results(res.path, skip=("frames",))
+    with pytest.raises(ValueError, match="would drop"):
+        write_results(res.path, partial)
+    partial.analyze("derived")
+    back = ds.load(res.path)
+    assert back.frames is not None and len(back.frames["time"]) == res.profile_attrs["samples"]

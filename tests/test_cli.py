@@ -261,10 +261,48 @@ def test_analyze_z_cells_gives_malik_cell_temperatures(tmp_path, capsys):
     flat = tmp_path / "chute.h5"
     _synthetic_run(flat, CHUTE, None)
     capsys.readouterr()
-    assert main(["analyze", str(flat), "--what", "profiles", "--z-cells", "2"]) == 1
+    assert main(["analyze", str(flat), "--what", "profiles", "--z-cells", "2"]) == 2  # refused
     err = capsys.readouterr().err
     assert "--z-cells 2" in err and "3D" in err and "2D" in err
-    assert main(["analyze", str(run), "--what", "profiles", "--z-cells", "0"]) == 1
+    assert main(["analyze", str(run), "--what", "profiles", "--z-cells", "0"]) == 2
     assert ">= 1" in capsys.readouterr().err
-    assert main(["analyze", str(run), "--what", "gr", "--z-cells", "4"]) == 1
+    assert main(["analyze", str(run), "--what", "gr", "--z-cells", "4"]) == 2
     assert "none of them is requested" in capsys.readouterr().err
+
+
+def test_engines_sharing_an_option_name_share_one_flag(monkeypatch, capsys):
+    """Two engines declaring the same option: one --flag, its help naming both; the engine
+    that lacks it still refuses it."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from ballistic_backend import BallisticBackend
+
+    from demstudy import engines
+    from demstudy.engines.backend import EngineOption
+
+    class Timed(BallisticBackend):
+        name = "timed"
+        options = {"tc": EngineOption("tc", float, "a time of its own")}
+
+    monkeypatch.setattr(engines, "_BACKENDS", {**engines._BACKENDS, "timed": Timed})
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    out = capsys.readouterr().out
+    words = " ".join(out.split())  # argparse wraps the help
+    assert out.count("\n  --tc") == 1 and "timed only: a time of its own" in words
+    assert "edmd only: TC-model time" in words
+
+
+def test_analyze_refusals_exit_2_naming_what_is_missing(tmp_path, capsys):
+    """A statistic the file cannot supply (no frames, a 3D-only one in 2D, no collision
+    log) is refused with exit 2 and nothing is written."""
+    out = tmp_path / "r.h5"
+    assert main(["run", str(CHUTE), "--engine", "edmd", "--out", str(out), "-q",
+                 *SHORT]) == 0
+    before = out.stat().st_mtime_ns
+    for what, said in (("vdf", "needs the stored frames"), ("lambda", "needs a 3D"),
+                       ("angles", "no /collisions log")):
+        assert main(["analyze", str(out), "--what", what]) == 2, what
+        assert said in capsys.readouterr().err, what
+    assert out.stat().st_mtime_ns == before

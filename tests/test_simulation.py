@@ -160,3 +160,64 @@ def test_a_statistic_an_engine_cannot_supply_is_refused_before_it_starts(name, t
             pass
         assert not (tmp_path / f"{engine}.{engine}").exists()
     assert any(getattr(get_backend(e).capabilities, capability) for e in backend_names())
+
+
+def test_what_the_loop_is_asked_that_contradicts_itself_is_refused(tmp_path):
+    """A statistic needing frames with keep_frames = False, a collision-counted run in an
+    engine that counts none: refused before anything starts, naming the field."""
+    out = tmp_path / "x.h5"
+    vdf = gas(measure={"statistics": ["vdf"]})
+    with pytest.raises(UnsupportedByEngine, match="'vdf' in measure.statistics needs the "
+                                                  "stored frames") as info:
+        run_scene(vdf, "edmd", RunOptions(out=out, progress=False, keep_frames=False))
+    assert info.value.field_name == "keep_frames"
+    counted = gas(run={**GAS["run"], "unit": "collisions"})
+    with pytest.raises(UnsupportedByEngine) as info:
+        run_scene(counted, "ballistic", RunOptions(out=out, progress=False))
+    assert (info.value.field_name, info.value.value) == ("run.unit", "collisions")
+    assert not out.exists()
+
+
+def test_a_statistic_failing_after_the_run_keeps_the_results(tmp_path):
+    """10 discs for half a time unit: no disc collides twice, so the free paths cannot be
+    computed. The run's results are written all the same, the failure is recorded in them,
+    and the caller is told (EngineError naming the file), through the child process too."""
+    import demstudy as ds
+
+    scene = gas(particles={"count": 10},
+                run={"equilibration": 0.0, "production": 0.5, "sample_interval": 0.25},
+                measure={"statistics": ["profiles", "freepath"]})
+    out = tmp_path / "fp.h5"
+    with pytest.raises(EngineError, match=rf"(?s)results are in {out}.*freepath: .*no particle "
+                                          "collides twice"):
+        ds.run(scene, engine="edmd", out=out)
+    res = ds.load(out)
+    assert "freepath" in res.attrs["statistics_failed"] and res.profiles
+    assert "collisions" in res.groups and "statistics/derived" in res.groups
+    assert not (tmp_path / "fp.edmd").exists()  # the run finished: no checkpoint left
+
+
+def test_collisions_logged_before_a_stop_inside_an_interval_are_kept(tmp_path, monkeypatch):
+    """Stops between event chunks (chunks of 50 events here) keep the collisions logged on
+    the way: the resumed run's log and collision angles equal the uninterrupted run's."""
+    from demstudy.engines.edmd import core
+
+    monkeypatch.setattr(core, "STALL_CHUNK", 50)
+    scene = validate_scene({**small_scene("angles"), "run": {
+        "equilibration": 0.25, "production": 1.0, "sample_interval": 0.5}})
+    whole = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "w.h5",
+                                                             progress=False)))
+    out = tmp_path / "p.h5"
+    for _ in range(200):  # each part stops after its first chunk
+        try:
+            run_scene(scene, "edmd", RunOptions(out=out, progress=False, wall_limit=0.0,
+                                                resume=(tmp_path / "p.edmd").exists()))
+            break
+        except EngineError as stopped:
+            assert "after a checkpoint" in str(stopped)
+    parts = read_results(out)
+    assert len(whole.groups["collisions"]["time"]) > 20
+    for key, value in whole.groups["collisions"].items():
+        np.testing.assert_array_equal(value, parts.groups["collisions"][key], err_msg=key)
+    for key, value in whole.groups["statistics/angles"].items():
+        np.testing.assert_array_equal(value, parts.groups["statistics/angles"][key], key)

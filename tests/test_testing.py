@@ -43,6 +43,36 @@ def test_runs_of_one_state_fail_at_the_stated_rate():
     assert per_value > 60  # why the correction is needed
 
 
+def blocked(rng, n_blocks: int) -> Results:
+    """Profiles of one state whose errors are estimated from ``n_blocks`` block means, as
+    the profiles' jackknife estimates them."""
+    edges = np.linspace(0.0, 20.0, N_BINS + 1)
+    blocks = rng.normal(0.0, 1.0, (n_blocks, N_BINS))
+    prof = {"edges": edges, "y": 0.5 * (edges[1:] + edges[:-1]),
+            "temperature": 1.0 + blocks.mean(axis=0),
+            "temperature_err": blocks.std(axis=0, ddof=1) / np.sqrt(n_blocks)}
+    return Results({"scene_name": "blocked", "engine": "none"}, profiles=prof,
+                   profile_attrs={"n_blocks": n_blocks})
+
+
+def test_estimated_errors_are_judged_with_students_t():
+    """Errors estimated from 10 blocks: judged with the normal distribution, a 3σ
+    comparison of 40 bins fails far more often than 0.27 %; with Student's t on the blocks'
+    degrees of freedom it keeps its rate."""
+    rng = np.random.default_rng(4)
+    trials = 2000
+    fails = sum(not compare_profiles(blocked(rng, 10), blocked(rng, 10),
+                                     fields=["temperature"]).ok for _ in range(trials))
+    assert fails <= 16, fails  # 0.27 % is 5.4 expected
+    as_normal = 0
+    for _ in range(trials // 4):
+        a, b = blocked(rng, 10), blocked(rng, 10)
+        a.profile_attrs.clear()
+        b.profile_attrs.clear()  # no block count: errors taken as exact
+        as_normal += not compare_profiles(a, b, fields=["temperature"]).ok
+    assert as_normal > 5, as_normal  # > 1 %: why the degrees of freedom matter
+
+
 def test_a_single_bin_off_by_seven_sigma_is_found_and_tabled():
     rng = np.random.default_rng(2)
     a, b = synthetic(rng), synthetic(rng, {("temperature", 12): 0.1})  # 0.1 = 7 × √2 σ
@@ -62,6 +92,13 @@ def test_empty_bins_are_left_out_and_bins_must_match():
     a.profiles["temperature"][:5] = np.nan  # empty bins have no temperature
     result = assert_profiles_agree(a, b, fields=["temperature"])
     assert result.skipped == 5 and len(result.rows) == N_BINS - 5
+    for res in (a, b):  # a bin empty in both runs: ν = 0 ± 0, nothing to compare
+        res.profiles["solid_fraction"][7] = 0.0
+        res.profiles["solid_fraction_err"][7] = 0.0
+    assert compare_profiles(a, b, fields=["solid_fraction"]).skipped == 1
+    b.profiles["solid_fraction"][7] = 0.1  # one run has particles there: a disagreement
+    with pytest.raises(AssertionError, match="solid_fraction"):
+        assert_profiles_agree(a, b, fields=["solid_fraction"])
     b.profiles["edges"] = b.profiles["edges"] * 1.01
     with pytest.raises(ValueError, match="different bins"):
         compare_profiles(a, b)

@@ -307,7 +307,7 @@ def test_analyze_cli_stores_the_new_statistics(tmp_path, capsys):
     assert main(["analyze", str(flat), "--what", "vcorr,waves,cgprofiles"]) == 0
     assert read_results(flat).groups["statistics/vcorr"]["C"].shape == (56, 2, 50)
     capsys.readouterr()
-    assert main(["analyze", str(flat), "--what", "lambda"]) == 1
+    assert main(["analyze", str(flat), "--what", "lambda"]) == 2  # refused: nothing computed
     err = capsys.readouterr().err
     assert "3D" in err and "Traceback" not in err
 

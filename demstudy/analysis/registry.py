@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any, Literal
 
+from ..errors import StatisticUnavailable
 from ..io.frames import Frame
 
 Source = Literal["stream", "frames", "collisions", "results"]
@@ -59,16 +60,20 @@ class Statistic:
         """(datasets, attributes) of this statistic from ``ctx``."""
         if self.source == "stream":
             if ctx.frames is None:
-                raise ValueError(f"{self.name}: needs frames (run with --keep-frames or "
-                                 "measure.keep_frames = true)")
+                raise StatisticUnavailable(f"{self.name}: needs frames (run with "
+                                           "--keep-frames or measure.keep_frames = true)")
             analysis = self.build(ctx).run(ctx.frames())
             return analysis.results, analysis.attrs
         if self.source == "frames" and ctx.frames is None:
-            raise ValueError(f"{self.name}: needs the stored frames (run with --keep-frames)")
+            raise StatisticUnavailable(f"{self.name}: needs the stored frames (run with "
+                                       "--keep-frames)")
         return self.build(ctx)
 
 
 STATISTICS: dict[str, Statistic] = {}
+#: what each engine capability a statistic can need is, in words
+CAPABILITY_TEXT = {"collision_log": "a log of the collisions (event-driven engines)",
+                   "stress": "the engine's interaction stress"}
 
 
 def statistic(name: str, description: str, source: Source, **spec: Any):
@@ -102,8 +107,7 @@ def engine_problems(scene: Any, capabilities: Any) -> list[tuple[str, Any, str]]
     for name in scene.measure.statistics:
         stat = STATISTICS[name]
         if stat.capability and not getattr(capabilities, stat.capability):
-            what = {"collision_log": "a log of the collisions (event-driven engines)",
-                    "stress": "the engine's interaction stress"}[stat.capability]
+            what = CAPABILITY_TEXT.get(stat.capability, f"the {stat.capability} capability")
             out.append(("measure.statistics", name, f"{stat.description} needs {what}, "
                                                     "which this engine does not provide"))
         if stat.axis_y and scene.measure.axis != "y":
@@ -118,24 +122,24 @@ def compute_statistics(names: Iterable[str], ctx: Context) -> dict[str, tuple[di
     names = list(names)
     unknown = [n for n in names if n not in STATISTICS]
     if unknown:
-        raise ValueError(f"--what {unknown[0]!r}: unknown statistic (allowed: "
-                         f"{', '.join(STATISTICS)})")
+        raise StatisticUnavailable(f"{unknown[0]!r}: unknown statistic (allowed: "
+                                   f"{', '.join(STATISTICS)})")
+    cells = f"--z-cells {ctx.z_cells} (z_cells)"
     if ctx.z_cells < 1:
-        raise ValueError(f"--z-cells {ctx.z_cells}: the number of z cells per y-bin must "
-                         "be >= 1")
+        raise StatisticUnavailable(f"{cells}: the number of z cells per y-bin must be >= 1")
     if ctx.z_cells != 1:
         if ctx.scene.dimension != 3:
-            raise ValueError(f"--z-cells {ctx.z_cells}: Malik's cells split the y-bins along "
-                             f"z, so they need a 3D run (this one is {ctx.scene.dimension}D; "
-                             "use 1)")
+            raise StatisticUnavailable(f"{cells}: Malik's cells split the y-bins along z, so "
+                                       "they need a 3D run (this one is "
+                                       f"{ctx.scene.dimension}D; use 1)")
         takes = [n for n, s in STATISTICS.items() if s.z_cells]
         if not set(names) & set(takes):
-            raise ValueError(f"--z-cells {ctx.z_cells}: applies to {', '.join(takes)}; none "
-                             f"of them is requested (--what {','.join(names)})")
+            raise StatisticUnavailable(f"{cells}: applies to {', '.join(takes)}; none of them "
+                                       f"is requested ({', '.join(names)})")
     for name in names:
         stat = STATISTICS[name]
         if ctx.scene.dimension not in stat.dims:
-            raise ValueError(f"--what {name}: {stat.description} needs a "
+            raise StatisticUnavailable(f"{name}: {stat.description} needs a "
                              f"{' or '.join(f'{d}D' for d in stat.dims)} run")
     return {name: STATISTICS[name].compute(ctx) for name in names}
 

@@ -338,7 +338,12 @@ def stress_results(scene: Any, profiles: Mapping[str, Any], timeseries: Mapping[
             out[f"balance_{key}"] = bal[key]
         if inertia is not None:
             out["balance_inertia"] = inertia
+    measured = [n for n, part in (("contact", contact), ("collisional", collisional))
+                if part is not None]
     attrs = {"units": STRESS_UNITS, "dim": dim, "axis": "y", "cross_section": section,
+             "total_of": " + ".join(["kinetic", *measured]) + (
+                 "" if measured else " only: no interaction stress was measured (run with "
+                                     "'stress' in measure.statistics)"),
              "convention": "P = -sigma (compressive positive); Campbell tau_yy = P_yy, "
                            "tau_xy = -P_xy; wall_<side> = column P_ay at that wall",
              "balance": ("unsteady: includes rho nu a from the momentum change of each bin "

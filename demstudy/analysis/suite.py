@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import StatisticUnavailable
 from ..io.frames import Frame
 from ..scene import Scene
 from .base import bin_edges
@@ -58,7 +59,7 @@ def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None,
 
 def _need_results(results: Any, name: str) -> Any:
     if results is None:
-        raise ValueError(f"--what {name}: needs a results file (RUN.h5), not a dump")
+        raise StatisticUnavailable(f"{name}: needs a results file (RUN.h5), not a dump")
     return results
 
 
@@ -67,8 +68,9 @@ def _collision_log(results: Any, name: str) -> tuple[Any, dict]:
     res = _need_results(results, name)
     log = res.groups.get("collisions")
     if not log:
-        raise ValueError(f"--what {name}: the results file has no /collisions log "
-                         "(event-driven runs write it when the scene measures angles)")
+        raise StatisticUnavailable(f"{name}: the results file has no /collisions log "
+                                   "(event-driven runs write it when the scene's "
+                                   "measure.statistics names angles or freepath)")
     return res, log
 
 
@@ -102,8 +104,8 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
     res, log = _collision_log(results, "freepath")
     every = int(res.group_attrs.get("collisions", {}).get("log_every", 1))
     if every != 1:
-        raise ValueError(f"--what freepath: the log keeps every {every}th collision; free "
-                         "paths need every collision (run with log_every = 1)")
+        raise StatisticUnavailable(f"freepath: the log keeps every {every}th collision; "
+                                   "free paths need every collision (run with log_every = 1)")
     dim = scene.dimension
     radius = build_initial_state(scene).diameter / 2
     periods = [scene.box.size[a] if "xyz"[a] in scene.periodic else 0.0 for a in range(dim)]
@@ -113,8 +115,9 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
         shear, ly = scene.shear.rate, scene.box.size[1]
         t_s = np.asarray(ts.get("time", [0.0]), float)
         if "tilt" not in ts or len(ts["tilt"]) != t_s.size:
-            raise ValueError("--what freepath: a Lees–Edwards run needs /timeseries/tilt (the "
-                             "image offset, one per time sample); this file has none")
+            raise StatisticUnavailable("freepath: a Lees–Edwards run needs /timeseries/tilt "
+                                       "(the image offset, one per time sample); this file "
+                                       "has none")
         tilt = np.asarray(ts["tilt"], float)
 
         def offset(t: np.ndarray) -> np.ndarray:  # exactly linear from the last sample
@@ -137,7 +140,7 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
         width = campbell_depth(res.profiles, scene.wall_position("lower"))
     lam, tau = flights["length"], flights["tau"]
     if lam.size == 0:
-        raise ValueError("--what freepath: no particle collides twice in the logged window")
+        raise StatisticUnavailable("freepath: no particle collides twice in the logged window")
     ana = FreePath(edges, lambda_max=8 * float(lam.mean()), tau_max=8 * float(tau.mean()),
                    width=width, dim=dim)
     ana.run(flight_chunks(flights, n_chunks))
@@ -174,7 +177,7 @@ def stress_from_results(scene: Scene, results: Any) -> tuple[dict, dict]:
 
     res = _need_results(results, "stress")
     if not res.profiles:
-        raise ValueError("--what stress: the results file has no /profiles")
+        raise StatisticUnavailable("stress: the results file has no /profiles")
     stored = res.groups.get("stress", {})
     parts = {k: (stored[k], stored[f"{k}_err"]) for k in ("contact", "collisional")
              if k in stored and f"{k}_err" in stored}

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from ..scene import Scene
 
-__all__ = ["ServoController", "WallMotion", "has_servo", "servo_settings"]
+__all__ = ["ServoController", "WallMotion", "has_servo", "servo_samples", "servo_settings"]
 
 
 def has_servo(scene: Scene) -> bool:
@@ -27,6 +27,12 @@ def has_servo(scene: Scene) -> bool:
 def servo_settings(scene: Scene):
     """The servo settings the walls share (interval, width and shear-rate rules)."""
     return next(w.servo for w in scene.walls if w.servo is not None)
+
+
+def servo_samples(scene: Scene) -> int:
+    """Sample intervals between two servo updates in time-stepped engines, which update at
+    sample ends: ``interval_time`` rounded to whole sample intervals (at least one)."""
+    return max(1, round(servo_settings(scene).interval_time / scene.run.sample_interval))
 
 
 @dataclass

@@ -38,7 +38,10 @@ from ..errors import UnsupportedByEngine
 from ..io.frames import Frame
 from ..scene import Scene
 
-__all__ = ["BackendBase", "Capabilities", "EngineOption", "Needs"]
+__all__ = ["LOG_CAPACITY", "BackendBase", "Capabilities", "EngineOption", "Needs"]
+
+#: collision-log records a run keeps (sampled every ``log_every`` collisions)
+LOG_CAPACITY = 200_000
 
 
 @dataclass(frozen=True)
@@ -83,7 +86,7 @@ class Needs:
 
     stress_bins: tuple[float, float, int] | None = None
     log_every: int = 0
-    log_capacity: int = 200_000
+    log_capacity: int = LOG_CAPACITY
 
 
 class BackendBase:

@@ -73,6 +73,7 @@ class Results:
     group_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
     dataset_attrs: dict[str, dict[str, Any]] = field(default_factory=dict)
     path: Path | None = field(default=None, compare=False)
+    skipped: tuple[str, ...] = field(default=(), compare=False)  # groups not read (``skip``)
 
     @property
     def scene(self) -> Any:
@@ -112,8 +113,8 @@ class Results:
 
         scene = self.scene
         names = [w for w in what if isinstance(w, str)]
-        ctx = Context(scene, frames=lambda: self.iter_frames(start), results=self,
-                      z_cells=z_cells)
+        ctx = Context(scene, frames=(lambda: self.iter_frames(start)) if self.frames else None,
+                      results=self, z_cells=z_cells)
         computed = compute_statistics(names, ctx)
         for analysis in (w for w in what if not isinstance(w, str)):
             analysis.run(self.iter_frames(start))
@@ -126,7 +127,13 @@ class Results:
                 self.groups[f"statistics/{name}"] = data
                 self.group_attrs[f"statistics/{name}"] = attrs
         if save and self.path is not None:
-            write_results(self.path, self)
+            whole = self
+            if self.skipped:  # read without some groups: write them back as they are
+                whole = read_results(self.path)
+                whole.profiles, whole.profile_attrs = self.profiles, self.profile_attrs
+                whole.groups.update(self.groups)
+                whole.group_attrs.update(self.group_attrs)
+            write_results(self.path, whole)
         return self
 
     def plot(self, kind: str = "profiles", out: str | os.PathLike | None = None, *,
@@ -135,10 +142,12 @@ class Results:
         """The figure of ``kind`` (:data:`demstudy.plots.KINDS`) for this run, overlaid with
         ``others`` (results or files); saved to ``out`` when given. Returns the matplotlib
         Figure."""
-        from ..plots import draw
+        from ..plots import KINDS, draw
         from ..plots.common import Run, missing_notice
         from ..plots.common import save as save_figure
 
+        if kind not in KINDS:
+            raise ValueError(f"unknown plot kind {kind!r} (allowed: {', '.join(KINDS)})")
         runs = [Run.of(self)] + [Run.of(o) if isinstance(o, Results) else Run.load(o)
                                  for o in others]
         lacking = [run for run in runs if run.group(kind) is None]
@@ -310,6 +319,11 @@ def write_results(path: str | os.PathLike, results: Results,
     Every dataset gets ``units`` and ``description`` (:func:`demstudy.io.fields.field_info`,
     overridden by ``results.dataset_attrs``)."""
     path = Path(path)
+    if results.skipped and results.path is not None and \
+            Path(results.path).resolve() == path.resolve():
+        raise ValueError(f"{path}: these results were read without "
+                         f"{', '.join(results.skipped)}; writing them back would drop those "
+                         "groups (read the whole file)")
     path.parent.mkdir(parents=True, exist_ok=True)
     image = io.BytesIO()
     attrs = root_attrs(results, command_line)
@@ -353,7 +367,8 @@ def read_results(path: str | os.PathLike, skip: tuple[str, ...] = ()) -> Results
     (e.g. ``("frames", "collisions")``, the large ones, when only the figures are wanted).
     Attributes come back with the types they were written with (module doc)."""
     with h5py.File(path, "r") as f:
-        res = Results(attrs=read_attrs(f), path=Path(path))
+        res = Results(attrs=read_attrs(f), path=Path(path),
+                      skipped=tuple(name for name in skip if name in f))
 
         def datasets(group: h5py.Group) -> dict[str, np.ndarray]:
             out = {}
@@ -394,8 +409,10 @@ def frames_of(results: Results, dim: int) -> Iterator[Frame]:
     """The frames stored in a results file (``--keep-frames``), as ``Frame`` objects."""
     fr = results.frames
     if not fr or "box_lo" not in fr:
-        raise ValueError("the results file holds no frames with their box: run with "
-                         "--keep-frames (or measure.keep_frames = true)")
+        from ..errors import StatisticUnavailable
+
+        raise StatisticUnavailable("the results file holds no frames with their box: run "
+                                   "with --keep-frames (or measure.keep_frames = true)")
     for i, t in enumerate(fr["time"]):
         yield Frame(time=float(t), box_lo=fr["box_lo"][i], box_hi=fr["box_hi"][i],
                     position=fr["position"][i][:, :dim], velocity=fr["velocity"][i][:, :dim],

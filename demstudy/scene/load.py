@@ -254,6 +254,8 @@ def load_scene(source: str | os.PathLike, overrides: Iterable[str] = (),
     ``load_scene("campbell1982/couette-noslip", run={"production": 50})``;
     ``overrides``: ``--set`` strings ``key.path=value`` applied after them.
     """
+    if isinstance(overrides, str):  # one override given as a string, not a list of them
+        overrides = [overrides]
     path, name = resolve_scene(source)
     data = read_scene_data(path)
     if sections:

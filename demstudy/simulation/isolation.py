@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from .. import UNITS_NOTE
-from ..errors import EngineError, RunRefused, RunStopped
+from ..errors import EngineError, RunRefused, RunStopped, UnsupportedByEngine
 from ..scene import Scene
 from .options import RunOptions, work_folder
 
@@ -35,13 +35,23 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     """Run ``scene`` in ``backend`` (a registered backend class) in a child process, started
     by the backend's launcher (``mpirun -np N``) when np > 1.
 
-    Ctrl-C reaches the child too, which stops at the end of its current segment after a
-    checkpoint; the caller then waits for it rather than killing it."""
+    Ctrl-C (or a notebook's interrupt, which reaches only this process) is passed on to the
+    child, which stops at the end of its current segment after a checkpoint; the caller then
+    waits for it rather than killing it. The child's error message comes back in the
+    ``EngineError``."""
+    where = f"{backend.__module__}:{backend.__qualname__}"
+    if backend.__module__ == "__main__" or "<locals>" in backend.__qualname__:
+        raise UnsupportedByEngine(backend.name, "isolate", True,
+                                  f"the backend {where} cannot be imported by a child process "
+                                  "(defined in a script, a notebook or a function): define it "
+                                  "in a module, or run with isolate=False")
     payload = {
         "units": UNITS_NOTE,
         "engine": backend.name,
-        # by import path: a backend registered in this process runs in the child too
-        "backend": f"{backend.__module__}:{backend.__qualname__}",
+        # by import path: a backend registered in this process runs in the child too, which
+        # searches the same module path
+        "backend": where,
+        "sys_path": sys.path,
         "scene": scene.model_dump(mode="json"),
         "out": str(Path(options.out).resolve()),
         "dump": str(Path(options.dump).resolve()) if options.dump else None,
@@ -57,6 +67,8 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     job = out.with_name(f".{out.name}.job.json")
     job.write_text(json.dumps(payload))
+    error = job.with_suffix(".error")
+    error.unlink(missing_ok=True)
     env = dict(os.environ, **{WORKER_FLAG: "1"})
     cmd = [sys.executable, "-m", "demstudy.simulation.isolation", str(job)]
     if options.np > 1:
@@ -68,6 +80,7 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     except KeyboardInterrupt:
         print(f"\n{backend.name}: stopping after the current segment and a checkpoint "
               "(Ctrl-C again aborts without one)", file=sys.stderr, flush=True)
+        proc.send_signal(signal.SIGINT)  # a terminal's Ctrl-C reached it already: harmless
         try:
             returncode = proc.wait(timeout=300)
         except (subprocess.TimeoutExpired, KeyboardInterrupt):
@@ -75,19 +88,23 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
             returncode = -9
     finally:
         job.unlink(missing_ok=True)
+    message = error.read_text().strip() if error.exists() else ""
+    error.unlink(missing_ok=True)
     if returncode == STOPPED:
         raise RunStopped("the run stopped after writing a checkpoint: run the same command "
                          "again with --resume to continue")
     if returncode == REFUSED:
-        raise RunRefused(f"the {backend.name} engine refused the run (see the message above)")
+        raise RunRefused(message or f"the {backend.name} engine refused the run (see the "
+                                    "message above)")
     if returncode != 0:
         how = ("was interrupted" if returncode == -signal.SIGINT
                else f"was killed by signal {-returncode}" if returncode < 0
                else f"failed (exit {returncode})")
         log_file = backend.log_file(work_folder(out, backend.name))
         log = f" and {log_file}" if log_file is not None and log_file.exists() else ""
-        raise EngineError(f"the {backend.name} run on {options.np} rank(s) {how}; see the "
-                          f"messages above{log}")
+        said = f": {message}" if message else f"; see the messages above{log}"
+        raise EngineError(f"the {backend.name} run on {options.np} rank(s) {how}{said}"
+                          + (f" (and {log_file})" if message and log else ""))
     return out
 
 
@@ -99,15 +116,25 @@ def _die_with_parent() -> None:
     ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
 
 
+def _tell_parent(path: Path, message: str) -> None:
+    """The child's error, for the parent's exception (rank 0 writes it; best effort)."""
+    if os.environ.get("PMI_RANK", "0") == "0":
+        try:
+            path.write_text(message)
+        except OSError:
+            pass
+
+
 def worker(job: str) -> int:
     from ..engines import get_backend, register_backend
-    from ..errors import UnsupportedByEngine
     from ..scene import validate_scene
     from ..scene.load import SceneError
     from .loop import Simulation
 
     payload = json.loads(Path(job).read_text())
+    sys.path[:0] = [p for p in payload["sys_path"] if p not in sys.path]
     register_backend(payload["backend"], payload["engine"])
+    error = Path(job).with_suffix(".error")
     scene = validate_scene(payload["scene"], source=job)
     options = RunOptions(out=Path(payload["out"]), np=payload["np"],
                          dump=Path(payload["dump"]) if payload["dump"] else None,
@@ -121,9 +148,11 @@ def worker(job: str) -> int:
         return STOPPED  # the parent says so, once
     except (UnsupportedByEngine, SceneError) as exc:  # refused before anything ran
         print(f"error: {exc}", file=sys.stderr)
+        _tell_parent(error, str(exc))
         return REFUSED
     except Exception as exc:  # one line, never a bare traceback
         print(f"error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        _tell_parent(error, f"{type(exc).__name__}: {exc}")
         return FAILED
     return 0
 

@@ -33,8 +33,8 @@ from ..analysis.base import bin_edges
 from ..analysis.registry import STATISTICS, Context
 from ..analysis.stress import CollisionalSums, ContactStress, momentum_snapshot
 from ..analysis.suite import profile_bounds
-from ..effects.servo import ServoController, has_servo, servo_settings
-from ..engines.backend import BackendBase, Needs, frame_mass
+from ..effects.servo import ServoController, has_servo, servo_samples, servo_settings
+from ..engines.backend import LOG_CAPACITY, BackendBase, Needs, frame_mass
 from ..errors import EngineError, RunStopped
 from ..io.frames import Frame
 from ..io.results import write_results
@@ -54,8 +54,6 @@ __all__ = ["Simulation"]
 
 LOOP_VERSION = f"demstudy {__version__} (simulation loop 1)"
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
-#: collision-log records kept per run (sampled every ``log_every`` collisions)
-LOG_CAPACITY = 200_000
 
 
 class Simulation:
@@ -192,9 +190,7 @@ class Simulation:
 
     def _sample_servo(self, state: RunState) -> None:
         """Time-stepped engines update the servo at the end of every m-th sample interval."""
-        settings = servo_settings(self.scene)
-        every = max(1, round(settings.interval_time / self.scene.run.sample_interval))
-        if state.samples % every == 0:
+        if state.samples % servo_samples(self.scene) == 0:
             self._servo_update(state)
 
     # -- sampling -------------------------------------------------------------------------
@@ -356,6 +352,9 @@ class Simulation:
                     # there, and the resumed run redoes this interval from that point (its
                     # chunks start where this one ended, so it continues bit-identically)
                     state.samples -= 1
+                    # the collisions logged on the way are the checkpoint's, not the engine's
+                    self._keep_log(state, backend.take_collision_log(),
+                                   state.samples + 1 > sched.n_eq)
                     self._checkpoint(state, started)
                     raise RunStopped(
                         f"stopped ({self.stop.reason}) at t = {backend.time:.6g}, inside a "
@@ -377,9 +376,14 @@ class Simulation:
 
     # -- results ------------------------------------------------------------------------------
     def _write(self, state: RunState, extra: dict[str, Any]) -> Path:
-        path = write_results(self.out, run_results(self, state, extra))
+        results = run_results(self, state, extra)
+        path = write_results(self.out, results)
         (self.workdir / CHECKPOINT).unlink(missing_ok=True)
         self.backend.cleanup(None)
         if self.workdir.exists() and not any(self.workdir.iterdir()):
             self.workdir.rmdir()
+        failed = results.attrs.get("statistics_failed")
+        if failed:  # the run's results are safe; say what is missing from them
+            raise EngineError(f"the run finished and its results are in {path}, but these "
+                              f"statistics could not be computed from them:\n{failed}")
         return path

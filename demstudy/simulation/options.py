@@ -92,10 +92,26 @@ def check_run_options(backend: Any, options: RunOptions) -> None:
         raise UnsupportedByEngine(engine, "--out", str(out), f"{blocking} is a file, not a folder")
 
 
+def keep_frames_refused(scene: Any, options: RunOptions) -> str | None:
+    """The statistic that needs frames when the options say not to keep them (None: no
+    conflict)."""
+    if options.keep_frames is not False:
+        return None
+    return next((s for s in scene.measure.statistics if STATISTICS[s].source == "frames"),
+                None)
+
+
 def check_run(backend: Any, scene: Any, options: RunOptions) -> None:
     """Everything refused before any engine starts: the run options, the effects and the
     statistics the engine cannot supply (``UnsupportedByEngine``)."""
     check_run_options(backend, options)
+    if scene.run.unit == "collisions" and not backend.capabilities.collision_count:
+        raise UnsupportedByEngine(backend.name, "run.unit", scene.run.unit,
+                                  "this engine counts no collisions: give times")
+    if keep_frames_refused(scene, options):
+        raise UnsupportedByEngine(backend.name, "keep_frames", False,
+                                  f"{keep_frames_refused(scene, options)!r} in "
+                                  "measure.statistics needs the stored frames")
     backend.check(scene, options)
     for field_name, value, reason in engine_problems(scene, backend.capabilities):
         raise UnsupportedByEngine(backend.name, field_name, value, reason)

@@ -72,10 +72,17 @@ def run_results(sim: Any, state: RunState, extra: dict[str, Any]) -> Results:
         results.group_attrs[f"statistics/{name}"] = analysis.attrs
     ctx = Context(scene, results=results,
                   frames=(lambda: frames_of(results, scene.dimension)) if frames else None)
+    failed = []
     for name in sim.after:
-        data, group_attrs = STATISTICS[name].compute(ctx)
+        try:  # a finished run's results are written whatever one statistic does
+            data, group_attrs = STATISTICS[name].compute(ctx)
+        except Exception as exc:  # noqa: BLE001 - recorded and reported after the write
+            failed.append(f"{name}: {type(exc).__name__}: {exc}")
+            continue
         results.groups[f"statistics/{name}"] = data
         results.group_attrs[f"statistics/{name}"] = group_attrs
+    if failed:
+        results.attrs["statistics_failed"] = "\n".join(failed)
     return results
 
 

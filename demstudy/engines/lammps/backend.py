@@ -68,7 +68,7 @@ class LammpsBackend(BackendBase):
     capabilities = Capabilities(time_step=True, stress="contact", mpi=True, dump=True,
                                 inputs=True)
     translations = TRANSLATIONS
-    version = f"demstudy {__version__} (lammps checkpoint 3)"
+    version = f"demstudy {__version__} (lammps checkpoint 4)"
 
     @classmethod
     def check(cls, scene: Scene, options) -> None:
@@ -148,6 +148,7 @@ class LammpsBackend(BackendBase):
             raise EngineError(f"--resume: {restart} holds step {step}, the checkpoint's state "
                               f"step {saved['step']}; remove {workdir} to start afresh")
         self.step, self.impulse = saved["step"], saved["impulse"]
+        self.edges = saved["edges"]  # servo runs re-bin where production starts
         if self.dump is not None and self.rank == 0 and self.dump.exists():
             os.truncate(self.dump, saved["dump_size"])  # drop frames after the checkpoint
         self._set_up_again(saved["forces"])
@@ -319,8 +320,8 @@ class LammpsBackend(BackendBase):
         if not resetup:  # write_restart re-initialised LAMMPS
             self._set_up_again(forces)
         return {"restart": restart.name, "forces": forces, "step": self.step,
-                "impulse": self.wall_impulse(), "dump": str(self.dump) if self.dump else None,
-                "dump_size": dump_size}
+                "impulse": self.wall_impulse(), "edges": self.edges,
+                "dump": str(self.dump) if self.dump else None, "dump_size": dump_size}
 
     def cleanup(self, keep: dict | None) -> None:
         if self.rank != 0:

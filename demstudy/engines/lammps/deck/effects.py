@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from ....contact.stiffness import ContactSetup
 from ....effects import Cannot, Translation
-from ....effects.servo import servo_settings
+from ....effects.servo import servo_samples
 from ....errors import UnsupportedByEngine
 from ....scene import Scene
 from ....scene.schema import Wall
@@ -53,9 +53,7 @@ def wall_force_sources(scene: Scene) -> list[tuple[str, str, float]]:
 
 def servo_interval_steps(scene: Scene, dt: float) -> int:
     """Steps between servo updates: whole sample intervals (updates happen at sample ends)."""
-    servo = servo_settings(scene)
-    n_sample = max(1, round(scene.run.sample_interval / dt))
-    return n_sample * max(1, round(servo.interval_time / scene.run.sample_interval))
+    return max(1, round(scene.run.sample_interval / dt)) * servo_samples(scene)
 
 
 # ---------------------------------------------------------------- walls
