@@ -175,7 +175,8 @@ class BackendBase:
 
     # -- MPI, checkpoints, end ----------------------------------------------------------
     def agree(self, flag: bool) -> bool:
-        """True on every rank if ``flag`` is true on any rank."""
+        """True on every rank if ``flag`` is true on any rank (collective on MPI ranks; the
+        loop's last call, after ``close``, is the barrier before the ranks exit)."""
         return flag
 
     def cleanup(self, keep: dict | None) -> None:

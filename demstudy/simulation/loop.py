@@ -330,9 +330,11 @@ class Simulation:
                               "checkpoint (if any)") from None
         finally:
             backend.close()
-        if backend.rank != 0:
-            return self.out
-        return self._write(state, extra)
+        path = self._write(state, extra) if backend.rank == 0 else self.out
+        # MPI: no rank exits before rank 0 has written the results file (mpirun ends the
+        # other ranks once one has exited: rank 0 was killed while writing, silently)
+        backend.agree(False)
+        return path
 
     def _loop(self, state: RunState, started: float) -> None:
         sched, backend = self.schedule, self.backend

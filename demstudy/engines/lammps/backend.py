@@ -32,7 +32,7 @@ from .deck.effects import TRANSLATIONS, wall_fix_id, wall_force_sources
 from .deck.output import STRESS_COLUMNS, STRESS_IDS, STRESS_PAIRS, WALL_FORCES, sample_steps
 from .deck.system import DATA_FILE
 from .library import mpirun_executable
-from .session import LammpsSession, quoted
+from .session import LammpsSession, any_rank, quoted
 
 __all__ = ["LammpsBackend"]
 
@@ -104,6 +104,7 @@ class LammpsBackend(BackendBase):
         self.dump = Path(options.dump).resolve() if options.dump else None
         self.sources = wall_force_sources(scene)
         self.session: LammpsSession | None = None
+        self.nprocs = 1
         self._mobile: np.ndarray | None = None
         self._frame: Frame | None = None
         self._all: tuple[np.ndarray, np.ndarray] | None = None  # (x, radius) of every atom
@@ -135,7 +136,7 @@ class LammpsBackend(BackendBase):
                 raise EngineError(f"--resume: {restart}, the restart file of the checkpoint, "
                                   "is missing")
         self.session = session = LammpsSession(workdir)
-        self.rank = session.rank
+        self.rank, self.nprocs = session.rank, session.nprocs
         self.n_particles = scene.n_particles
         self._issue_deck(restart)
         if saved is None:
@@ -331,7 +332,7 @@ class LammpsBackend(BackendBase):
                 old.unlink(missing_ok=True)
 
     def agree(self, flag: bool) -> bool:
-        return self.session.any_rank(flag)
+        return any_rank(flag, self.nprocs)  # also after close: the loop's last barrier
 
     def result_attrs(self) -> dict:
         return {"engine_version": f"LAMMPS {self.session.lmp.version()}",

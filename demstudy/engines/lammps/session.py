@@ -24,6 +24,21 @@ def quoted(path: Path | str) -> str:
     return '"' + str(path).replace('"', '\\"') + '"'
 
 
+def any_rank(flag: bool, nprocs: int) -> bool:
+    """True on every one of ``nprocs`` ranks if ``flag`` is true on any rank (MPI_Allreduce with
+    MPI_MAX on MPI_COMM_WORLD): needs the MPI runtime, not a LAMMPS instance, so it also works
+    after ``close`` (MPI outlives the instance)."""
+    if nprocs == 1:
+        return flag
+    lib = ctypes.CDLL(str(preload_mpi()), mode=ctypes.RTLD_GLOBAL)
+    send, recv = ctypes.c_int(int(flag)), ctypes.c_int(0)
+    status = lib.MPI_Allreduce(ctypes.byref(send), ctypes.byref(recv), 1, _MPI_INT,
+                               _MPI_MAX, _MPI_COMM_WORLD)
+    if status != 0:
+        raise EngineError(f"MPI_Allreduce failed with code {status}")
+    return bool(recv.value)
+
+
 class LammpsSession:
     """One LAMMPS instance; errors come back as ``EngineError`` naming the deck line."""
 
@@ -71,15 +86,7 @@ class LammpsSession:
 
     def any_rank(self, flag: bool) -> bool:
         """True on every rank if ``flag`` is true on any rank (MPI_Allreduce with MPI_MAX)."""
-        if self.nprocs == 1:
-            return flag
-        lib = ctypes.CDLL(str(preload_mpi()), mode=ctypes.RTLD_GLOBAL)
-        send, recv = ctypes.c_int(int(flag)), ctypes.c_int(0)
-        status = lib.MPI_Allreduce(ctypes.byref(send), ctypes.byref(recv), 1, _MPI_INT,
-                                   _MPI_MAX, _MPI_COMM_WORLD)
-        if status != 0:
-            raise EngineError(f"MPI_Allreduce failed with code {status}")
-        return bool(recv.value)
+        return any_rank(flag, self.nprocs)
 
     def local_array(self, compute_id: str, columns: int) -> np.ndarray:
         """This rank's rows of a local compute's array (e.g. ``compute pair/local``)."""
