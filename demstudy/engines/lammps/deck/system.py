@@ -12,7 +12,6 @@ times heavier than a particle of their size, so the pair contact sees m_eff = m 
 
 from __future__ import annotations
 
-import io
 import math
 
 import numpy as np
@@ -102,15 +101,141 @@ def data_file(scene: Scene, state: InitialState, bumps: list[BumpRow]) -> str:
         vel[:n, 5] = state.angular_velocity[:, 0]
     else:
         vel[:n, 3:] = state.angular_velocity
-    lines += ["", "Atoms # sphere", "", _table(atoms, "%d %d" + " %.17g" * 5)]
-    lines += ["", "Velocities", "", _table(np.column_stack([ids, vel]), "%d" + " %.17g" * 6)]
+    lines += ["", "Atoms # sphere", "", format_rows(atoms)]
+    lines += ["", "Velocities", "", format_rows(np.column_stack([ids, vel]))]
     return "\n".join(lines) + "\n"
 
 
-def _table(rows: np.ndarray, fmt_row: str) -> str:
-    buffer = io.StringIO()
-    np.savetxt(buffer, rows, fmt=fmt_row)
-    return buffer.getvalue().rstrip("\n")
+# 10**k for k = 0 … 27, exact in a long double with a 64-bit mantissa (5**27 < 2**64)
+_POW10_LD = np.array([10**k for k in range(28)], dtype=np.longdouble)
+_EXACT_LONGDOUBLE = np.finfo(np.longdouble).nmant >= 63
+_BITS_5K = np.array([(5**k).bit_length() for k in range(28)])  # 10^k = 5^k 2^k
+_E_MIN, _E_MAX = -11, 16  # decimal exponents of the vectorised path: 10^(16 - E) is exact
+# the two characters of 00 … 99 as one little-endian uint16 each
+_PAIRS = np.array([ord(f"{i:02d}"[0]) | ord(f"{i:02d}"[1]) << 8 for i in range(100)],
+                  dtype=np.uint16)
+# every field is laid out alike: sign, "0.000" (0.000ddd), each digit followed by a point,
+# "e-XX", a separator; a mask per decimal exponent E and count of significant digits keeps
+# the characters of %.17g's text
+_LEAD, _FIRST, _EXP, _FIELD = 1, 6, 40, 45
+
+
+def _masks() -> np.ndarray:
+    """Characters kept for E = E_MIN … E_MAX and s = 1 … 17 significant digits (row
+    (E - E_MIN) * 17 + s - 1), then for zero; the sign and the separator are set apart."""
+    rows = []
+    for e in range(_E_MIN, _E_MAX + 1):
+        for s in range(1, 18):
+            keep = np.zeros(_FIELD, dtype=bool)
+            if e >= 0:  # d…d[.d…d]
+                keep[_FIRST:_FIRST + 2 * max(e + 1, s):2] = True
+                keep[_FIRST + 2 * e + 1] = s > e + 1
+            elif e >= -4:  # 0.000d…d
+                keep[_LEAD:_LEAD + 1 - e] = True
+                keep[_FIRST:_FIRST + 2 * s:2] = True
+            else:  # d[.d…d]e-XX
+                keep[_FIRST:_FIRST + 2 * s:2] = True
+                keep[_FIRST + 1] = s > 1
+                keep[_EXP:_EXP + 4] = True
+            rows.append(keep)
+    zero = np.zeros(_FIELD, dtype=bool)
+    zero[_LEAD] = True
+    rows.append(zero)
+    return np.array(rows)
+
+
+_MASKS = _masks()
+
+
+def format_rows(rows: np.ndarray, chunk: int = 4096) -> str:
+    """Lines of space-separated numbers, each as ``"%.17g" % x`` writes it (so integral
+    values such as IDs and types as integers), the same text as ``numpy.savetxt``; no
+    newline after the last line. 17 significant digits: the text parses back to the very
+    same doubles. Vectorised, in chunks of rows: ~10x faster than ``numpy.savetxt``, which
+    formats row by row in Python (0.14 s for the 30 720 particles of a benchmark)."""
+    rows = np.asarray(rows, dtype=np.float64)
+    if rows.ndim != 2:
+        raise ValueError(f"format_rows: 2D rows needed, got shape {rows.shape}")
+    if not _EXACT_LONGDOUBLE:  # no 64-bit-mantissa long double here: Python's formatting
+        return "\n".join(" ".join(f"{x:.17g}" for x in row) for row in rows.tolist())
+    return "\n".join(_format_chunk(rows[i:i + chunk]) for i in range(0, len(rows), chunk))
+
+
+def _format_chunk(rows: np.ndarray) -> str:
+    n, c = rows.shape
+    if n == 0:
+        return ""
+    x = rows.ravel()
+    m = x.size
+    a = np.abs(x)
+    finite = np.isfinite(a) & (a > 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        exp10 = np.where(finite, np.floor(np.log10(a)), 0.0).astype(np.int64)
+    # the 17 digits N = rint(|x| 10^(16 - E)) in [1e16, 1e17), from one rounding p of the
+    # exact product by an exact power of ten (|p - exact| <= p 2^-64; exact when the
+    # significant bits of x and of 5^(16-E) fit in 64): N is %.17g's correctly rounded
+    # (half-even) integer unless the exact product may lie on the other side of a half or
+    # of 1e16; those few (~1 % of inexact products) go to Python's formatting below. E is
+    # that of the exact |x| (as %e's); log10 may be one off near powers of ten: corrected
+    # here (a carry to 1e17 is E + 1).
+    mantissa = (a.view(np.uint64) & np.uint64(2**52 - 1)) | np.uint64(2**52)
+    lowest = (mantissa & (~mantissa + np.uint64(1))).astype(np.float64)  # 2^trailing zeros
+    bits = 53 - np.log2(lowest).astype(np.int64)  # significant bits of x (normal numbers)
+    digits = np.zeros(m, dtype=np.uint64)
+    unsure = ~finite
+    todo = finite.copy()
+    for _ in range(3):
+        todo &= (exp10 >= _E_MIN) & (exp10 <= _E_MAX)
+        idx = np.flatnonzero(todo)
+        if idx.size == 0:
+            break
+        p = a[idx].astype(np.longdouble) * _POW10_LD[16 - exp10[idx]]
+        rounded = np.rint(p)
+        error = p * np.longdouble(2.0**-63)
+        inexact = bits[idx] + _BITS_5K[16 - exp10[idx]] > 64
+        unsure[idx] = inexact & ((np.abs(np.abs(p - rounded) - 0.5) <= error)
+                                 | (np.abs(p - np.longdouble(1e16)) <= error))
+        digits[idx] = rounded.astype(np.uint64)
+        high, low = rounded >= np.longdouble(1e17), p < np.longdouble(1e16)
+        exp10[idx[high]] += 1
+        exp10[idx[low]] -= 1
+        todo[:] = False
+        todo[idx[high | low]] = True
+    unsure |= todo | (exp10 < _E_MIN) | (exp10 > _E_MAX)
+    unsure &= a != 0.0
+    exp10[unsure] = 0
+    digits[unsure] = 10**16
+    text = np.empty((n, c, _FIELD), dtype=np.uint8)
+    flat = text.reshape(m, _FIELD)
+    flat[:, 0] = ord("-")
+    flat[:, _LEAD:_FIRST] = np.frombuffer(b"0.000", dtype=np.uint8)
+    pairs = np.empty((m, 8), dtype=np.uint16)  # digits 1 … 16, two by two
+    high, low = np.divmod(digits, np.uint64(10**8))
+    for i, rest in ((7, low.astype(np.uint32)), (3, high.astype(np.uint32))):
+        for j in range(i, i - 4, -1):
+            quotient = rest // np.uint32(100)
+            pairs[:, j] = _PAIRS[rest - quotient * np.uint32(100)]
+            rest = quotient
+    chars = pairs.view(np.uint8)
+    flat[:, _FIRST] = ord("0") + rest.astype(np.uint8)  # the first digit
+    flat[:, _FIRST + 2:_EXP:2] = chars
+    flat[:, _FIRST + 1:_EXP:2] = ord(".")
+    flat[:, _EXP:_EXP + 2] = np.frombuffer(b"e-", dtype=np.uint8)
+    flat[:, _EXP + 2:_EXP + 4] = _PAIRS[np.clip(-exp10, 0, 99)].view(np.uint8).reshape(m, 2)
+    flat[:, _FIELD - 1] = ord(" ")
+    text[:, c - 1, _FIELD - 1] = ord("\n")
+    nonzero = chars[:, ::-1] != ord("0")  # digits 16 … 1
+    significant = np.where(nonzero.any(axis=1), 17 - np.argmax(nonzero, axis=1), 1)
+    layout = np.where(a == 0.0, len(_MASKS) - 1, (exp10 - _E_MIN) * 17 + significant - 1)
+    keep = _MASKS[layout]
+    keep[:, 0] = np.signbit(x)
+    keep[:, _FIELD - 1] = True
+    for i in np.flatnonzero(unsure):  # near halves, outside 1e-11 … 1e17, inf, nan
+        field = f"{x[i]:.17g}".encode()
+        flat[i, :len(field)] = np.frombuffer(field, dtype=np.uint8)
+        keep[i, :-1] = False
+        keep[i, :len(field)] = True
+    return flat[keep].tobytes()[:-1].decode("ascii")
 
 
 def setup_block(scene: Scene, bumps: list[BumpRow]) -> Block:
