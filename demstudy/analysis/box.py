@@ -32,7 +32,6 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.spatial import cKDTree
 
 if TYPE_CHECKING:
     from demstudy.io.frames import Frame
@@ -302,6 +301,8 @@ class NeighbourQuery:
         r_edges[k+1]``, per shell (int, one fewer than the edges). With ``r_edges[0] = 0``
         a point is not its own partner (coincident points are not counted either). A
         dual-tree count: memory does not grow with the number of pairs."""
+        from scipy.spatial import cKDTree  # noqa: PLC0415 - ~0.1 s, not needed by a run
+
         r_edges = np.asarray(r_edges, float)
         pts, others, _, size = self._layout(float(r_edges[-1]))
         tree = cKDTree(pts, boxsize=size)
@@ -313,6 +314,8 @@ class NeighbourQuery:
         """Ordered pairs (i, j), i != j, at minimum-image distance ``<= r_max``: i over
         ``of`` (indices; default all points), j over all points (an image counts as its
         point). ``chunk`` bounds how many i are searched at once (memory)."""
+        from scipy.spatial import cKDTree  # noqa: PLC0415
+
         pts, others, owner, size = self._layout(float(r_max))
         other_tree = cKDTree(others, boxsize=size)
         chosen = None if of is None else np.asarray(of, np.intp).ravel()

@@ -37,7 +37,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.interpolate import CubicSpline
 
 from demstudy.theory.kinetic import mean_free_path
 
@@ -270,6 +269,8 @@ def shear_rate(
     cubic-spline derivatives; his end points came from a least-squares quartic, here the
     spline's not-a-knot end conditions). Exact for polynomials of degree <= 3. The error is
     the spline's linear map applied to the velocity errors (bins independent)."""
+    from scipy.interpolate import CubicSpline  # noqa: PLC0415 - not needed by engine runs
+
     y = np.asarray(profiles["y"], float)
     u = np.asarray(profiles["velocity"], float)[:, component]
     ue = _err(profiles, "velocity")[:, component]

@@ -26,7 +26,6 @@ from functools import lru_cache
 from typing import Literal
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 Model = Literal["hooke", "hertz"]
 Tangential = Literal["none", "spring", "coulomb"]
@@ -107,6 +106,7 @@ def hertz_damping_constant(e: float) -> float:
 @lru_cache(maxsize=256)
 def _hertz_scaled(c: float) -> tuple[float, float, float]:
     """Solve x'' = -x^1.5 - c x^0.25 x', x(0) = 0, x'(0) = 1: return (e, t_c, x_max)."""
+    from scipy.integrate import solve_ivp  # noqa: PLC0415 - ~0.25 s to import, Hertz only
 
     def rhs(_t: float, y: np.ndarray) -> list[float]:
         x = max(y[0], 0.0)

@@ -19,15 +19,13 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..io.results import Results, read_results
+from .kinds import HOW_PLOT_ONLY
 
 #: a dataset that must be present for the kind to be drawable
 REQUIRED = {"stress": "total", "eos": "total", "vdf": "X", "angles": "p_text",
             "freepath": "p_lambda", "gr": "g",
             "vcorr": "C", "lambda": "lambda", "waves": "series_time",
             "structure": "normal", "cgprofiles": "solid_fraction"}
-#: figures drawn from a run's time series and scene rather than from a statistic
-HOW_PLOT_ONLY = {"cooling": "Haff's law needs every axis periodic, no walls, gravity or "
-                            "shear, equal particles and a constant e < 1"}
 
 
 def statistic_of(kind: str) -> str:

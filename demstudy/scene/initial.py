@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .scene import Scene
 
@@ -112,6 +111,8 @@ def _random_placement(scene: Scene, rng: np.random.Generator, d_max: float) -> n
 def _sequential_addition(
     n, lo, hi, periodic, d_max, rng, max_tries: int = 200
 ) -> np.ndarray | None:
+    from scipy.spatial import cKDTree  # noqa: PLC0415 - scipy.spatial costs ~0.1 s to import
+
     lengths = hi - lo
     accepted = np.empty((0, len(lo)))
     remaining = n
