@@ -1,33 +1,45 @@
-"""Python-driven LAMMPS run vs bare ``lmp -in deck.in`` on the same ~30k-sphere chute deck.
+"""`demstudy run` (LAMMPS engine) vs bare ``lmp -in deck.in`` on the same ~30k-sphere chute.
 
-The Python run samples (gathers every particle from LAMMPS memory and accumulates exact
-volume-weighted profiles) every ``--sample-every`` steps; the bare run only prints thermo.
-Overhead = t_python / t_bare − 1 (goal ≤ 5 %). Prints a Markdown row for docs/benchmarks.md.
+Both are whole processes, timed from outside: ``demstudy run`` validates the scene, starts its
+child, builds the initial state and its data file, drives LAMMPS segment by segment, gathers
+every particle at each sample, accumulates exact volume-weighted profiles and writes the
+results file; the bare run reads the data file ``demstudy deck`` wrote and only prints thermo.
+Each case runs in interleaved pairs (python, bare, python, bare, …): this VM's speed drifts by
+tens of per cent, so only pairwise ratios are meaningful. Per pair: wall and CPU seconds
+(user + sys of the process and the children it waited for) and peak memory (the largest
+single process, ``ru_maxrss``), from ``os.wait4``. This process imports nothing heavy (a
+child inherits its parent's peak until it execs): the scene and the deck are written by a
+``--prepare`` call of this script in a process of its own.
 
-    python benchmarks/bench_python_overhead.py [--steps 2000] [--sample-every 100]
+The extra cost of a run, A − B, is a fixed part (start-up, initial state) plus a cost per
+sample. The fixed part is measured directly by a short case of one sample (100 steps; the
+default's third case): its A − B is the fixed cost plus one sample. (Splitting the two long
+cases' A − B into both parts is too noisy here: their times vary by ±0.3 s.)
 
-Dimensionless particle units: d = 1, m = 1, g = 1.
+    python benchmarks/bench_python_overhead.py [--cases 2000:100,5000:500,100:100] [--repeats 5]
+
+Prints Markdown rows for docs/benchmarks.md. Dimensionless particle units: d = 1, m = 1, g = 1.
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
 import platform
-import resource
+import statistics
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
 
-from demstudy.contact.stiffness import contact_setup
-from demstudy.engines.lammps.deck import write_deck
-from demstudy.engines.lammps.library import lmp_executable
-from demstudy.scene import validate_scene
-from demstudy.simulation import RunOptions, run_scene
-
 
 def chute_scene(steps: int, sample_every: int, dt: float | None = None) -> dict:
     """3D chute, 32 × 30 × 32 = 30 720 rough spheres on a rough base at 25°."""
+    from demstudy.contact.stiffness import contact_setup  # noqa: PLC0415 - see the docstring
+    from demstudy.scene import validate_scene  # noqa: PLC0415
+
     scene = {
         "meta": {"name": "bench-chute-30k"},
         "dimension": 3,
@@ -48,47 +60,111 @@ def chute_scene(steps: int, sample_every: int, dt: float | None = None) -> dict:
     return scene
 
 
-def timed_pair(scene, tmp: Path) -> tuple[float, float, float, float]:
-    """One bare and one Python-driven run of the same scene: wall and CPU seconds of each
-    (CPU time is less sensitive to other load on a shared VM)."""
-    deck = write_deck(scene, tmp / "bare")
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+def timed(cmd: list[str], cwd: Path) -> tuple[float, float, float]:
+    """Wall s, CPU s and peak MiB of one whole command (with the children it waited for)."""
     t0 = time.perf_counter()
-    subprocess.run([lmp_executable(), "-in", deck.name, "-log", "none", "-screen", "none"],
-                   cwd=deck.parent, check=True)
-    bare = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    bare_cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
-    c0, t0 = time.process_time(), time.perf_counter()
-    run_scene(scene, "lammps", RunOptions(out=tmp / "py.h5", progress=False))
-    return bare, time.perf_counter() - t0, bare_cpu, time.process_time() - c0
+    proc = subprocess.Popen(cmd, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+    _pid, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} exited with {proc.returncode}")
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
+
+
+def demstudy_command() -> list[str]:
+    script = Path(sys.executable).parent / "demstudy"
+    return [str(script)] if script.exists() else [sys.executable, "-c",
+                                                  "import sys; from demstudy.cli import main; "
+                                                  "sys.exit(main())"]
+
+
+def prepare(folder: Path, steps: int, every: int) -> None:
+    """The scene file and the bare deck (its data file too) of one case, in ``folder``."""
+    from demstudy.engines.lammps.deck import write_deck  # noqa: PLC0415 - see the docstring
+    from demstudy.scene import scene_to_toml, validate_scene  # noqa: PLC0415
+
+    scene = validate_scene(chute_scene(steps, every))
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "scene.toml").write_text(scene_to_toml(scene))
+    write_deck(scene, folder / "bare")
+    (folder / "particles").write_text(str(scene.n_particles))
+
+
+def run_case(steps: int, every: int, repeats: int, tmp: Path) -> dict:
+    folder = tmp / f"{steps}-{every}"
+    subprocess.run([sys.executable, __file__, "--prepare", str(folder), str(steps), str(every)],
+                   check=True)
+    lmp = Path(sys.executable).parent / "lmp"
+    python = [*demstudy_command(), "run", "scene.toml", "--out", "run.h5", "-q"]
+    bare = [str(lmp) if lmp.exists() else "lmp", "-in", "deck.in", "-log", "none", "-screen",
+            "none"]
+    pairs = []
+    for i in range(repeats + 1):  # the first pair warms the caches and is not counted
+        a = timed(python, folder)
+        b = timed(bare, folder / "bare")
+        if i:
+            pairs.append((a, b))
+    return {"steps": steps, "every": every, "samples": steps // every,
+            "n": int((folder / "particles").read_text()), "pairs": pairs}
+
+
+def median(values) -> float:
+    return statistics.median(values)
+
+
+def report(cases: list[dict]) -> None:
+    model = next((line.split(":", 1)[1].strip() for line in
+                  Path("/proc/cpuinfo").read_text().splitlines()
+                  if line.startswith("model name")), platform.processor() or platform.machine())
+    print(f"machine: {model}, {os.cpu_count()} CPUs, Python {platform.python_version()}, "
+          f"{datetime.date.today().isoformat()}")
+    print("| N steps, samples | bare wall / cpu (s) | python wall / cpu (s) | ratio wall | "
+          "ratio cpu | A − B wall / cpu (s) | peak MiB bare / python |")
+    print("|---|---|---|---|---|---|---|")
+    for case in cases:
+        a = [p[0] for p in case["pairs"]]
+        b = [p[1] for p in case["pairs"]]
+        ratio_wall = [x[0] / y[0] for x, y in zip(a, b, strict=True)]
+        ratio_cpu = [x[1] / y[1] for x, y in zip(a, b, strict=True)]
+        case["delta"] = [(x[0] - y[0], x[1] - y[1]) for x, y in zip(a, b, strict=True)]
+        print(f"| {case['steps']}, {case['samples']} | {median(y[0] for y in b):.2f} / "
+              f"{median(y[1] for y in b):.2f} | {median(x[0] for x in a):.2f} / "
+              f"{median(x[1] for x in a):.2f} | {median(ratio_wall):.3f} "
+              f"({min(ratio_wall):.3f}–{max(ratio_wall):.3f}) | {median(ratio_cpu):.3f} "
+              f"({min(ratio_cpu):.3f}–{max(ratio_cpu):.3f}) | "
+              f"{median(d[0] for d in case['delta']):+.2f} / "
+              f"{median(d[1] for d in case['delta']):+.2f} | "
+              f"{median(y[2] for y in b):.0f} / {median(x[2] for x in a):.0f} |")
+    for case in cases:
+        if case["samples"] == 1:
+            wall, cpu = (sorted(d[k] for d in case["delta"]) for k in (0, 1))
+            print(f"fixed cost (A − B of {case['steps']} steps, one sample): "
+                  f"{1000 * median(wall):.0f} ms wall ({1000 * wall[0]:.0f}–"
+                  f"{1000 * wall[-1]:.0f}), {1000 * median(cpu):.0f} ms cpu "
+                  f"({1000 * cpu[0]:.0f}–{1000 * cpu[-1]:.0f})")
+    for case in cases:
+        rows = " ".join(f"{x[0]:.2f}/{y[0]:.2f}" for x, y in case["pairs"])
+        print(f"{case['steps']} steps, python/bare wall per pair: {rows}")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("--steps", type=int, default=2000)
-    parser.add_argument("--sample-every", type=int, default=100)
-    parser.add_argument("--repeats", type=int, default=5,
-                        help="alternating bare/python pairs; the minimum of each is compared "
-                             "(this VM's timings vary by tens of per cent between runs)")
+    parser.add_argument("--cases", default="2000:100,5000:500,100:100",
+                        help="STEPS:SAMPLE_EVERY, comma-separated (default: 20, 10 and 1 "
+                             "samples; a case of one sample measures the fixed cost)")
+    parser.add_argument("--repeats", type=int, default=5, help="counted pairs per case")
+    parser.add_argument("--prepare", nargs=3, metavar=("FOLDER", "STEPS", "EVERY"),
+                        help=argparse.SUPPRESS)
     args = parser.parse_args()
-    scene = validate_scene(chute_scene(args.steps, args.sample_every))
-    runs = []
-    for _ in range(args.repeats):
-        with tempfile.TemporaryDirectory() as tmp:
-            runs.append(timed_pair(scene, Path(tmp)))
-    bare, python, bare_cpu, python_cpu = (list(col) for col in zip(*runs, strict=True))
-    n = scene.n_particles
-    print(f"machine: {platform.processor() or platform.machine()}, {platform.node()}")
-    for name, values in (("bare wall", bare), ("python wall", python), ("bare cpu", bare_cpu),
-                         ("python cpu", python_cpu)):
-        print(f"{name:12s}: {' '.join(f'{t:.2f}' for t in values)} s")
-    wall = 100 * (min(python) / min(bare) - 1)
-    cpu = 100 * (min(python_cpu) / min(bare_cpu) - 1)
-    print(f"| {n} spheres | {args.steps} steps | sample every {args.sample_every} | "
-          f"bare {min(bare):.2f} s wall, {min(bare_cpu):.2f} s cpu | "
-          f"python {min(python):.2f} s wall, {min(python_cpu):.2f} s cpu | "
-          f"overhead {wall:+.1f} % wall, {cpu:+.1f} % cpu (minima of {args.repeats}) |")
+    if args.prepare:
+        prepare(Path(args.prepare[0]), int(args.prepare[1]), int(args.prepare[2]))
+        return
+    cases = [tuple(int(v) for v in c.split(":")) for c in args.cases.split(",") if c.strip()]
+    with tempfile.TemporaryDirectory() as tmp:
+        results = [run_case(steps, every, args.repeats, Path(tmp)) for steps, every in cases]
+    print(f"{results[0]['n']} spheres; pairs python/bare interleaved, medians (min–max)")
+    report(results)
 
 
 if __name__ == "__main__":
