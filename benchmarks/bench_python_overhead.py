@@ -1,9 +1,10 @@
 """`demstudy run` (LAMMPS engine) vs bare ``lmp -in deck.in`` on the same ~30k-sphere chute.
 
 Both are whole processes, timed from outside: ``demstudy run`` validates the scene, starts its
-child, builds the initial state and its data file, drives LAMMPS segment by segment, gathers
-every particle at each sample, accumulates exact volume-weighted profiles and writes the
-results file; the bare run reads the data file ``demstudy deck`` wrote and only prints thermo.
+child, builds the initial state (created in LAMMPS from memory), drives LAMMPS segment by
+segment, gathers every particle at each sample, accumulates exact volume-weighted profiles and
+writes the results file; the bare run reads the data file ``demstudy deck`` wrote and only
+prints thermo.
 Each case runs in interleaved pairs (python, bare, python, bare, …): this VM's speed drifts by
 tens of per cent, so only pairwise ratios are meaningful. Per pair: wall and CPU seconds
 (user + sys of the process and the children it waited for) and peak memory (the largest

@@ -409,3 +409,67 @@ def test_campbell_rough_couette_runs_on_servo_walls():
     deck = build_deck(load_scene(ROOT / "inputs/campbell1982/couette-rough.toml"))
     assert deck.effects().count("wall:lower") == 1 and deck.effects().count("wall:upper") == 1
     assert "wall/gran/region" in deck.render()
+
+
+def _savetxt(rows) -> str:
+    """The data file's tables as numpy.savetxt wrote them before format_rows."""
+    import io
+
+    import numpy as np
+
+    buffer = io.StringIO()
+    np.savetxt(buffer, rows, fmt="%.17g")
+    return buffer.getvalue().rstrip("\n")
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_data_file_tables_are_savetxt_text_and_round_trip(make, dim):
+    """format_rows writes what numpy.savetxt wrote with %.17g, character for character, and
+    that text parses back to the very same doubles: positions, velocities, spins, the bumps'
+    rows and types, and values chosen to be hard (near powers of ten and ties, tiny, huge,
+    negative zero, inf, nan)."""
+    import numpy as np
+
+    from demstudy.effects.bumps import bump_rows
+    from demstudy.engines.lammps.deck.system import data_rows, format_rows
+    from demstudy.scene.initial import build_initial_state
+
+    scene = make(dim, particles={"count": 40},
+                 walls=[{**LOWER, "kind": "bumpy", "bumps": {"pattern": "random"}},
+                        {**UPPER, "kind": "bumpy", "bumps": {}}],
+                 initial={"velocity": {"temperature": 1.0}})
+    atoms, velocities = data_rows(scene, build_initial_state(scene), bump_rows(scene))
+    assert {2, 3} <= set(atoms[:, 1])  # both walls' bumps are in the tables
+    rng = np.random.default_rng(7)
+    near_ten = [np.nextafter(10.0**k, t) for k in range(-13, 19) for t in (0.0, np.inf)]
+    hard = np.array(near_ten + [10.0**k for k in range(-13, 19)] + [
+        0.5, 2.5, 1e-5, 1e-11, 9.999999999999999e-12, 1.5e-300, 5e-324, 1.7976931348623157e308,
+        1e17, 12345678901234567.0, 0.0, -0.0, np.inf, -np.inf, np.nan, 6 / math.pi, 1e6])
+    tables = [atoms, velocities, np.concatenate([hard, -hard]).reshape(-1, 2),
+              rng.normal(size=(3000, 3)) * 10.0 ** rng.integers(-15, 18, (3000, 3)),
+              rng.integers(0, 2**63, (3000, 2)).view(np.float64)]  # any bit pattern
+    for rows in tables:
+        text = format_rows(rows)
+        assert text == _savetxt(rows)
+        back = np.array([[float(v) for v in line.split()] for line in text.split("\n")])
+        finite = ~np.isnan(rows)
+        assert np.array_equal(np.isnan(back), ~finite)
+        assert np.array_equal(back[finite].view(np.int64), rows[finite].view(np.int64))
+    assert format_rows(np.zeros((0, 3))) == ""
+
+
+def test_deck_without_data_file_builds_no_initial_state(make, monkeypatch):
+    """``build_deck(data=False)``, as a run builds it (its atoms come from memory): the same
+    commands, no data file, and no initial state built for it."""
+    import demstudy.engines.lammps.deck as deck_module
+
+    scene = make(2, walls=[LOWER, UPPER])
+    full = build_deck(scene)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("an initial state was built")
+
+    monkeypatch.setattr(deck_module, "build_initial_state", refuse)
+    bare = build_deck(scene, data=False)
+    assert DATA_FILE not in bare.files and DATA_FILE in full.files
+    assert bare.render() == full.render()

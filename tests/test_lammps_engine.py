@@ -336,3 +336,61 @@ def test_paths_with_spaces_and_two_bumpy_walls(tmp_path):
     assert res.profile_attrs["samples"] == 4
     y = res.profiles["y"]
     assert y.min() > 0.0 and y.max() < 8.0
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_atoms_created_from_memory_are_those_of_the_data_file(tmp_path, dim):
+    """A run creates its atoms through the library interface (nothing formatted and parsed);
+    the state is read_data's bit for bit (positions, order, velocities, spins, radii, the
+    masses of particles and bumps): the two set-ups give identical results files."""
+    from demstudy.engines.lammps.backend import LammpsBackend
+
+    class FromDataFile(LammpsBackend):
+        state_from_memory = False  # the deck's data file, written and read (read_data)
+
+    if dim == 2:
+        scene = load_scene(CHUTE, ["run.equilibration=0.5", "run.production=1.0",
+                                   "run.sample_interval=0.25", "walls[0].kind=bumpy",
+                                   "walls.0.bumps.pattern=random", "measure.keep_frames=true"])
+    else:
+        scene = validate_scene({
+            "dimension": 3, "box": {"size": [4.4, 10.0, 4.4]}, "particles": {"inertia": "sphere"},
+            "contact": {"restitution": 0.8, "tangential": {"model": "beta", "beta": 0.0}},
+            "walls": [{"side": "lower", "restitution": 0.8, "kind": "bumpy", "bumps": {}}],
+            "gravity": {"angle": 25.0},
+            "initial": {"placement": "lattice", "rows": 5, "columns": 4, "layers": 4,
+                        "spacing": 1.1, "velocity": {"profile": "uniform", "scale": 1.0,
+                                                     "perturbation": 0.1, "temperature": 0.5}},
+            "run": {"equilibration": 0.0, "production": 1.0, "sample_interval": 0.25},
+            "measure": {"keep_frames": True}})
+    results = {}
+    for how, backend in (("memory", LammpsBackend), ("data file", FromDataFile)):
+        out = tmp_path / how / "run.h5"
+        run_scene(scene, backend, RunOptions(out=out, progress=False))
+        work = sorted(p.name for p in out.with_suffix(".lammps").iterdir())
+        assert ("initial.data" in work) == (how == "data file"), work
+        results[how] = read_results(out)
+    a, b = results["memory"], results["data file"]
+    assert a.frames and len(a.frames["time"]) == 4
+    for group in ("timeseries", "profiles", "frames"):
+        for key, value in getattr(a, group).items():
+            other = getattr(b, group)[key]
+            assert np.array_equal(np.asarray(value), np.asarray(other), equal_nan=True), key
+
+
+def test_atoms_outside_the_box_are_an_engine_error(tmp_path):
+    """Rows LAMMPS cannot place (outside a fixed box) are reported, not silently dropped."""
+    from demstudy.engines.lammps.deck.system import data_header
+
+    scene = chute()
+    session = LammpsSession(tmp_path)
+    try:
+        for cmd in ("units lj", "atom_style sphere", "dimension 2", "boundary p f p"):
+            session.command(cmd)
+        (tmp_path / "box.data").write_text("\n".join(data_header(scene, 0)) + "\n")
+        session.command(f"read_data {tmp_path / 'box.data'}")
+        atoms = np.array([[1, 1, 1.0, 1.9, 1.0, 1.0, 0.0], [2, 1, 1.0, 1.9, 1.0, -5.0, 0.0]])
+        with pytest.raises(EngineError, match="created 1 of 2 atoms"):
+            session.create_atoms(atoms, np.zeros((2, 7)))
+    finally:
+        session.close()

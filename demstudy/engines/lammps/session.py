@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import EngineError
+from .deck.system import sphere_mass
 from .library import open_lammps, preload_mpi
 
 # MPICH ABI handles (the runtime is the `mpich` wheel's): MPI_COMM_WORLD, MPI_INT, MPI_MAX
@@ -72,6 +73,34 @@ class LammpsSession:
         ids = np.array(self.lmp.numpy.extract_atom("id")[:nlocal], dtype=np.int64)
         target = self.lmp.numpy.extract_atom(name)
         target[:nlocal] = values[ids - 1]
+
+    def create_atoms(self, atoms: np.ndarray, velocities: np.ndarray) -> None:
+        """Add the atoms of a data file's Atoms and Velocities rows (``deck.system.data_rows``)
+        through the library interface, as ``read_data`` would: the same positions, order,
+        velocities, radii, masses (``sphere_mass``) and spins, without formatting and parsing
+        text. Every rank passes every row; each keeps those it owns."""
+        n = len(atoms)
+        tagint = np.int64 if self.lmp.extract_setting("tagint") == 8 else np.int32
+        ids = np.ascontiguousarray(atoms[:, 0], dtype=tagint)
+        types = np.ascontiguousarray(atoms[:, 1], dtype=np.int32)
+        x = np.ascontiguousarray(atoms[:, 4:7], dtype=np.float64)
+        v = np.ascontiguousarray(velocities[:, 1:4], dtype=np.float64)
+        create = self.lmp.lib.lammps_create_atoms
+        create.argtypes = [ctypes.c_void_p, ctypes.c_int] + [ctypes.c_void_p] * 5 + [ctypes.c_int]
+        create.restype = ctypes.c_int
+        try:
+            with self._lam.core.ExceptionCheck(self.lmp):  # LAMMPS's error, as a command's
+                made = create(self.lmp.lmp, n, ids.ctypes.data, types.ctypes.data,
+                              x.ctypes.data, v.ctypes.data, None, 0)
+        except Exception as exc:
+            message = str(exc).strip() or type(exc).__name__
+            raise EngineError(f"LAMMPS error: {message}\n  creating the initial atoms") from None
+        total = int(self.lmp.get_natoms())
+        if made != n or total != n:
+            raise EngineError(f"LAMMPS created {total} of {n} atoms (some outside the box?)")
+        self.scatter("radius", 0.5 * atoms[:, 2])
+        self.scatter("rmass", sphere_mass(atoms[:, 2], atoms[:, 3]))
+        self.scatter("omega", np.ascontiguousarray(velocities[:, 4:7]))
 
     def fix_vector(self, fix_id: str, length: int) -> np.ndarray:
         """Global vector of a fix (e.g. ``fix ave/time``), identical on every rank."""

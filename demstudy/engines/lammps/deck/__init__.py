@@ -37,12 +37,13 @@ def check_scene(scene: Scene) -> ContactSetup:
 
 
 def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None = None,
-               setup: ContactSetup | None = None) -> Deck:
-    """Compose the deck; raises ``UnsupportedByEngine`` for effects LAMMPS cannot express."""
+               setup: ContactSetup | None = None, data: bool = True) -> Deck:
+    """Compose the deck; raises ``UnsupportedByEngine`` for effects LAMMPS cannot express.
+    ``data=False``: without the data file (no initial state is built): a run creates its
+    atoms from memory (``LammpsSession.create_atoms``)."""
     setup = setup or check_scene(scene)
     draft = DeckDraft(setup)
     apply_effects(scene, "lammps", TRANSLATIONS, draft)
-    state = state or build_initial_state(scene)
     bumps = bump_rows(scene)
     blocks: list[Block] = [
         setup_block(scene, bumps),
@@ -55,7 +56,8 @@ def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None
         run_block(scene, setup, dump),
     ]
     deck = Deck(blocks, notes=draft.notes)
-    deck.files[DATA_FILE] = data_file(scene, state, bumps)
+    if data:
+        deck.files[DATA_FILE] = data_file(scene, state or build_initial_state(scene), bumps)
     return deck
 
 

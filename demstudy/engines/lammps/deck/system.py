@@ -63,17 +63,22 @@ def y_bounds(scene: Scene) -> tuple[float, float]:
 
 def data_file(scene: Scene, state: InitialState, bumps: list[BumpRow]) -> str:
     """LAMMPS data file (atom_style sphere) holding the initial state and any wall bumps."""
-    dim = scene.dimension
-    n = len(state.position)
-    bump_xyz = [row.centres for row in bumps]
-    nb = sum(len(c) for c in bump_xyz)
+    atoms, velocities = data_rows(scene, state, bumps)
+    lines = data_header(scene, len(atoms))
+    lines += ["", "Atoms # sphere", "", format_rows(atoms)]
+    lines += ["", "Velocities", "", format_rows(velocities)]
+    return "\n".join(lines) + "\n"
+
+
+def data_header(scene: Scene, n_atoms: int) -> list[str]:
+    """The data file's header: atom count, atom types, box (triclinic under Lees–Edwards)."""
     lo_y, hi_y = y_bounds(scene)
     pad = 0.0 if scene.y_periodic else bump_padding(scene)  # bumps sit on the wall planes
-    z = (0.0, scene.box.size[2]) if dim == 3 else (-0.5, 0.5)
+    z = (0.0, scene.box.size[2]) if scene.dimension == 3 else (-0.5, 0.5)
     lines = [
         "demstudy initial state (dimensionless particle units: d = 1, m = 1)",
         "",
-        f"{n + nb} atoms",
+        f"{n_atoms} atoms",
         f"{n_atom_types(scene)} atom types",
         "",
         f"0 {fmt(scene.box.size[0])} xlo xhi",
@@ -82,7 +87,18 @@ def data_file(scene: Scene, state: InitialState, bumps: list[BumpRow]) -> str:
     ]
     if scene.shear is not None:
         lines.append("0 0 0 xy xz yz")
-    # columns: id type diameter density x y z (bumps: their wall's type, 1e6 times denser)
+    return lines
+
+
+def data_rows(scene: Scene, state: InitialState,
+              bumps: list[BumpRow]) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of the data file's Atoms (id type diameter density x y z) and Velocities
+    (id vx vy vz wx wy wz) sections, particles then bumps, as floats."""
+    dim = scene.dimension
+    n = len(state.position)
+    bump_xyz = [row.centres for row in bumps]
+    nb = sum(len(c) for c in bump_xyz)
+    # bumps: their wall's type, 1e6 times denser
     pos = np.zeros((n + nb, 3))
     pos[:n, :dim] = state.position
     if nb:
@@ -101,9 +117,15 @@ def data_file(scene: Scene, state: InitialState, bumps: list[BumpRow]) -> str:
         vel[:n, 5] = state.angular_velocity[:, 0]
     else:
         vel[:n, 3:] = state.angular_velocity
-    lines += ["", "Atoms # sphere", "", format_rows(atoms)]
-    lines += ["", "Velocities", "", format_rows(np.column_stack([ids, vel]))]
-    return "\n".join(lines) + "\n"
+    return atoms, np.column_stack([ids, vel])
+
+
+def sphere_mass(diameter: np.ndarray, density: np.ndarray) -> np.ndarray:
+    """The mass ``read_data`` gives a sphere, bit for bit: LAMMPS's AtomVecSphere computes
+    rmass = density * (4 pi / 3 * r * r * r), r = diameter / 2, in this order (the pinned
+    LAMMPS; tests/test_lammps_engine.py compares the two set-ups)."""
+    radius = 0.5 * diameter
+    return density * (4.0 * math.pi / 3.0 * radius * radius * radius)
 
 
 # 10**k for k = 0 … 27, exact in a long double with a 64-bit mantissa (5**27 < 2**64)
