@@ -45,7 +45,8 @@ def test_a_third_backend_runs_through_the_loop_unchanged(tmp_path):
     loop knows nothing of this engine but its class."""
     from demstudy.scene.initial import build_initial_state
 
-    scene = gas(measure={"keep_frames": True, "statistics": ["profiles", "gr", "vdf"]})
+    scene = gas(measure={"keep_frames": True, "statistics": ["profiles", "gr", "vdf",
+                                                              "derived"]})
     assert "ballistic" in backend_names()
     res = read_results(run_scene(scene, "ballistic", RunOptions(out=tmp_path / "b.h5",
                                                                 progress=False)))
@@ -186,7 +187,7 @@ def test_a_statistic_failing_after_the_run_keeps_the_results(tmp_path):
 
     scene = gas(particles={"count": 10},
                 run={"equilibration": 0.0, "production": 0.5, "sample_interval": 0.25},
-                measure={"statistics": ["profiles", "freepath"]})
+                measure={"statistics": ["profiles", "freepath", "derived"]})
     out = tmp_path / "fp.h5"
     with pytest.raises(EngineError, match=rf"(?s)results are in {out}.*freepath: .*no particle "
                                           "collides twice"):

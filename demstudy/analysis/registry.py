@@ -54,7 +54,6 @@ class Statistic:
     log_every: int = 0  # collisions the engine must log (1: every one)
     z_cells: bool = False  # takes Malik's cells (``--z-cells``)
     run_group: str | None = None  # the group a run writes it to besides /statistics/<name>
-    every_run: bool = False  # every run writes it, asked for or not
 
     def compute(self, ctx: Context) -> tuple[dict[str, Any], dict[str, Any]]:
         """(datasets, attributes) of this statistic from ``ctx``."""
@@ -235,7 +234,7 @@ def _stress(ctx: Context):
 
 
 @statistic("derived", "derived quantities: S, f_s, f_N, friction, χ, wall slip, Knudsen",
-           "results", every_run=True)
+           "results")
 def _derived(ctx: Context):
     from .derived import derived_results
 

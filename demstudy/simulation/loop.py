@@ -73,7 +73,7 @@ class Simulation:
         # computed at the end: from the kept frames or log, then from the results so far
         self.after = [s for s in statistics if STATISTICS[s].source in ("frames", "collisions")]
         self.after += [s for s, stat in STATISTICS.items() if stat.source == "results"
-                       and s != "stress" and (stat.every_run or s in statistics)]
+                       and s != "stress" and s in statistics]
         self.measure_stress = "stress" in statistics
         frames_needed = any(STATISTICS[s].source == "frames" for s in statistics)
         keep = options.keep_frames
