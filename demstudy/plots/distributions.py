@@ -84,11 +84,18 @@ def draw_vdf(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
             ax.set_ylim(1e-4, 3)
             ax.yaxis.set_minor_locator(NullLocator())  # decades only: cheaper to draw
             ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=6, loc="upper right")
-    axes[0, 4].legend(fontsize=6, loc="upper right")
-    axes[1, 0].legend(fontsize=6, loc="upper right")
+    # one legend below the panels (the distributions fill them): the bins, then each
+    # reference curve once
+    entries: dict[str, object] = {}
+    for ax in (axes[0, 0], axes[0, 4], axes[1, 0]):
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    rows = -(-len(entries) // 4)
+    fig.legend(list(entries.values()), list(entries), fontsize=7, loc="lower center",
+               ncol=min(len(entries), 4), bbox_to_anchor=(0.5, 0.03), frameon=False)
     return finish(fig, runs, "velocity distributions: Campbell's P(X) (top), "
-                             "Malik's C/σ (bottom), fluctuations about the bin means")
+                             "Malik's C/σ (bottom), fluctuations about the bin means",
+                  bottom=(0.4 + 0.16 * rows) / fig.get_figheight())
 
 
 def draw_angles(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:

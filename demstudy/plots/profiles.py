@@ -19,9 +19,9 @@ from .common import MARKERS, Run, finish, new_figure
 
 PANELS = (
     ("solid_fraction", "solid fraction ν"),
-    ("velocity", "mean velocity u_x"),
-    ("temperature", "temperature T (per d.o.f.)"),
-    ("rotational_temperature", "rotational temperature"),
+    ("velocity", "mean velocity u_x (d/τ)"),
+    ("temperature", "temperature T (m d²/τ², per d.o.f.)"),
+    ("rotational_temperature", "rotational T (m d²/τ², per d.o.f.)"),
 )
 
 
@@ -105,17 +105,25 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
                                   (cell, cell.get_label())])
             ax.set_xlabel(title)
             ax.grid(alpha=0.3)
+    for ax in axes:  # few ticks, small values with a shared power of ten: labels apart
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=4))
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 4))
     axis = runs[0].results.profile_attrs.get("axis", "y")
     if scaled:
         kind = what.pop() if len(what) == 1 else "see the legend"
         axes[0].set_ylabel(f"({axis} − {axis}_0)/H,  H = {kind}")
     else:
         axes[0].set_ylabel(f"{axis} (particle diameters)")
-    axes[0].legend(fontsize=8, loc="upper right")
+    # the runs' legend below the panels: profiles fill the panels' height, no corner is free
+    handles, labels = axes[0].get_legend_handles_labels()
+    lines = sum(label.count("\n") + 1 for label in labels[::2]) + len(labels) % 2
+    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=min(len(labels), 2),
+               bbox_to_anchor=(0.5, 0.045), frameon=False)
     for ax, pairs in cells.items():
         if pairs:
             ax.legend(*zip(*pairs, strict=True), fontsize=7, loc="upper right")
-    return finish(fig, runs, "profiles: solid fraction, mean velocity, temperatures")
+    return finish(fig, runs, "profiles: solid fraction, mean velocity, temperatures",
+                  bottom=(0.5 + 0.17 * max(1, lines)) / fig.get_figheight())
 
 
 def panels_with_legend_row(n_cols: int, legend_lines: int, width: float, height: float,
