@@ -184,8 +184,8 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03) -
     fig.suptitle(title, fontsize=10)
     footer = f"{units_text(runs)}  |  engine: {engines}"
     chars = int(fig.get_figwidth() * 72 / (7 * 0.56))  # 7 pt characters across the figure
-    if len(footer) > chars:  # units on one line, the engines (long version strings) below
-        footer = "\n".join([units_text(runs)] + textwrap.wrap(
+    if len(footer) > chars:  # the units, then the engines, each wrapped to the figure's width
+        footer = "\n".join(textwrap.wrap(units_text(runs), chars) + textwrap.wrap(
             f"engine: {engines}", chars, break_on_hyphens=False))
     fig.text(0.005, 0.005, footer, fontsize=7, ha="left", va="bottom")
     lines = footer.count("\n") + 1
