@@ -58,6 +58,16 @@ def reference_height(run: Run) -> tuple[float, float, str]:
     return base, scene.wall_position("upper") - base, "gap between the walls"
 
 
+def set_height_label(ax: Axes, axis: str, scaled: bool, what: set[str], unit: str) -> None:
+    """The profile axis's label: the axis in ``unit``, or (axis − axis_0)/H with what H is
+    (``what``: the runs' kinds of H; several: see the legend)."""
+    if scaled:
+        kind = what.pop() if len(what) == 1 else "see the legend"
+        ax.set_ylabel(f"({axis} − {axis}_0)/H,  H = {kind}")
+    else:
+        ax.set_ylabel(f"{axis} ({unit})")
+
+
 def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
     """ν, u_x and T (translational and rotational) against y, one curve per results file;
     ``scaled``: against (y − y_0)/H (see :func:`reference_height`)."""
@@ -108,12 +118,8 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
     for ax in axes:  # few ticks, small values with a shared power of ten: labels apart
         ax.xaxis.set_major_locator(MaxNLocator(nbins=4))
         ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 4))
-    axis = runs[0].results.profile_attrs.get("axis", "y")
-    if scaled:
-        kind = what.pop() if len(what) == 1 else "see the legend"
-        axes[0].set_ylabel(f"({axis} − {axis}_0)/H,  H = {kind}")
-    else:
-        axes[0].set_ylabel(f"{axis} (particle diameters)")
+    set_height_label(axes[0], runs[0].results.profile_attrs.get("axis", "y"), scaled, what,
+                     "particle diameters")
     # the runs' legend below the panels: profiles fill the panels' height, no corner is free
     handles, labels = axes[0].get_legend_handles_labels()
     lines = sum(label.count("\n") + 1 for label in labels[::2]) + len(labels) % 2
@@ -229,12 +235,8 @@ def draw_cgprofiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
     if spans:  # empty space above an open top's flow is left out (1 d or 5 % margin)
         margin = 0.05 if scaled else 1.0
         axes[0].set_ylim(max(lo, min(spans) - margin), min(hi, max(spans) + margin))
-    axis = runs[0].group("cgprofiles")[1].get("axis", "y")
-    if scaled:
-        kind = what.pop() if len(what) == 1 else "see the legend"
-        axes[0].set_ylabel(f"({axis} − {axis}_0)/H,  H = {kind}")
-    else:
-        axes[0].set_ylabel(f"{axis} (d)")
+    set_height_label(axes[0], runs[0].group("cgprofiles")[1].get("axis", "y"), scaled, what,
+                     "d")
     handles, labels = axes[0].get_legend_handles_labels()
     legend_row.legend(handles, labels, fontsize=7, loc="center", ncol=2, frameon=False)
     taus = ", ".join(dict.fromkeys(str(run.attrs["time_unit"]) for run in runs
