@@ -70,11 +70,11 @@ class Simulation:
         statistics = scene.measure.statistics
         self.streams = [s for s in statistics if STATISTICS[s].source == "stream"
                         and s != "profiles"]
-        # computed at the end: from the kept frames or log, then from the results so far
-        self.after = [s for s in statistics if STATISTICS[s].source in ("frames", "collisions")]
-        self.after += [s for s, stat in STATISTICS.items() if stat.source == "results"
-                       and s != "stress" and s in statistics]
+        # computed at the end: from the kept frames or log, then from the results so far (the
+        # stress is the loop's own: the engine's interaction sums, accumulated on the way)
         self.measure_stress = "stress" in statistics
+        self.after = sorted((s for s in statistics if STATISTICS[s].source != "stream"
+                             and s != "stress"), key=lambda s: STATISTICS[s].source == "results")
         frames_needed = any(STATISTICS[s].source == "frames" for s in statistics)
         keep = options.keep_frames
         self.keep_frames = frames_needed or (scene.measure.keep_frames if keep is None else keep)
