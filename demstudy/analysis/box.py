@@ -74,6 +74,23 @@ def _periods(rel: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray]:
     return k, r
 
 
+def wrap_periodic(values: np.ndarray, lo: float, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """(wrapped, turns): ``values`` put into [lo, lo + length) along one periodic axis, and
+    how many periods each moved (``wrapped = values - turns * length``); values already
+    inside come back bit for bit. The image rule of every periodic coordinate (a Lees–Edwards
+    centre that moved by ``turns`` periods along y moves its x velocity by ``-turns`` times
+    the image velocity)."""
+    out = np.array(values, dtype=float)
+    turns = np.zeros(out.shape)
+    rel = out - lo
+    outside = np.flatnonzero(~((rel >= 0) & (rel < length)))
+    if outside.size:
+        k, r = _periods(rel[outside], length)
+        out[outside] = _into(lo, r, length)
+        turns[outside] = k
+    return out, turns
+
+
 @dataclass(frozen=True, eq=False)
 class Box:
     """An immutable box ``[lo, lo + lengths)`` with per-axis periodicity.
@@ -187,18 +204,15 @@ class Box:
         image = np.zeros(pos.shape, np.int64)
         order = (1, 0, 2) if self.dim > 1 else (0,)  # y first: it moves x
         for axis in (a for a in order if a < self.dim and self.periodic[a]):
-            lo, length = self.lo[axis], self.lengths[axis]
-            rel = pos[:, axis] - lo
-            out = np.flatnonzero(~((rel >= 0) & (rel < length)))
+            pos[:, axis], k = wrap_periodic(pos[:, axis], self.lo[axis], self.lengths[axis])
+            out = np.flatnonzero(k)
             if out.size == 0:
                 continue
-            k, r = _periods(rel[out], length)
-            pos[out, axis] = _into(lo, r, length)
-            image[out, axis] = k.astype(np.int64)
+            image[out, axis] = k[out].astype(np.int64)
             if axis == 1:
-                pos[out, 0] -= k * self.tilt
+                pos[out, 0] -= k[out] * self.tilt
                 if vel is not None:
-                    vel[out, 0] -= k * self.shear_velocity
+                    vel[out, 0] -= k[out] * self.shear_velocity
         return Wrapped(pos, vel, image)
 
     def minimum_image(self, delta: ArrayLike) -> np.ndarray:

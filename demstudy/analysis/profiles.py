@@ -60,6 +60,7 @@ from numpy.typing import ArrayLike
 from demstudy import UNITS_NOTE
 from demstudy.analysis.base import AnalysisBase, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.analysis.box import wrap_periodic
 from demstudy.analysis.volumes import bin_profile_sums, profile_nvalues
 from demstudy.io.frames import Frame
 
@@ -264,10 +265,16 @@ class ProfileAnalysis(AnalysisBase):
     def _lees_edwards_images(
         self, coord: np.ndarray, radius: np.ndarray, vel: np.ndarray, *rest: np.ndarray
     ) -> tuple[np.ndarray, ...]:
-        """Explicit periodic images of boundary straddlers, with shifted x velocities (the
+        """Centres put into the period with the image rule (a centre moved by k periods moves
+        its x velocity by −k × the image velocity: engines leave centres slightly outside),
+        then explicit periodic images of boundary straddlers with shifted x velocities (the
         ``rest`` per-particle arrays, spin and z-slab, are copied unchanged)."""
         lo, p = self.lo, self.period
-        c = lo + np.mod(coord - lo, p)
+        c, turns = wrap_periodic(coord, lo, p)
+        moved = np.flatnonzero(turns)
+        if moved.size:
+            vel = vel.copy()
+            vel[moved, 0] -= turns[moved] * self.image_velocity_shift
         below, above = c - radius < lo, c + radius > lo + p
         img_v = [vel, vel[below].copy(), vel[above].copy()]
         img_v[1][:, 0] += self.image_velocity_shift  # image at c + P
