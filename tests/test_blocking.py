@@ -114,3 +114,50 @@ def test_errors():
         BlockAccumulator(2).add([1.0, 2.0, 3.0])
     with pytest.raises(ValueError):
         jackknife(BlockAccumulator(2), lambda m: m)
+
+
+def test_blocks_shorter_than_the_correlation_are_lengthened():
+    """AR(1) with ρ = 0.95 (2τ_int = 39 samples) over 2048 samples: the stored blocks (64
+    samples) are too short, so their errors are > 15 % low; the blocking curve's longer
+    blocks (>= 8 of them) recover the exact error, and the report says how."""
+    from demstudy.analysis.blocking import jackknife_report
+
+    rho, n, chains = 0.95, 2048, 200
+    x = ar1(rho, n, chains, seed=3)
+    acc = feed(BlockAccumulator(chains, max_blocks=64), x)
+    exact = ar1_error_of_mean(rho, n)
+    stored = np.sqrt(acc.n_blocks * acc.block_length / n * np.var(
+        acc.block_sums / acc.block_length, axis=0, ddof=1) / acc.n_blocks)
+    assert np.median(stored) < 0.85 * exact  # the fixed blocks' error is too small
+    est, err, report = jackknife_report(acc, lambda m: m)
+    assert np.median(err) == pytest.approx(exact, rel=0.1)
+    (figures,) = report.values()
+    assert figures["block_length"] > acc.block_length and figures["inefficiency"] > 1.1
+    # 2τ_int = (1 + ρ)/(1 − ρ) = 39 samples: about 2048/39 = 53 independent samples
+    assert 35 < figures["effective_samples"] < 80
+
+
+def test_uncorrelated_samples_keep_their_errors_and_converge():
+    rng = np.random.default_rng(8)
+    x = rng.normal(size=(4096, 100))
+    from demstudy.analysis.blocking import jackknife_report
+
+    acc = feed(BlockAccumulator(100, max_blocks=64), x)
+    _, err, report = jackknife_report(acc, lambda m: m)
+    (figures,) = report.values()
+    assert figures["converged"] and figures["inefficiency"] < 1.2
+    assert np.median(err) == pytest.approx(1 / np.sqrt(4096), rel=0.1)
+    assert 3400 < figures["effective_samples"] <= 4096
+
+
+def test_correlations_as_long_as_the_run_are_flagged():
+    """ρ = 0.999 (correlation ~ 2000 samples) over 2048 samples: no plateau within the run;
+    the errors are lower bounds and the report says so."""
+    from demstudy.analysis.blocking import jackknife_report
+
+    x = ar1(0.999, 2048, 50, seed=4)
+    acc = feed(BlockAccumulator(50, max_blocks=64), x)
+    _, err, report = jackknife_report(acc, lambda m: m)
+    (figures,) = report.values()
+    assert not figures["converged"]
+    assert np.median(err) < ar1_error_of_mean(0.999, 2048)

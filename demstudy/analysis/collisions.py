@@ -468,7 +468,8 @@ class FreePath(AnalysisBase):
         }
 
     def _conclude(self) -> None:
-        est, err = jackknife(self._acc, self._estimate)
+        # chunks of flights by start time, weighted to be independent: no blocking
+        est, err = jackknife(self._acc, self._estimate, blocking=False)
         total = self._acc.total
         nb, size = self.n_bins, self._size
         counts = total[2 * size:].reshape(len(self._SUMS), nb)

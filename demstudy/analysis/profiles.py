@@ -59,7 +59,7 @@ from numpy.typing import ArrayLike
 
 from demstudy import UNITS_NOTE
 from demstudy.analysis.base import AnalysisBase, z_slab
-from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.analysis.blocking import BlockAccumulator, error_figures, jackknife_report
 from demstudy.analysis.box import wrap_periodic
 from demstudy.analysis.volumes import bin_profile_sums, profile_nvalues
 from demstudy.io.frames import Frame
@@ -330,12 +330,16 @@ class ProfileAnalysis(AnalysisBase):
         w = q[:, self._c_w]
         jw = q[:, self._c_jw]
         t_rot = q[:, self._c_jww] - 2.0 * (w * jw).sum(1) + (w * w).sum(1) * q[:, self._c_j]
+        temperature = comps.sum(1) / dim
+        filled = vol > 0
         return {
             "solid_fraction": mean[:nb],
             "number_density": mean[:nb] / mean_volume,
             "mean_mass": mean_mass,
             "velocity": v,
-            "temperature": comps.sum(1) / dim,
+            "temperature": temperature,
+            "mean_temperature": np.sum(mean[:nb][filled] * temperature[filled]) /
+                                np.sum(mean[:nb][filled]),  # mass-weighted over the bins
             "temperature_components": comps,
             "kinetic_shear": cov[:, 0, 1],
             "spin": w,
@@ -343,7 +347,7 @@ class ProfileAnalysis(AnalysisBase):
         }
 
     def _conclude(self) -> None:
-        est, err = jackknife(self._acc, self._estimate)
+        est, err, report = jackknife_report(self._acc, self._estimate)
         self.results = {"y": 0.5 * (self.edges[1:] + self.edges[:-1]), "edges": self.edges}
         for key in est:
             self.results[key] = est[key]
@@ -371,4 +375,5 @@ class ProfileAnalysis(AnalysisBase):
             "block_length": self._acc.block_length,
             "n_blocks": self._acc.n_blocks,
             "units": UNITS_NOTE,
+            **error_figures(report),
         }

@@ -74,6 +74,8 @@ _PROFILES = {
     "kinetic_shear": (SPEED2, "<u'v'>: velocity fluctuation covariance (x, y)"),
     "spin": (SPIN, "mass-weighted mean angular velocity (z in 2D; x, y, z in 3D)"),
     "rotational_temperature": (ENERGY, "I<ω'^2> per rotational degree of freedom"),
+    "mean_temperature": (ENERGY, "the mass-weighted mean over the bins of the translational "
+                                 "temperature (one number for the run)"),
     "cell_temperature": (ENERGY, "temperature with fluctuations about Malik's z-cell means"),
     "cell_temperature_components": (ENERGY, "temperature components about the z-cell means"),
     "cell_rotational_temperature": (ENERGY, "rotational temperature about the z-cell means"),
