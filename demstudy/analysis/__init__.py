@@ -8,8 +8,7 @@ compiled extension ``demstudy._native``.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from demstudy._lazy import lazy_exports
 
 #: public name -> the module of this package that defines it
 _WHERE = {
@@ -54,8 +53,4 @@ _WHERE = {
 __all__ = sorted(_WHERE)
 
 
-def __getattr__(name: str) -> Any:
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module 'demstudy.analysis' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"demstudy.analysis.{module}"), name)
+__getattr__, __dir__ = lazy_exports(__name__, {k: f".{v}" for k, v in _WHERE.items()})

@@ -27,9 +27,7 @@ writes the PNGs. The kinds (:mod:`.kinds`) need no matplotlib; the drawing funct
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
+from .._lazy import lazy_exports
 from .kinds import KINDS, SCALED, parse_kinds
 
 __all__ = ["KINDS", "SCALED", "Run", "draw", "draw_angles", "draw_cgprofiles", "draw_cooling",
@@ -38,14 +36,7 @@ __all__ = ["KINDS", "SCALED", "Run", "draw", "draw_angles", "draw_cgprofiles", "
            "output_path", "parse_kinds", "plot_files", "plot_profiles", "reference_height"]
 
 
-def __getattr__(name: str) -> Any:
-    """The drawing functions, imported with matplotlib on first use (PEP 562)."""
-    if name not in __all__ and name != "DRAW":
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.figures"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+# the drawing functions, imported with matplotlib on first use
+__getattr__, __dir__ = lazy_exports(__name__, {
+    name: ".figures" for name in [*__all__, "DRAW"] if name not in ("KINDS", "SCALED",
+                                                                     "parse_kinds")})

@@ -3,7 +3,7 @@ m = 1; conventions in :mod:`demstudy.theory.kinetic`)."""
 
 from __future__ import annotations
 
-import importlib
+from demstudy._lazy import lazy_exports
 
 # imported on first use (PEP 562): an engine run needs a few of these modules, and
 # the others pull in scipy.integrate, scipy.special, scipy.spatial (~0.3 s, ~30 MiB)
@@ -70,14 +70,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    module = _WHERE.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, {k: f".{v}" for k, v in _WHERE.items()})

