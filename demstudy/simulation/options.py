@@ -108,9 +108,9 @@ def check_run(backend: Any, scene: Any, options: RunOptions) -> None:
     if scene.run.unit == "collisions" and not backend.capabilities.collision_count:
         raise UnsupportedByEngine(backend.name, "run.unit", scene.run.unit,
                                   "this engine counts no collisions: give times")
-    if keep_frames_refused(scene, options):
-        raise UnsupportedByEngine(backend.name, "keep_frames", False,
-                                  f"{keep_frames_refused(scene, options)!r} in "
+    needs_frames = keep_frames_refused(scene, options)
+    if needs_frames:
+        raise UnsupportedByEngine(backend.name, "keep_frames", False, f"{needs_frames!r} in "
                                   "measure.statistics needs the stored frames")
     backend.check(scene, options)
     for field_name, value, reason in engine_problems(scene, backend.capabilities):

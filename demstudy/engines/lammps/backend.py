@@ -29,7 +29,7 @@ from ...errors import EngineError
 from ...io.frames import Frame
 from ...scene import Scene
 from ...scene.initial import build_initial_state
-from ..backend import BackendBase, Capabilities, Needs
+from ..backend import BackendBase, Capabilities, Needs, frame_mass
 from .deck import build_deck, check_scene, write_deck
 from .deck.effects import TRANSLATIONS, wall_fix_id, wall_force_sources
 from .deck.output import STRESS_COLUMNS, STRESS_IDS, STRESS_PAIRS, WALL_FORCES, sample_steps
@@ -279,7 +279,7 @@ class LammpsBackend(BackendBase):
             self.session.command(
                 f"write_dump mobile custom {quoted(self.dump)} id type radius x y z vx vy vz "
                 "omegax omegay omegaz modify sort id append yes format float %.17g")
-        mass = (2 * frame.radius) ** frame.dim
+        mass = frame_mass(frame)
         inertia = self.scene.inertia_k * mass * frame.radius**2
         return {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
                 "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
