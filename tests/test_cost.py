@@ -109,3 +109,18 @@ def test_cli_refuses_bad_input_naming_the_option(argv, named, capsys, tmp_path):
     assert code == 2
     assert named in capsys.readouterr().err
     assert not list(tmp_path.glob("*.h5"))  # nothing ran
+
+
+def test_reference_tc_ladder_keeps_the_largest_tc_when_the_tc_model_never_acts(tmp_path):
+    study = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=tmp_path, workers=1,
+                    tc_ladder=True, **{**LADDER, "kstars": [1e2]})
+    refs = [r for r in study.rows if r["engine"] == "edmd"]
+    assert [r["tc"] for r in refs] == pytest.approx([1e-5, 1e-6, 1e-7])
+    elastic = [read_results(r["path"]).attrs["elastic_tc_collisions"] for r in refs]
+    if any(elastic):
+        pytest.skip("the TC model acted in this tiny scene: t_c changes the dynamics")
+    # t_c only matters through TC collisions: without any, the runs are the same trajectory,
+    # agree with the smallest t_c, and the cheapest (largest t_c) is the reference
+    assert [r["steps"] for r in refs] == [refs[0]["steps"]] * 3
+    assert [r["reference"] for r in refs] == [True, False, False]
+    assert study.reference["name"] == "ref-edmd-tc1e-05"

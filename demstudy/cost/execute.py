@@ -62,6 +62,18 @@ def run_task(task: Task) -> dict[str, Any]:
             "wall_seconds": float(res.attrs.get("wall_seconds", float("nan")))}
 
 
+def _start_method() -> str:
+    """fork (cheap: no new interpreter, no imports) while this process is one thread without
+    the LAMMPS runtime loaded, as the command line is; spawn otherwise (a fork must not
+    inherit threads' locks or an initialised MPI)."""
+    import sys
+    import threading
+
+    safe = (sys.platform == "linux" and threading.active_count() == 1
+            and "lammps" not in sys.modules)
+    return "fork" if safe else "spawn"
+
+
 def _worker_start() -> None:
     """Pool worker start: take tqdm's multiprocessing lock now, so that the engine's forked
     child inherits it instead of creating a semaphore of its own that its hard exit would
@@ -102,8 +114,8 @@ def execute(tasks: list[Task], workers: int = 1, dask: Any = None,
                 finished(run_task(task))
             except Exception as exc:  # noqa: BLE001 - reported together below
                 failures.append(f"{task.spec.name}: {exc}")
-    else:  # spawn: workers start clean (no LAMMPS runtime, no threads inherited)
-        context = multiprocessing.get_context("spawn")
+    else:
+        context = multiprocessing.get_context(_start_method())
         with ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                  initializer=_worker_start) as pool:
             futures = {pool.submit(run_task, t): t for t in tasks}

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,6 +52,9 @@ class CostStudy:
     skipped: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     scale_label: str = "$k^*$"
+    #: seconds spent: "runs" (executing, as the workers saw it: task_seconds summed),
+    #: "ladder" (running everything), "analysis" (comparisons, fits, outputs)
+    timings: dict[str, float] = field(default_factory=dict)
 
 
 def _check(name: str, values: Sequence[float], low: float = 0.0) -> list[float]:
@@ -101,25 +105,32 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_
         if todo:
             progress(f"cost: {len(todo)} run(s) to make, {len(done)} reused, "
                      f"{'dask' if dask is not None else f'{min(workers, len(todo))} worker(s)'}")
-        execute(todo, min(workers, len(todo)) if dask is None else workers, dask,
-                lambda r: (study.executed.append(r["name"]),
-                           progress(f"  done {r['name']} ({r['wall_seconds']:.3g} s)")))
+        started = time.perf_counter()
+        records = execute(todo, min(workers, len(todo)) if dask is None else workers, dask,
+                          lambda r: (study.executed.append(r["name"]),
+                                     progress(f"  done {r['name']} ({r['wall_seconds']:.3g} s)")))
+        study.timings["ladder"] = study.timings.get("ladder", 0.0) + time.perf_counter() - started
+        study.timings["runs"] = study.timings.get("runs", 0.0) + sum(
+            r["task_seconds"] for r in records)
 
     from ..engines.edmd.core import DEFAULT_TC
 
     refs = reference_ladder(DEFAULT_TC)
     run_all(refs[:1])
     if tc_ladder or (tc_ladder is None and _tc_active(folder / f"{refs[0].name}.h5")):
-        study.notes.append("the TC model acted in the reference: t_c laddered")
+        study.notes.append("reference t_c laddered (" + (
+            "asked for)" if tc_ladder else "its TC model acted)"))
         run_all(refs[1:])
     else:
         refs = refs[:1]
     softs = soft_ladder(kstars, steps, list(models))
     run_all(softs)
+    started = time.perf_counter()
     _assemble(study, scene, refs, softs)
     from .report import write_outputs
 
     write_outputs(study, figure=figure)
+    study.timings["analysis"] = time.perf_counter() - started
     return study
 
 
