@@ -124,3 +124,16 @@ def test_reference_tc_ladder_keeps_the_largest_tc_when_the_tc_model_never_acts(t
     assert [r["steps"] for r in refs] == [refs[0]["steps"]] * 3
     assert [r["reference"] for r in refs] == [True, False, False]
     assert study.reference["name"] == "ref-edmd-tc1e-05"
+
+
+def test_health_figures_when_present_give_the_contact_time_law():
+    from demstudy.cost.study import _fits
+
+    ratio = np.array([0.3, 0.1, 0.03, 0.01])  # t_c/τ_flight of four soft runs
+    rows = [{"model": "hooke", "steps_per_contact": 50.0, "kstar": 1e2 / r**2,
+             "error": 0.4 * r**1.5, "tc_flight": r} for r in ratio]
+    fits = _fits(rows)
+    assert fits["error(t_c/tau_flight)"].p == pytest.approx(1.5, abs=1e-3)
+    assert fits["error(k*) hooke, 50 steps/contact"].p == pytest.approx(0.75, abs=1e-3)
+    without = _fits([{k: v for k, v in r.items() if k != "tc_flight"} for r in rows])
+    assert "error(t_c/tau_flight)" not in without

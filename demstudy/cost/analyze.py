@@ -5,7 +5,8 @@ Error rule (one number per run): for each profile field f the compare module giv
 relative L2 difference rel_l2_f and the noise floor rel_l2_floor_f (what the statistical
 errors alone produce); the run's error is max_f max(rel_l2_f − rel_l2_floor_f, 0), the worst
 field's difference beyond its noise. A run meets a tolerance X when that error ≤ X; when the
-worst floor itself exceeds X the runs are too short to tell, and the choice says so.
+noise floor of the chosen run (or, with none chosen, of the quietest run) exceeds X, the runs
+are too short to tell, and the recommendation says so.
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 """
 

@@ -27,7 +27,7 @@ DEFAULT_KSTARS = (1e3, 1e4, 1e5, 1e6)
 DEFAULT_STEPS = (10.0, 50.0, 200.0)
 DEFAULT_MODELS = ("hooke", "hertz")
 QUICK = {"kstars": (1e2, 1e3, 1e4), "steps": (10.0,), "models": ("hooke",),
-         "run": {"equilibration": 5.0, "production": 10.0}}
+         "run": {"equilibration": 10.0, "production": 30.0}}
 
 #: the reference's t_c is laddered when more than this fraction of its events were
 #: collisions the TC model made elastic
@@ -157,7 +157,9 @@ def _assemble(study: CostStudy, scene: Scene, refs: list[RunSpec],
                      reference) for s in softs]
     study.rows = ref_rows + rows
     study.choice = analyze.pick_cheapest(rows, study.tolerance)
-    floor = max((r["floor"] for r in rows if math.isfinite(r["floor"])), default=math.nan)
+    # the noise that limits the verdict: the chosen run's, else the quietest run's
+    floor = (study.choice["floor"] if study.choice else
+             min((r["floor"] for r in rows if math.isfinite(r["floor"])), default=math.nan))
     study.recommendation = analyze.recommend(study.choice, reference["wall_seconds"],
                                              study.tolerance, floor)
     study.fits = _fits(rows)
