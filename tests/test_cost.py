@@ -54,6 +54,16 @@ def test_tolerance_picks_the_cheapest_qualifying_run():
         pick_cheapest(rows, 0.0)
 
 
+def test_recommendation_names_the_cheaper_engine_and_the_cost_ratio():
+    from demstudy.cost.analyze import recommend
+
+    soft = {"name": "soft-hooke-k1e+4-s10", "wall_seconds": 2.0, "error": 0.01, "floor": 0.005}
+    assert recommend(soft, 8.0, 0.02, 0.005).startswith("soft contacts")
+    assert "0.25 x" in recommend(soft, 8.0, 0.02, 0.005)
+    assert recommend(soft, 1.0, 0.02, 0.005).startswith("event-driven")
+    assert "caution" in recommend(None, 1.0, 0.02, 0.05)
+
+
 def test_pareto_front_keeps_the_non_dominated_runs():
     points = [(1.0, 0.5), (2.0, 0.6), (3.0, 0.1), (4.0, 0.1), (5.0, 0.01)]
     assert pareto_front(points) == [(1.0, 0.5), (3.0, 0.1), (5.0, 0.01)]
@@ -82,6 +92,32 @@ def test_ladder_resumes_and_skips_what_was_done(tmp_path):
     longer = ds.cost("shear/lees-edwards-2d", overrides=[*TINY, "run.production=2.5"],
                      out=out, workers=1, **{**LADDER, "kstars": [1e2]})
     assert set(longer.executed) == {"ref-edmd-tc1e-05", "soft-hooke-k100-s10"}
+
+
+def test_a_ladder_killed_after_its_first_runs_resumes_with_the_rest(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "ladder"
+    argv = [sys.executable, "-m", "demstudy.cli", "cost", "shear/lees-edwards-2d", "--out",
+            str(out), "--kstar", "1e2,1e3", "--steps", "10", "--models", "hooke",
+            "--workers", "1", *[a for kv in TINY for a in ("--set", kv)]]
+    proc = subprocess.Popen(argv, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    first = out / "ref-edmd-tc1e-05.h5"
+    deadline = time.monotonic() + 120
+    while not first.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGKILL)  # the whole ladder, engine children included
+    proc.wait()
+    assert first.exists()
+    done = {p.stem for p in out.glob("*.h5")}  # whole files only (atomic writes)
+    study = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=1, **LADDER)
+    names = {"ref-edmd-tc1e-05", "soft-hooke-k100-s10", "soft-hooke-k1e+3-s10"}
+    assert set(study.skipped) == done and set(study.executed) == names - done
 
 
 def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
