@@ -30,7 +30,7 @@ UNITS_NOTE = (
     "(otherwise the wall speed or shear rate sets the time scale)"
 )
 
-__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "load", "load_scene",
+__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "cost", "load", "load_scene",
            "open_lammps", "run"]
 
 #: public names loaded on first use (``import demstudy`` stays cheap)
@@ -39,6 +39,7 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "Scene": "demstudy.scene",
     "run": "demstudy.api",
     "load": "demstudy.api",
+    "cost": "demstudy.cost",  # the package, callable as ds.cost(...) (its __init__)
     "Results": "demstudy.io.results",
     "open_lammps": "demstudy.engines.lammps.library",
     "testing": "demstudy.testing",

@@ -1,4 +1,4 @@
-"""Command line: ``demstudy validate | deck | run | plot | calibrate``.
+"""Command line: ``demstudy validate | deck | run | plot | analyze | calibrate | cost``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
@@ -138,6 +138,29 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _numbers(option: str, text: str) -> list[float]:
+    from .errors import BadOption
+
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise BadOption(option, text, "comma-separated numbers, e.g. 1e3,1e4") from None
+
+
+def _cmd_cost(args: argparse.Namespace) -> int:
+    from .cost.report import text_report
+    from .cost.study import DEFAULT_KSTARS, DEFAULT_MODELS, DEFAULT_STEPS, cost
+
+    study = cost(args.scene, overrides=args.set, quick=args.quick, tolerance=args.tolerance,
+                 kstars=_numbers("--kstar", args.kstar) if args.kstar else DEFAULT_KSTARS,
+                 steps=_numbers("--steps", args.steps) if args.steps else DEFAULT_STEPS,
+                 models=([m.strip() for m in args.models.split(",") if m.strip()]
+                         if args.models else DEFAULT_MODELS),
+                 workers=args.workers, dask=args.dask, out=args.out)
+    print(text_report(study))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .analysis.registry import STATISTICS
     from .engines import DEFAULT_ENGINE, backend_names, get_backend
@@ -240,11 +263,32 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0, 2.0])
     p.add_argument("--angles", type=float, nargs="+", default=[0.0, 30.0, 60.0])
     p.set_defaults(func=_cmd_calibrate)
+
+    p = sub.add_parser("cost", parents=[overrides],
+                       help="accuracy vs cost: soft runs over stiffness and steps per contact "
+                            "against the event-driven reference (docs/cost.md)")
+    p.add_argument("scene", help=scene_help)
+    p.add_argument("--kstar", metavar="K1,K2,...",
+                   help="dimensionless stiffnesses k* (default 1e3,1e4,1e5,1e6; the scene's "
+                        "k* definition is printed)")
+    p.add_argument("--steps", metavar="S1,S2,...",
+                   help="steps per contact, each >= 10 (default 10,50,200)")
+    p.add_argument("--models", metavar="hooke,hertz", help="contact models (default both)")
+    p.add_argument("--tolerance", type=float, default=0.02,
+                   help="relative profile error to meet (default 0.02)")
+    p.add_argument("--workers", type=int, help="local processes (default: the cores)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead")
+    p.add_argument("--out", help="ladder folder (default results/cost/<scene>/)")
+    p.add_argument("--quick", action="store_true",
+                   help="a tiny ladder of short runs (k* 1e2,1e3,1e4, 10 steps/contact, "
+                        "hooke)")
+    p.set_defaults(func=_cmd_cost)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     from .errors import (
+        BadOption,
         EngineError,
         RunRefused,
         RunStopped,
@@ -262,7 +306,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         if isinstance(exc, RunStopped):
             return 3  # checkpoint written: run again with --resume
-        refused = SceneError | UnsupportedByEngine | RunRefused | StatisticUnavailable
+        refused = (SceneError | UnsupportedByEngine | RunRefused | StatisticUnavailable
+                   | BadOption)
         return 2 if isinstance(exc, refused) else 1  # 2: nothing ran or was computed
     except KeyboardInterrupt:  # outside a run loop (which checkpoints and stops by itself)
         print("error: interrupted", file=sys.stderr)

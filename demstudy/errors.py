@@ -33,9 +33,19 @@ class StatisticUnavailable(ValueError):
     wrong dimension): nothing was computed (exit 2 on the command line)."""
 
 
+class BadOption(ValueError):
+    """A command-line option or keyword argument has a value that is not allowed: its
+    ``option`` name, the ``value`` and what is allowed are attributes and in the message
+    (exit 2: nothing ran)."""
+
+    def __init__(self, option: str, value: object, allowed: str):
+        self.option, self.value = option, value
+        super().__init__(f"{option} = {value!r}: {allowed}")
+
+
 class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["EngineError", "RunRefused", "RunStopped", "StatisticUnavailable",
+__all__ = ["BadOption", "EngineError", "RunRefused", "RunStopped", "StatisticUnavailable",
            "UnsupportedByEngine"]

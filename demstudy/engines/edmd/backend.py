@@ -262,5 +262,6 @@ class EdmdBackend(BackendBase):
         if servo is not None and servo.scale_width:
             notes.append("servo width scaling: x positions are rescaled affinely at each "
                          "servo update")
-        return {"tc": self.tc, "events": core.events, "cell_crossings": core.cell_crossings,
+        return {"tc": self.tc, "elastic_tc_collisions": core.elastic_tc_collisions,
+                "events": core.events, "cell_crossings": core.cell_crossings,
                 "wall_collisions": core.wall_collisions, "approximations": "\n".join(notes)}

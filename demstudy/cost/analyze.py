@@ -1,0 +1,117 @@
+"""Errors of the soft runs against the reference, the convergence law, the choice at a
+tolerance and the engine recommendation.
+
+Error rule (one number per run): for each profile field f the compare module gives the
+relative L2 difference rel_l2_f and the noise floor rel_l2_floor_f (what the statistical
+errors alone produce); the run's error is max_f max(rel_l2_f − rel_l2_floor_f, 0), the worst
+field's difference beyond its noise. A run meets a tolerance X when that error ≤ X; when the
+noise floor of the chosen run (or, with none chosen, of the quietest run) exceeds X, the runs
+are too short to tell, and the recommendation says so.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class RunError:
+    error: float        # worst field's rel_l2 beyond its noise floor
+    field: str          # that field
+    rel_l2: float       # its rel_l2
+    floor: float        # the largest noise floor of all fields
+    resolved: list[str]  # fields whose difference is resolved (max |Δ|/σ > sigma)
+
+
+def run_error(comparison) -> RunError:
+    """The error rule of the module doc, from one ``Comparison``."""
+    worst, name, raw = -1.0, "—", math.nan
+    for field, fc in comparison.fields.items():
+        excess = max(fc.rel_l2 - fc.rel_l2_floor, 0.0)
+        if excess > worst:
+            worst, name, raw = excess, field, fc.rel_l2
+    floor = max((fc.rel_l2_floor for fc in comparison.fields.values()), default=math.nan)
+    resolved = [f for f, fc in comparison.fields.items() if fc.resolved]
+    return RunError(worst if worst >= 0 else math.nan, name, raw, floor, resolved)
+
+
+@dataclass(frozen=True)
+class ConvergenceFit:
+    """error = a x^(−p) + floor, with one-sigma errors (``floor`` fixed at 0 with < 4
+    points: three parameters need a residual to have errors)."""
+
+    a: float
+    p: float
+    floor: float
+    a_err: float
+    p_err: float
+    floor_err: float
+    n: int
+
+    def law(self, variable: str = "k*") -> str:
+        floor = f" + {self.floor:.2g} ± {self.floor_err:.1g}" if self.n >= 4 else ""
+        return (f"error = {self.a:.3g} {variable}^-({self.p:.3g} ± {self.p_err:.2g})"
+                f"{floor} ({self.n} runs)")
+
+
+def fit_convergence(x, error, rel_sigma: float = 0.1) -> ConvergenceFit:
+    """Fit error = a x^(−p) + floor (scipy ``curve_fit``) with relative weights (each point
+    ``rel_sigma`` of its own value, so that every decade counts alike); parameter errors from
+    the covariance scaled by the residuals. Needs ≥ 3 positive-x points."""
+    from scipy.optimize import curve_fit
+
+    x, y = np.asarray(x, float), np.asarray(error, float)
+    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    x, y = x[ok], y[ok]
+    if x.size < 3:
+        raise ValueError(f"the convergence fit needs at least 3 runs with an error > 0, "
+                         f"got {x.size}")
+    scale = float(np.exp(np.mean(np.log(x))))  # fit in x/scale: a of order y
+    sigma = rel_sigma * y
+    p0_slope = -np.polyfit(np.log(x), np.log(y), 1)[0]
+    p0 = [float(np.max(y)) * (x.min() / scale) ** p0_slope, max(p0_slope, 0.1)]
+    if x.size >= 4:
+        def model(xs, a, p, floor):
+            return a * (xs / scale) ** (-p) + floor
+        popt, pcov = curve_fit(model, x, y, p0=[*p0, float(y.min()) / 2], sigma=sigma,
+                               bounds=([0, 0, 0], [np.inf, 20, np.inf]), maxfev=20000)
+    else:
+        def model(xs, a, p):
+            return a * (xs / scale) ** (-p)
+        popt, pcov = curve_fit(model, x, y, p0=p0, sigma=sigma, maxfev=20000)
+        popt, pcov = np.append(popt, 0.0), np.pad(pcov, ((0, 1), (0, 1)))
+    errs = np.sqrt(np.clip(np.diag(pcov), 0, None))
+    a, p, floor = popt
+    # a refers to x/scale: a' = a scale^p, its error by the same factor (p's share ignored)
+    return ConvergenceFit(float(a * scale**p), float(p), float(floor),
+                          float(errs[0] * scale**p), float(errs[1]), float(errs[2]),
+                          int(x.size))
+
+
+def pick_cheapest(rows: list[dict], tolerance: float) -> dict | None:
+    """The cheapest row (``wall_seconds``) whose ``error`` ≤ ``tolerance`` (module doc);
+    None when none does."""
+    if not tolerance > 0:
+        raise ValueError(f"tolerance must be > 0, not {tolerance}")
+    meeting = [r for r in rows if np.isfinite(r.get("error", np.nan))
+               and r["error"] <= tolerance]
+    return min(meeting, key=lambda r: r["wall_seconds"], default=None)
+
+
+def recommend(choice: dict | None, reference_seconds: float, tolerance: float,
+              worst_floor: float) -> str:
+    """The engine to use at ``tolerance`` for this scene, with the soft/hard cost ratio."""
+    caveat = (f" (caution: the noise floor {worst_floor:.2g} exceeds the tolerance; "
+              "longer runs are needed to confirm)" if worst_floor > tolerance else "")
+    if choice is None:
+        return (f"event-driven (edmd): no soft run met the tolerance {tolerance:g}; the "
+                f"reference took {reference_seconds:.3g} s{caveat}")
+    ratio = choice["wall_seconds"] / reference_seconds
+    engine = "soft contacts (lammps)" if ratio < 1 else "event-driven (edmd)"
+    return (f"{engine} at tolerance {tolerance:g}: cheapest soft run {choice['name']} "
+            f"({choice['wall_seconds']:.3g} s, error {choice['error']:.3g}) costs "
+            f"{ratio:.3g} x the event-driven reference ({reference_seconds:.3g} s){caveat}")

@@ -1,0 +1,161 @@
+"""Running the ladder: one ``ds.run`` per task into its own results file, in a local process
+pool or on a Dask cluster, skipping every task whose file is already there and whole.
+
+Resumability rests on the results files alone: ``write_results`` writes atomically (a file is
+whole or absent), and a file counts as done only if ``read_results`` reads it and its
+``scene_toml`` is the scene this task would run (a file from other settings is redone).
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .plan import RunSpec, scene_for, scene_key
+
+
+@dataclass(frozen=True)
+class Task:
+    """A run to make: its settings, the ladder's base scene (as TOML, so that it travels to
+    any worker) and the results file."""
+
+    spec: RunSpec
+    scene_toml: str
+    path: Path
+
+    def scene(self):
+        from ..scene import parse_scene_text, validate_scene
+
+        base = validate_scene(parse_scene_text(self.scene_toml, str(self.path)), str(self.path))
+        return scene_for(base, self.spec)
+
+
+def is_done(path: Path, expected_scene_toml: str) -> bool:
+    """Whether ``path`` holds the finished run of that scene (readable, same scene)."""
+    from ..io.results import read_results
+
+    if not path.is_file():
+        return False
+    try:
+        attrs = read_results(path, skip=("frames", "collisions")).attrs
+    except Exception:  # noqa: BLE001 - any unreadable file (truncated, not HDF5) is redone
+        return False
+    return attrs.get("scene_toml") == expected_scene_toml and "wall_seconds" in attrs
+
+
+def run_task(task: Task) -> dict[str, Any]:
+    """Make one run (in a pool worker or a Dask worker); the engine runs in a child process
+    (``isolate``) on one rank. Returns what the ladder records of the execution."""
+    from ..api import run
+
+    started = time.perf_counter()
+    res = run(task.scene(), engine=task.spec.engine, out=task.path, isolate=True, np=1,
+              progress=False, **task.spec.options())
+    return {"name": task.spec.name, "path": str(res.path),
+            "task_seconds": time.perf_counter() - started,
+            "wall_seconds": float(res.attrs.get("wall_seconds", float("nan")))}
+
+
+def _start_method() -> str:
+    """fork (cheap: no new interpreter, no imports) while this process is one thread without
+    the LAMMPS runtime loaded, as the command line is; spawn otherwise (a fork must not
+    inherit threads' locks or an initialised MPI)."""
+    import sys
+    import threading
+
+    safe = (sys.platform == "linux" and threading.active_count() == 1
+            and "lammps" not in sys.modules)
+    return "fork" if safe else "spawn"
+
+
+def _worker_start() -> None:
+    """Pool worker start: take tqdm's multiprocessing lock now, so that the engine's forked
+    child inherits it instead of creating a semaphore of its own that its hard exit would
+    leave registered (a 'leaked semaphore' warning at shutdown)."""
+    from tqdm import tqdm
+
+    tqdm.get_lock()
+
+
+def pending(tasks: Iterable[Task]) -> tuple[list[Task], list[Task]]:
+    """(to run, already done)."""
+    todo, done = [], []
+    for task in tasks:
+        (done if is_done(task.path, scene_key(task.scene())) else todo).append(task)
+    return todo, done
+
+
+def execute(tasks: list[Task], workers: int = 1, dask: Any = None,
+            on_done: Callable[[dict], None] | None = None) -> list[dict]:
+    """Run ``tasks`` (all of them: filter with :func:`pending` first) and return their
+    records in completion order. ``dask``: a scheduler address or a ``distributed.Client``;
+    else ``workers`` local processes (1: in this process, one after the other). A failed
+    run raises after the others finished (their files are kept for the rerun)."""
+    if not tasks:
+        return []
+    if dask is not None:
+        return _on_dask(tasks, dask, on_done)
+    records, failures = [], []
+
+    def finished(record: dict) -> None:
+        records.append(record)
+        if on_done is not None:
+            on_done(record)
+
+    if workers <= 1:
+        for task in tasks:
+            try:
+                finished(run_task(task))
+            except Exception as exc:  # noqa: BLE001 - reported together below
+                failures.append(f"{task.spec.name}: {exc}")
+    else:
+        context = multiprocessing.get_context(_start_method())
+        with ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                 initializer=_worker_start) as pool:
+            futures = {pool.submit(run_task, t): t for t in tasks}
+            for future in as_completed(futures):
+                try:
+                    finished(future.result())
+                except Exception as exc:  # noqa: BLE001
+                    failures.append(f"{futures[future].spec.name}: {exc}")
+    _raise_failures(failures)
+    return records
+
+
+def _on_dask(tasks: list[Task], dask: Any, on_done) -> list[dict]:
+    from distributed import Client
+    from distributed import as_completed as dask_completed
+
+    client = dask if isinstance(dask, Client) else Client(dask)
+    try:
+        futures = {client.submit(run_task, t, pure=False, key=f"demstudy-cost-{t.spec.name}-"
+                                 f"{time.time_ns()}"): t for t in tasks}
+        records, failures = [], []
+        for future in dask_completed(list(futures)):
+            try:
+                record = future.result()
+            except Exception as exc:  # noqa: BLE001
+                failures.append(f"{futures[future].spec.name}: {exc}")
+                continue
+            records.append(record)
+            if on_done is not None:
+                on_done(record)
+    finally:
+        if client is not dask:
+            client.close()
+    _raise_failures(failures)
+    return records
+
+
+def _raise_failures(failures: list[str]) -> None:
+    if failures:
+        from ..errors import EngineError
+
+        raise EngineError("cost ladder: runs failed (finished ones are kept; rerun to "
+                          "resume):\n  " + "\n  ".join(failures))

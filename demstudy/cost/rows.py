@@ -1,0 +1,76 @@
+"""One table row per run of the ladder, read from its results file: cost (wall time, steps),
+health figures of soft runs (when the results carry a ``health`` group) and the error against
+the reference (``analyze.run_error``). Dimensionless particle units: d = 1, m = 1, g = 1 when
+gravity acts."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from ..io.results import Results, read_results
+from . import analyze
+from .plan import RunSpec
+
+NAN = math.nan
+HEALTH = ("max_overlap", "tc_flight", "tc_shear", "healthy")
+
+
+def _read(path: Path) -> Results:
+    return read_results(path, skip=("frames", "collisions"))
+
+
+def _base(spec: RunSpec, res: Results) -> dict:
+    attrs = res.attrs
+    time = res.timeseries.get("time")
+    duration = float(time[-1]) if time is not None and len(time) else NAN
+    dt = float(attrs.get("timestep", NAN))
+    steps = (round(duration / dt) if spec.soft and math.isfinite(dt) and dt > 0
+             else int(attrs.get("events", 0)))  # soft: time steps; edmd: events
+    health = res.group_attrs.get("health", {})
+    return {"name": spec.name, "engine": spec.engine, "model": spec.model or "—",
+            "kstar": spec.kstar if spec.soft else NAN, "kn": NAN,
+            "steps_per_contact": spec.steps if spec.soft else NAN,
+            "tc": spec.tc if spec.tc is not None else NAN, "dt": dt, "steps": steps,
+            "wall_seconds": float(attrs.get("wall_seconds", NAN)), "error": NAN,
+            "field": "—", "rel_l2": NAN, "floor": NAN, "resolved": "",
+            **{k: health.get(k, NAN) for k in HEALTH}, "path": str(res.path)}
+
+
+def _error_columns(row: dict, reference: Results, res: Results) -> dict:
+    from ..compare import compare
+
+    err = analyze.run_error(compare(reference, res)[0])
+    row.update(error=err.error, field=err.field, rel_l2=err.rel_l2, floor=err.floor,
+               resolved=",".join(err.resolved))
+    return row
+
+
+def soft_row(folder: Path, spec: RunSpec, scene, kn: float, reference: dict) -> dict:
+    """The row of a soft run, its error against ``reference`` (the reference's row)."""
+    res = _read(folder / f"{spec.name}.h5")
+    row = _base(spec, res)
+    row["kn"] = kn
+    return _error_columns(row, reference["results"], res)
+
+
+def choose_reference(folder: Path, refs: list[RunSpec], notes: list[str]
+                     ) -> tuple[dict, list[dict]]:
+    """The converged reference among the t_c ladder ``refs`` (largest t_c first): the
+    largest t_c whose profiles agree with the smallest t_c's (no field resolved), else the
+    smallest. Returns (its row with its ``results``, the rows of every reference run)."""
+    runs = [(spec, _read(folder / f"{spec.name}.h5")) for spec in refs]
+    rows = [_base(spec, res) for spec, res in runs]
+    chosen = len(runs) - 1
+    if len(runs) > 1:
+        finest = runs[-1][1]
+        for i, (_, res) in enumerate(runs[:-1]):
+            _error_columns(rows[i], finest, res)
+        agree = [i for i, row in enumerate(rows[:-1]) if not row["resolved"]]
+        chosen = agree[0] if agree else chosen
+        notes.append(f"reference: t_c = {refs[chosen].tc:g} "
+                     + ("(agrees with the smallest t_c)" if agree else
+                        "(the smallest t_c: the larger ones differ resolvably)"))
+    for i, row in enumerate(rows):
+        row["reference"] = i == chosen
+    return {**rows[chosen], "results": runs[chosen][1]}, rows

@@ -1,0 +1,189 @@
+"""``cost(scene, ...)``: the whole accuracy-versus-cost study of one scene (docs/cost.md).
+
+The event-driven reference runs first (with a t_c ladder when its TC model acted), then the
+soft ladder; every run is one results file in the ladder folder, reused on a rerun.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise the shear rate
+or wall speed sets the time unit).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import BadOption
+from ..scene import Scene, load_scene, scene_to_toml
+from . import analyze
+from .execute import Task, execute, pending
+from .plan import RunSpec, reference_ladder, scene_for, soft_kn, soft_ladder, stiffness_scale
+
+DEFAULT_KSTARS = (1e3, 1e4, 1e5, 1e6)
+DEFAULT_STEPS = (10.0, 50.0, 200.0)
+DEFAULT_MODELS = ("hooke", "hertz")
+QUICK = {"kstars": (1e2, 1e3, 1e4), "steps": (10.0,), "models": ("hooke",),
+         "run": {"equilibration": 10.0, "production": 30.0}}
+
+#: the reference's t_c is laddered when more than this fraction of its events were
+#: collisions the TC model made elastic
+TC_ACTIVE_FRACTION = 1e-4
+
+
+@dataclass
+class CostStudy:
+    """What ``cost`` found: ``rows`` (one per run, reference first), the chosen reference,
+    the fits, the choice at the tolerance, the recommendation, and which runs were made now
+    (``executed``) or reused (``skipped``)."""
+
+    folder: Path
+    scale: str
+    rows: list[dict]
+    reference: dict
+    tolerance: float
+    choice: dict | None
+    recommendation: str
+    fits: dict[str, Any] = field(default_factory=dict)
+    executed: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    scale_label: str = "$k^*$"
+    #: seconds spent: "runs" (executing, as the workers saw it: task_seconds summed),
+    #: "ladder" (running everything), "analysis" (comparisons, fits, outputs)
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def _check(name: str, values: Sequence[float], low: float = 0.0) -> list[float]:
+    values = [float(v) for v in values]
+    bad = [v for v in values if not (math.isfinite(v) and v > low)]
+    if not values or bad:
+        raise BadOption(name, bad or values, f"positive numbers (> {low:g}) are allowed")
+    return values
+
+
+def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_KSTARS,
+         steps: Sequence[float] = DEFAULT_STEPS, models: Sequence[str] = DEFAULT_MODELS,
+         tolerance: float = 0.02, workers: int | None = None, dask: Any = None,
+         out: str | os.PathLike | None = None, overrides: Sequence[str] = (),
+         quick: bool = False, tc_ladder: bool | None = None, figure: bool = True,
+         progress=print) -> CostStudy:
+    """Run (or resume) the cost ladder of ``scene`` and write its table, summary and figure
+    into ``out`` (default ``results/cost/<scene name>/``). ``kstars``: dimensionless
+    stiffnesses (``plan.stiffness_scale``), ``steps``: steps per contact (≥ 10), ``models``:
+    hooke and/or hertz; ``workers`` local processes (default: the machine's cores) or
+    ``dask`` (a scheduler address or a ``distributed.Client``). ``quick``: a tiny ladder of
+    short runs. ``tc_ladder``: force (True) or forbid (False) the reference's t_c ladder
+    (default: when its TC model acted). ``progress``: called with one line per event."""
+    if quick:
+        kstars, steps, models = QUICK["kstars"], QUICK["steps"], QUICK["models"]
+    kstars, steps = _check("--kstar", kstars), _check("--steps", steps, 9.999)
+    if not tolerance > 0:
+        raise BadOption("--tolerance", tolerance, "a relative error > 0 is allowed")
+    bad = [m for m in models if m not in ("hooke", "hertz")]
+    if bad or not models:
+        raise BadOption("--models", bad or list(models), "hooke and/or hertz are allowed")
+    if not isinstance(scene, Scene):
+        sections = {"run": QUICK["run"]} if quick else {}
+        scene = load_scene(scene, overrides, **sections)
+    elif quick:
+        scene = scene.model_copy(update={"run": scene.run.model_copy(update=QUICK["run"])})
+    folder = Path(out or Path("results") / "cost" / scene.meta.name)
+    folder.mkdir(parents=True, exist_ok=True)
+    base = scene_to_toml(scene)
+    workers = workers or os.cpu_count() or 1
+    scale = stiffness_scale(scene)
+    study = CostStudy(folder, scale.definition, [], {}, tolerance, None, "",
+                      scale_label=scale.label)
+
+    def run_all(specs: list[RunSpec]) -> None:
+        todo, done = pending(Task(s, base, folder / f"{s.name}.h5") for s in specs)
+        study.skipped += [t.spec.name for t in done]
+        if todo:
+            progress(f"cost: {len(todo)} run(s) to make, {len(done)} reused, "
+                     f"{'dask' if dask is not None else f'{min(workers, len(todo))} worker(s)'}")
+        started = time.perf_counter()
+        records = execute(todo, min(workers, len(todo)) if dask is None else workers, dask,
+                          lambda r: (study.executed.append(r["name"]),
+                                     progress(f"  done {r['name']} ({r['wall_seconds']:.3g} s)")))
+        study.timings["ladder"] = study.timings.get("ladder", 0.0) + time.perf_counter() - started
+        study.timings["runs"] = study.timings.get("runs", 0.0) + sum(
+            r["task_seconds"] for r in records)
+
+    from ..engines.edmd.core import DEFAULT_TC
+
+    refs = reference_ladder(DEFAULT_TC)
+    run_all(refs[:1])
+    if tc_ladder or (tc_ladder is None and _tc_active(folder / f"{refs[0].name}.h5")):
+        study.notes.append("reference t_c laddered (" + (
+            "asked for)" if tc_ladder else "its TC model acted)"))
+        run_all(refs[1:])
+    else:
+        refs = refs[:1]
+    softs = soft_ladder(kstars, steps, list(models))
+    run_all(softs)
+    started = time.perf_counter()
+    _assemble(study, scene, refs, softs)
+    from .report import write_outputs
+
+    write_outputs(study, figure=figure)
+    study.timings["analysis"] = time.perf_counter() - started
+    return study
+
+
+def _tc_active(path: Path) -> bool:
+    """Whether more than TC_ACTIVE_FRACTION of the reference's events were collisions its TC
+    model made elastic (attribute ``elastic_tc_collisions``, else its approximations note)."""
+    from ..io.results import read_results
+
+    attrs = read_results(path, skip=("frames", "collisions")).attrs
+    count = attrs.get("elastic_tc_collisions")
+    if count is None:
+        found = re.search(r"(\d+) such collisions", str(attrs.get("approximations", "")))
+        count = int(found.group(1)) if found else 0
+    return count > TC_ACTIVE_FRACTION * max(int(attrs.get("events", 0)), 1)
+
+
+def _assemble(study: CostStudy, scene: Scene, refs: list[RunSpec],
+              softs: list[RunSpec]) -> None:
+    from .rows import choose_reference, soft_row
+
+    reference, ref_rows = choose_reference(study.folder, refs, study.notes)
+    study.reference = reference
+    rows = [soft_row(study.folder, s, scene_for(scene, s), soft_kn(scene, s.model, s.kstar),
+                     reference) for s in softs]
+    study.rows = ref_rows + rows
+    study.choice = analyze.pick_cheapest(rows, study.tolerance)
+    # the noise that limits the verdict: the chosen run's, else the quietest run's
+    floor = (study.choice["floor"] if study.choice else
+             min((r["floor"] for r in rows if math.isfinite(r["floor"])), default=math.nan))
+    study.recommendation = analyze.recommend(study.choice, reference["wall_seconds"],
+                                             study.tolerance, floor)
+    study.fits = _fits(rows)
+
+
+def _fits(rows: list[dict]) -> dict[str, Any]:
+    """error(k*) per model at its largest steps per contact, and error(t_c/τ_flight) over
+    every run with health figures: fitted where enough runs have an error > 0."""
+    fits: dict[str, Any] = {}
+    for model in sorted({r["model"] for r in rows}):
+        mine = [r for r in rows if r["model"] == model]
+        top = max(r["steps_per_contact"] for r in mine)
+        mine = [r for r in mine if r["steps_per_contact"] == top]
+        key = f"error(k*) {model}, {top:g} steps/contact"
+        try:
+            fits[key] = analyze.fit_convergence([r["kstar"] for r in mine],
+                                                [r["error"] for r in mine])
+        except (ValueError, RuntimeError) as exc:
+            fits[key] = f"not fitted: {exc}"
+    flight = [r for r in rows if math.isfinite(r.get("tc_flight", math.nan))]
+    if flight:
+        try:  # error = a (t_c/τ)^p + floor: fitted as a function of τ/t_c
+            fits["error(t_c/tau_flight)"] = analyze.fit_convergence(
+                [1 / r["tc_flight"] for r in flight], [r["error"] for r in flight])
+        except (ValueError, RuntimeError) as exc:
+            fits["error(t_c/tau_flight)"] = f"not fitted: {exc}"
+    return fits

@@ -1,0 +1,175 @@
+"""The cost ladder (demstudy.cost): convergence fit, the choice at a tolerance, resuming,
+the Dask path, and the command line's refusals. Tiny 2D Lees–Edwards runs (≈ 75 discs, a
+few strain units): dimensionless particle units, d = 1, m = 1, γ̇ = 1."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import demstudy as ds
+from demstudy.cli import main
+from demstudy.cost.analyze import fit_convergence, pick_cheapest
+from demstudy.cost.figure import pareto_front
+from demstudy.io.results import read_results
+
+TINY = ["box.size=[10.0, 10.0]", "run.equilibration=1.0", "run.production=2.0",
+        "run.sample_interval=0.5"]
+LADDER = {"kstars": [1e2, 1e3], "steps": [10], "models": ["hooke"], "figure": False,
+          "progress": lambda line: None}
+
+
+def test_fit_recovers_a_synthetic_power_law():
+    rng = np.random.default_rng(7)
+    k = np.logspace(2, 7, 11)
+    exact = 3.0 * k**-0.7 + 2e-4
+    noisy = exact * (1 + 0.05 * rng.standard_normal(k.size))
+    fit = fit_convergence(k, noisy)
+    assert abs(fit.p - 0.7) < 3 * fit.p_err  # within its (three-sigma) error
+    assert fit.p_err < 0.2  # and the error is informative
+    assert abs(fit.floor - 2e-4) < 3 * fit.floor_err + 1e-5
+
+
+def test_fit_without_floor_is_exact_on_an_exact_law():
+    k = np.array([1e3, 1e4, 1e5])
+    fit = fit_convergence(k, 0.5 * k**-1.0)
+    assert fit.p == pytest.approx(1.0, rel=1e-6) and fit.a == pytest.approx(0.5, rel=1e-5)
+    with pytest.raises(ValueError, match="at least 3"):
+        fit_convergence([1e3, 1e4], [0.1, 0.01])
+
+
+def test_tolerance_picks_the_cheapest_qualifying_run():
+    rows = [{"name": "a", "error": 0.05, "wall_seconds": 1.0},   # too inaccurate
+            {"name": "b", "error": 0.015, "wall_seconds": 9.0},
+            {"name": "c", "error": 0.019, "wall_seconds": 4.0},  # cheapest meeting 0.02
+            {"name": "d", "error": 0.0, "wall_seconds": 30.0},
+            {"name": "e", "error": math.nan, "wall_seconds": 0.1}]  # no error: never chosen
+    assert pick_cheapest(rows, 0.02)["name"] == "c"
+    assert pick_cheapest(rows, 0.01)["name"] == "d"
+    assert pick_cheapest(rows[:1], 0.02) is None
+    with pytest.raises(ValueError, match="tolerance"):
+        pick_cheapest(rows, 0.0)
+
+
+def test_recommendation_names_the_cheaper_engine_and_the_cost_ratio():
+    from demstudy.cost.analyze import recommend
+
+    soft = {"name": "soft-hooke-k1e+4-s10", "wall_seconds": 2.0, "error": 0.01, "floor": 0.005}
+    assert recommend(soft, 8.0, 0.02, 0.005).startswith("soft contacts")
+    assert "0.25 x" in recommend(soft, 8.0, 0.02, 0.005)
+    assert recommend(soft, 1.0, 0.02, 0.005).startswith("event-driven")
+    assert "caution" in recommend(None, 1.0, 0.02, 0.05)
+
+
+def test_pareto_front_keeps_the_non_dominated_runs():
+    points = [(1.0, 0.5), (2.0, 0.6), (3.0, 0.1), (4.0, 0.1), (5.0, 0.01)]
+    assert pareto_front(points) == [(1.0, 0.5), (3.0, 0.1), (5.0, 0.01)]
+
+
+def test_ladder_resumes_and_skips_what_was_done(tmp_path):
+    out = tmp_path / "ladder"
+    first = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=1, **LADDER)
+    names = {"ref-edmd-tc1e-05", "soft-hooke-k100-s10", "soft-hooke-k1e+3-s10"}
+    assert set(first.executed) == names and not first.skipped
+    for name in names:  # each run's file is whole and holds its settings
+        assert read_results(out / f"{name}.h5").attrs["wall_seconds"] > 0
+    soft = {r["name"]: r for r in first.rows if r["engine"] == "lammps"}
+    assert soft["soft-hooke-k100-s10"]["kn"] < soft["soft-hooke-k1e+3-s10"]["kn"]
+    summary = json.loads((out / "ladder.json").read_text())
+    assert "d = 1" in summary["units"] and len(summary["runs"]) == 3
+    # a run killed mid-write leaves no file (atomic writes); a corrupted one is redone too
+    (out / "soft-hooke-k100-s10.h5").unlink()
+    (out / "soft-hooke-k1e+3-s10.h5").write_bytes(b"half a file")
+    second = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=2, **LADDER)
+    assert set(second.executed) == {"soft-hooke-k100-s10", "soft-hooke-k1e+3-s10"}
+    assert second.skipped == ["ref-edmd-tc1e-05"]
+    third = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=2, **LADDER)
+    assert third.executed == [] and set(third.skipped) == names
+    # other settings of the scene (a longer run) are not mistaken for done ones
+    longer = ds.cost("shear/lees-edwards-2d", overrides=[*TINY, "run.production=2.5"],
+                     out=out, workers=1, **{**LADDER, "kstars": [1e2]})
+    assert set(longer.executed) == {"ref-edmd-tc1e-05", "soft-hooke-k100-s10"}
+
+
+def test_a_ladder_killed_after_its_first_runs_resumes_with_the_rest(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "ladder"
+    argv = [sys.executable, "-m", "demstudy.cli", "cost", "shear/lees-edwards-2d", "--out",
+            str(out), "--kstar", "1e2,1e3", "--steps", "10", "--models", "hooke",
+            "--workers", "1", *[a for kv in TINY for a in ("--set", kv)]]
+    proc = subprocess.Popen(argv, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    first = out / "ref-edmd-tc1e-05.h5"
+    deadline = time.monotonic() + 120
+    while not first.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGKILL)  # the whole ladder, engine children included
+    proc.wait()
+    assert first.exists()
+    done = {p.stem for p in out.glob("*.h5")}  # whole files only (atomic writes)
+    study = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=1, **LADDER)
+    names = {"ref-edmd-tc1e-05", "soft-hooke-k100-s10", "soft-hooke-k1e+3-s10"}
+    assert set(study.skipped) == done and set(study.executed) == names - done
+
+
+def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        study = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=tmp_path, dask=client,
+                        **{**LADDER, "kstars": [1e2]})
+    assert set(study.executed) == {"ref-edmd-tc1e-05", "soft-hooke-k100-s10"}
+    row = next(r for r in study.rows if r["engine"] == "lammps")
+    assert row["wall_seconds"] > 0 and row["steps"] > 0 and math.isfinite(row["floor"])
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["--set", "soft.stiffnes=3"], "stiffnes"),
+    (["--kstar", "1e3,-1e4"], "--kstar"),
+    (["--kstar", "1e3,abc"], "--kstar"),
+    (["--steps", "5"], "--steps"),
+    (["--tolerance", "0"], "--tolerance"),
+    (["--models", "hooke,jkr"], "--models"),
+])
+def test_cli_refuses_bad_input_naming_the_option(argv, named, capsys, tmp_path):
+    code = main(["cost", "shear/lees-edwards-2d", "--out", str(tmp_path), *argv])
+    assert code == 2
+    assert named in capsys.readouterr().err
+    assert not list(tmp_path.glob("*.h5"))  # nothing ran
+
+
+def test_reference_tc_ladder_keeps_the_largest_tc_when_the_tc_model_never_acts(tmp_path):
+    study = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=tmp_path, workers=1,
+                    tc_ladder=True, **{**LADDER, "kstars": [1e2]})
+    refs = [r for r in study.rows if r["engine"] == "edmd"]
+    assert [r["tc"] for r in refs] == pytest.approx([1e-5, 1e-6, 1e-7])
+    elastic = [read_results(r["path"]).attrs["elastic_tc_collisions"] for r in refs]
+    if any(elastic):
+        pytest.skip("the TC model acted in this tiny scene: t_c changes the dynamics")
+    # t_c only matters through TC collisions: without any, the runs are the same trajectory,
+    # agree with the smallest t_c, and the cheapest (largest t_c) is the reference
+    assert [r["steps"] for r in refs] == [refs[0]["steps"]] * 3
+    assert [r["reference"] for r in refs] == [True, False, False]
+    assert study.reference["name"] == "ref-edmd-tc1e-05"
+
+
+def test_health_figures_when_present_give_the_contact_time_law():
+    from demstudy.cost.study import _fits
+
+    ratio = np.array([0.3, 0.1, 0.03, 0.01])  # t_c/τ_flight of four soft runs
+    rows = [{"model": "hooke", "steps_per_contact": 50.0, "kstar": 1e2 / r**2,
+             "error": 0.4 * r**1.5, "tc_flight": r} for r in ratio]
+    fits = _fits(rows)
+    assert fits["error(t_c/tau_flight)"].p == pytest.approx(1.5, abs=1e-3)
+    assert fits["error(k*) hooke, 50 steps/contact"].p == pytest.approx(0.75, abs=1e-3)
+    without = _fits([{k: v for k, v in r.items() if k != "tc_flight"} for r in rows])
+    assert "error(t_c/tau_flight)" not in without
