@@ -42,7 +42,9 @@ LIMITS: dict[str, float] = {
     "tc_flight": 0.1,  # t_c / τ_flight: collisions not instantaneous against free flights
     "tc_shear": 0.1,  # t_c γ̇: the flow deforms during a contact
     "multi_contact_fraction": 0.1,  # particles in ≥ 2 contacts at once: not binary collisions
-    "persistent_fraction": 0.5,  # contacts outliving a sample interval: enduring contacts
+    # contacts found again one sample later, beyond the share max(0, 1 − Δt/t_c) expected of
+    # binary collisions lasting t_c: enduring contacts
+    "persistent_fraction": 0.5,
     "min_steps_per_contact": 10.0,  # steps resolving the shortest contact (fewest realised)
 }
 
@@ -186,8 +188,14 @@ def assess(values: Mapping[str, Any], limits: Mapping[str, float] = LIMITS) -> l
     over("tc_shear", "contact time not short against the shear time 1/γ̇")
     over("multi_contact_fraction", "many particles in two or more contacts at once: "
                                    "collisions are not binary")
-    over("persistent_fraction", "contacts outlive a sample interval: enduring contacts, "
-                                "not collisions")
+    excess = values.get("persistent_fraction", math.nan) - values.get("persistent_expected",
+                                                                         0.0)
+    if np.isfinite(excess) and excess > limits["persistent_fraction"]:
+        problems.append(f"persistent_fraction {values['persistent_fraction']:.3g} > "
+                        f"{values.get('persistent_expected', 0.0):.3g} + "
+                        f"{limits['persistent_fraction']:g} (binary collisions of duration t_c "
+                        "+ limit): contacts outlive a sample interval: enduring contacts, "
+                        "not collisions")
     steps = values.get("min_steps_per_contact")
     if steps is not None and steps < limits["min_steps_per_contact"]:
         problems.append(f"min_steps_per_contact {steps:.3g} < "
@@ -238,6 +246,7 @@ def health_results(scene: Scene, timestep: float, samples: Mapping[str, list],
             "coordination": float(np.nanmean(data["coordination"])),
             "multi_contact_fraction": float(np.nanmean(data["multi_contact_fraction"])),
             "persistent_fraction": _nanmean(data["persistent_fraction"]),
+            "persistent_expected": max(0.0, 1.0 - _interval(data["time"]) / tc),
             "max_impact_speed": _nanmax(data["max_impact_speed"]),
             "median_impact_speed": _nanmedian(data["median_impact_speed"]),
             "impact_speed_method": "per touching pair: √(v_n² + stored elastic energy × 2/m_eff)"
@@ -249,6 +258,11 @@ def health_results(scene: Scene, timestep: float, samples: Mapping[str, list],
     values.update(healthy=not problems, problems=problems, limits=dict(LIMITS),
                   units="d = 1, m = 1 (g = 1 with gravity); overlaps in d, times in τ")
     return data, values
+
+
+def _interval(time: np.ndarray) -> float:
+    """The sampling interval (inf with fewer than two samples: nothing can persist)."""
+    return float(np.median(np.diff(time))) if time.size > 1 else math.inf
 
 
 def _mobile_count(scene: Scene) -> int:
