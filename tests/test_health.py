@@ -166,6 +166,15 @@ def test_soft_gas_is_flagged_with_the_overlap_named(tmp_path, capsys):
     assert any(p.startswith("max_overlap") and "too soft" in p for p in attrs["problems"])
     err = capsys.readouterr().err
     assert "violate the hard-particle assumptions" in err and "max_overlap" in err
+    # the health figure draws the stored series and the limit the run broke
+    from demstudy.plots import Run, draw_health
+
+    fig = draw_health([Run.of(res)])
+    lines = {line.get_gid(): line for ax in fig.axes for line in ax.get_lines()}
+    drawn = lines[f"{res.path.name}:max_overlap"].get_ydata()
+    np.testing.assert_array_equal(drawn, res.groups["health"]["max_overlap"])
+    assert LIMITS["max_overlap"] in [line.get_ydata()[0] for line in fig.axes[0].get_lines()
+                                     if line.get_gid() is None]
 
 
 def resting_bed():
