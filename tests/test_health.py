@@ -217,6 +217,20 @@ def test_two_mpi_ranks_see_the_same_contacts(tmp_path):
         np.testing.assert_allclose(two[key], one[key], rtol=1e-6, err_msg=key)
 
 
+def test_resumed_run_keeps_every_sample_once(tmp_path):
+    """A run stopped after its first sample (a checkpoint) and resumed: the health series
+    holds each production sample once, as the uninterrupted run's."""
+    from demstudy.errors import EngineError
+
+    scene = gas(200, 0.1, 1e5, production=1.0)
+    whole = run(scene, tmp_path, name="whole.h5").groups["health"]
+    with pytest.raises(EngineError, match="--resume"):
+        run(scene, tmp_path, name="parts.h5", wall_limit=0.0)
+    parts = run(scene, tmp_path, name="parts.h5", resume=True).groups["health"]
+    np.testing.assert_allclose(parts["time"], whole["time"])
+    np.testing.assert_allclose(parts["max_overlap"], whole["max_overlap"], rtol=1e-6)
+
+
 def test_event_driven_runs_have_no_health_group(tmp_path):
     res = run(gas(50, 0.1, 1e5, production=1.0), tmp_path, engine="edmd")
     assert "health" not in res.groups and "health" not in res.group_attrs

@@ -53,7 +53,7 @@ from .state import RunState
 
 __all__ = ["Simulation"]
 
-LOOP_VERSION = f"demstudy {__version__} (simulation loop 1)"
+LOOP_VERSION = f"demstudy {__version__} (simulation loop 2)"  # 2: RunState.health
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 
 
