@@ -15,7 +15,13 @@ import numpy as np
 import pytest
 
 from demstudy.contact import mapping
-from demstudy.contact.health import LIMITS, assess, contact_sample, impact_speeds
+from demstudy.contact.health import (
+    LIMITS,
+    assess,
+    contact_sample,
+    impact_speeds,
+    shear_rate_of,
+)
 from demstudy.contact.stiffness import contact_setup
 from demstudy.io.fields import UNKNOWN_UNITS
 from demstudy.io.results import read_results
@@ -175,6 +181,48 @@ def test_soft_gas_is_flagged_with_the_overlap_named(tmp_path, capsys):
     np.testing.assert_array_equal(drawn, res.groups["health"]["max_overlap"])
     assert LIMITS["max_overlap"] in [line.get_ydata()[0] for line in fig.axes[0].get_lines()
                                      if line.get_gid() is None]
+
+
+def test_lees_edwards_shear_time_and_image_velocities(tmp_path):
+    """Under Lees–Edwards shear the shear time is 1/γ̇ and t_c γ̇ follows; pairs across the
+    sheared boundary get the image's velocity γ̇ L_y: no reconstructed impact speed comes
+    near γ̇ L_y = 20 (without the shift they reach ~36)."""
+    scene = validate_scene({
+        "dimension": 2, "box": {"size": [20.0, 20.0]}, "particles": {"solid_fraction": 0.4},
+        "contact": {"restitution": 0.8}, "shear": {"rate": 1.0},
+        "initial": {"placement": "random", "velocity": {"profile": "linear",
+                                                          "temperature": 0.5}},
+        "run": {"equilibration": 1.0, "production": 3.0, "sample_interval": 0.1},
+        "soft": {"stiffness": 2e4, "steps_per_contact": 50},
+    })
+    attrs = run(scene, tmp_path).group_attrs["health"]
+    assert attrs["shear_rate_source"] == "scene shear rate"
+    assert attrs["shear_time"] == pytest.approx(1.0)
+    assert attrs["tc_shear"] == pytest.approx(attrs["contact_time"])
+    assert attrs["contact_time"] == pytest.approx(
+        mapping.hooke_contact(2e4, 0.8, 0.5).contact_time)
+    assert 0 < attrs["max_impact_speed"] < 10
+
+
+def test_shear_rate_from_walls_and_from_the_profile():
+    couette = validate_scene({
+        "dimension": 2, "box": {"size": [10.0, 8.0]}, "particles": {"count": 10},
+        "contact": {"restitution": 0.9},
+        "walls": [{"side": "lower", "restitution": 0.9, "velocity": -1.0},
+                  {"side": "upper", "restitution": 0.9, "velocity": 1.0}],
+        "initial": {"placement": "random"},
+        "run": {"equilibration": 0.0, "production": 1.0},
+    })
+    assert shear_rate_of(couette, None) == (pytest.approx(2.0 / 8.0),
+                                            "wall speed difference / gap (Couette)")
+    gas_scene = gas(10, 0.1, 1e5)
+    y = np.linspace(0.5, 9.5, 10)
+    profile = {"y": y, "velocity": np.column_stack([0.3 * y + 1.0, 0 * y]),
+               "solid_fraction": np.full(10, 0.1)}
+    rate, source = shear_rate_of(gas_scene, profile)
+    assert rate == pytest.approx(0.3) and "fit" in source
+    profile["velocity"][:, 0] = 2.0  # plug flow: no shear
+    assert shear_rate_of(gas_scene, profile) == (None, "no shear")
 
 
 def resting_bed():
