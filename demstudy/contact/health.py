@@ -133,20 +133,21 @@ def shear_rate_of(scene: Scene, profiles: Mapping[str, Any] | None) -> tuple[flo
 
 
 def _enskog_flight_time(scene: Scene, profiles: Mapping[str, Any] | None) -> float | None:
-    """1/ω of Enskog theory at the run's mean solid fraction and temperature."""
+    """1/ω̄ of Enskog theory, ω̄ the particle-weighted mean over the profile bins of the local
+    collision frequency at the bin's ν and T (ν capped below close packing)."""
     from ..theory.kinetic import collision_frequency  # noqa: PLC0415 - theory is lazy
 
     if not profiles or "solid_fraction" not in profiles or "temperature" not in profiles:
         return None
     nu = np.asarray(profiles["solid_fraction"], float)
     temp = np.asarray(profiles["temperature"], float)
-    ok = np.isfinite(nu) & np.isfinite(temp) & (nu > 0)
+    ok = np.isfinite(nu) & np.isfinite(temp) & (nu > 0) & (temp > 0)
     if not ok.any():
         return None
-    mean_nu = float(nu[ok].mean())
-    mean_t = float(np.sum(nu[ok] * temp[ok]) / np.sum(nu[ok]))
-    omega = float(collision_frequency(min(mean_nu, 0.6), mean_t, scene.dimension))
-    return 1.0 / omega if omega > 0 else None
+    cap = 0.6 if scene.dimension == 3 else 0.8
+    omega = collision_frequency(np.minimum(nu[ok], cap), temp[ok], scene.dimension)
+    mean = float(np.sum(nu[ok] * omega) / np.sum(nu[ok]))
+    return 1.0 / mean if mean > 0 else None
 
 
 def _contact_times(scene: Scene, speeds: np.ndarray) -> tuple[float, float, float, float]:
