@@ -32,7 +32,7 @@ from . import mapping
 from .stiffness import contact_setup
 
 __all__ = ["LIMITS", "SAMPLE_KEYS", "assess", "contact_sample", "health_results",
-           "impact_speeds", "shear_rate_of"]
+           "impact_speeds", "shear_rate_of", "warning_text"]
 
 #: Thresholds of the verdict (dimensionless; each flags a run when exceeded, or for
 #: ``min_steps_per_contact`` when not reached). Documented in docs/contact.md.
@@ -217,15 +217,15 @@ def health_results(scene: Scene, timestep: float, samples: Mapping[str, list],
     tc, tc_wall, tc_fast, tc_slow = _contact_times(
         scene, np.concatenate([data["min_impact_speed"], data["median_impact_speed"],
                                data["max_impact_speed"]]))
-    n = max(1, len(data["time"]))
-    z_pair = float(np.mean(2 * data["pair_contacts"])) / max(1, _mobile_count(scene))
-    z_wall = float(np.mean(data["wall_contacts"])) / max(1, _mobile_count(scene))
+    n_mobile = max(1, scene.n_particles)  # bumps are not particles
+    z_pair = float(np.mean(2 * data["pair_contacts"])) / n_mobile
+    z_wall = float(np.mean(data["wall_contacts"])) / n_mobile
     omega = z_pair / tc + z_wall / tc_wall  # Little's law (module docstring)
     flight = max(0.0, 1.0 / omega - tc) if omega > 0 else math.inf
     rate, rate_source = shear_rate_of(scene, profiles)
     with np.errstate(all="ignore"):
         values: dict[str, Any] = {
-            "max_overlap": float(np.nanmax(data["max_overlap"])) if n else 0.0,
+            "max_overlap": _nanmax(data["max_overlap"]),
             "mean_overlap": mean_overlap,
             "contact_time": tc,
             "contact_time_wall": tc_wall,
@@ -253,7 +253,7 @@ def health_results(scene: Scene, timestep: float, samples: Mapping[str, list],
             "impact_speed_method": "per touching pair: √(v_n² + stored elastic energy × 2/m_eff)"
                                    " (a lower bound: damping)",
             "model": scene.soft.model,
-            "samples": n,
+            "samples": len(data["time"]),
         }
     problems = assess(values)
     values.update(healthy=not problems, problems=problems, limits=dict(LIMITS),
@@ -264,10 +264,6 @@ def health_results(scene: Scene, timestep: float, samples: Mapping[str, list],
 def _interval(time: np.ndarray) -> float:
     """The sampling interval (inf with fewer than two samples: nothing can persist)."""
     return float(np.median(np.diff(time))) if time.size > 1 else math.inf
-
-
-def _mobile_count(scene: Scene) -> int:
-    return scene.n_particles
 
 
 def _nanmean(a: np.ndarray) -> float:
