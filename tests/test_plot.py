@@ -171,7 +171,7 @@ def test_all_kinds_write_pngs_and_skip_the_absent_one(chute, tmp_path, capsys):
     out = tmp_path / "fig.png"
     assert main(["plot", str(chute), "--kind", "all", "-o", str(out)]) == 0
     cap = capsys.readouterr()
-    absent = ("structure", "freepath", "lambda", "cgprofiles", "cooling")  # KINDS order
+    absent = ("structure", "freepath", "lambda", "cgprofiles", "cooling", "health")  # KINDS order
     drawn = [k for k in KINDS if k not in absent]
     for kind in drawn:
         png = tmp_path / f"fig-{kind}.png"
@@ -189,6 +189,7 @@ def test_all_kinds_write_pngs_and_skip_the_absent_one(chute, tmp_path, capsys):
     assert "lambda skipped" in notices[2] and "--what lambda" in notices[2]
     assert "no /statistics/cgprofiles" in notices[3] and "--what cgprofiles" in notices[3]
     assert "cooling skipped" in notices[4] and "homogeneous cooling" in notices[4]
+    assert "no /health" in notices[5] and "event-driven runs are hard" in notices[5]
     assert "Traceback" not in cap.err
 
 

@@ -312,12 +312,31 @@ _DERIVED = {
     "lambda_enskog": (LENGTH, "Enskog mean free path of the bin's solid fraction"),
 }
 
+_HEALTH = {  # soft-contact engines, one value per production sample (demstudy.contact.health)
+    "time": (TIME, "simulation time of the sample"),
+    "max_overlap": (LENGTH, "largest overlap of the contacts touching at the sample "
+                            "(particle–particle, particle–wall, particle–bump)"),
+    "mean_overlap": (LENGTH, "mean overlap of the contacts touching at the sample (NaN: none)"),
+    "contacts": (COUNT, "contacts touching at the sample (pairs, walls and bumps)"),
+    "pair_contacts": (COUNT, "particle–particle contacts touching at the sample"),
+    "wall_contacts": (COUNT, "particle–wall and particle–bump contacts touching at the sample"),
+    "coordination": (ONE, "mean number of contacts per mobile particle"),
+    "multi_contact_fraction": (ONE, "fraction of mobile particles in two or more contacts"),
+    "persistent_fraction": (ONE, "share of the touching pairs already touching at the "
+                                 "previous sample (NaN: unknown)"),
+    "min_impact_speed": (SPEED, "smallest normal impact speed reconstructed from the "
+                                "touching pairs (overlap and normal speed, elastic energy)"),
+    "median_impact_speed": (SPEED, "median reconstructed normal impact speed of the pairs"),
+    "max_impact_speed": (SPEED, "largest reconstructed normal impact speed of the pairs"),
+}
+
 FIELDS: dict[str, dict[str, tuple[str, str]]] = {
     "timeseries": _TIMESERIES,
     "profiles": _PROFILES,
     "frames": _FRAMES,
     "stress": _STRESS,
     "collisions": _COLLISIONS,
+    "health": _HEALTH,
     "statistics/vdf": _VDF,
     "statistics/gr": _GR,
     "statistics/structure": _STRUCTURE,

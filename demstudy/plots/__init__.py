@@ -17,7 +17,9 @@ Kinds (``demstudy plot RUN.h5 … --kind``; see docs/plots.md):
 * ``vcorr``: C_αα(r) per component and the off-diagonal C_αβ(r);
 * ``lambda``: Λ(y) with 1/3;
 * ``waves``: power spectrum of the dominant plane, its density contour, mode amplitudes;
-* ``cooling``: homogeneous cooling runs only, T(t)/T0 with Haff's law (log–log).
+* ``cooling``: homogeneous cooling runs only, T(t)/T0 with Haff's law (log–log);
+* ``health``: soft-contact runs only, overlaps and coordination per sample with the limits
+  of the hard-particle verdict (:data:`demstudy.contact.health.LIMITS`).
 
 Every ``draw_<kind>(runs, …)`` returns a :class:`matplotlib.figure.Figure` (Agg canvas, no
 pyplot); :func:`plot_files` loads files, skips kinds a file lacks with a one-line notice and
@@ -31,7 +33,7 @@ from .._lazy import lazy_exports
 from .kinds import KINDS, SCALED, parse_kinds
 
 __all__ = ["KINDS", "SCALED", "Run", "draw", "draw_angles", "draw_cgprofiles", "draw_cooling",
-           "draw_eos", "draw_freepath", "draw_gr", "draw_lambda", "draw_profiles",
+           "draw_eos", "draw_freepath", "draw_gr", "draw_health", "draw_lambda", "draw_profiles",
            "draw_stress", "draw_structure", "draw_vcorr", "draw_vdf", "draw_waves",
            "output_path", "parse_kinds", "plot_files", "plot_profiles", "reference_height"]
 

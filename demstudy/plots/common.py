@@ -137,6 +137,9 @@ class Run:
             ts = self.results.timeseries
             ok = homogeneous_cooling(self.scene) and "kinetic_energy" in ts and "time" in ts
             return (ts, {}) if ok else None
+        if kind == "health":  # the run's own group (soft-contact engines)
+            data = self.results.groups.get("health")
+            return (data, self.results.group_attrs.get("health", {})) if data else None
         for name in groups_of(kind):
             data = self.results.groups.get(name)
             if data and REQUIRED.get(kind, next(iter(data), "")) in data:
@@ -146,6 +149,8 @@ class Run:
     def where(self, kind: str) -> str:
         if kind == "cooling":
             return "homogeneous cooling scene with /timeseries/kinetic_energy"
+        if kind == "health":
+            return "/health"
         return "/profiles" if kind == "profiles" else " or ".join(f"/{g}" for g in groups_of(kind))
 
 

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from .common import Run, missing_notice, save
 from .correlations import draw_gr, draw_lambda, draw_structure, draw_vcorr
 from .distributions import draw_angles, draw_freepath, draw_vdf
+from .health import draw_health
 from .kinds import KINDS, SCALED
 from .profiles import (
     draw_cgprofiles,
@@ -34,14 +35,14 @@ DRAW: dict[str, tuple[Callable[..., Figure], bool]] = {
     "freepath": (draw_freepath, True), "gr": (draw_gr, True), "vcorr": (draw_vcorr, True),
     "lambda": (draw_lambda, False), "waves": (draw_waves, False),
     "cooling": (draw_cooling, False), "structure": (draw_structure, False),
-    "cgprofiles": (draw_cgprofiles, False),
+    "cgprofiles": (draw_cgprofiles, False), "health": (draw_health, False),
 }
 if set(KINDS) != set(DRAW):  # a statistic declares a figure nobody draws, or vice versa
     raise ImportError(f"plot kinds out of step: registered {sorted(KINDS)}, drawn "
                       f"{sorted(DRAW)}")
 
 __all__ = ["DRAW", "Run", "draw", "draw_angles", "draw_cgprofiles", "draw_cooling", "draw_eos",
-           "draw_freepath", "draw_gr", "draw_lambda", "draw_profiles", "draw_stress",
+           "draw_freepath", "draw_gr", "draw_health", "draw_lambda", "draw_profiles", "draw_stress",
            "draw_structure", "draw_vcorr", "draw_vdf", "draw_waves",
            "output_path", "plot_files", "plot_profiles", "reference_height"]
 

@@ -9,9 +9,11 @@ from collections.abc import Sequence
 
 from ..analysis.registry import STATISTICS
 
-#: figures drawn from a run's time series and scene rather than from a statistic
+#: figures drawn from a run's time series, scene or own groups rather than from a statistic
 HOW_PLOT_ONLY = {"cooling": "Haff's law needs every axis periodic, no walls, gravity or "
-                            "shear, equal particles and a constant e < 1"}
+                            "shear, equal particles and a constant e < 1",
+                 "health": "soft-contact (LAMMPS) runs store the contact health; "
+                           "event-driven runs are hard and have none"}
 #: the kinds that take ``scaled`` (against (y − y_0)/H)
 SCALED = ("profiles", "cgprofiles")
 #: the kinds, in the order ``--kind all`` draws them: each registered statistic's figures

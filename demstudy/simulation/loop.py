@@ -33,6 +33,7 @@ from ..analysis.base import bin_edges
 from ..analysis.registry import STATISTICS, Context
 from ..analysis.stress import CollisionalSums, ContactStress, momentum_snapshot
 from ..analysis.suite import profile_bounds
+from ..contact.health import warning_text
 from ..effects.servo import ServoController, has_servo, servo_samples, servo_settings
 from ..engines.backend import LOG_CAPACITY, BackendBase, Needs, frame_mass
 from ..errors import EngineError, RunStopped
@@ -52,7 +53,7 @@ from .state import RunState
 
 __all__ = ["Simulation"]
 
-LOOP_VERSION = f"demstudy {__version__} (simulation loop 1)"
+LOOP_VERSION = f"demstudy {__version__} (simulation loop 2)"  # 2: RunState.health
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 
 
@@ -242,6 +243,19 @@ class Simulation:
                 state.momentum_end = snap
         if production:
             self._production_frame(state, frame)
+            self._health(state, t)
+
+    def _health(self, state: RunState, t: float) -> None:
+        """The contact health of a soft-contact engine (those with ``health_sample``; a
+        collective call on MPI ranks), kept per production sample."""
+        sample = getattr(self.backend, "health_sample", None)
+        if sample is None:
+            return
+        values = sample()
+        if self.backend.rank == 0:
+            state.health.setdefault("time", []).append(t)
+            for key, value in values.items():
+                state.health.setdefault(key, []).append(value)
 
     def _begin_production(self, state: RunState) -> bool:
         """Production starts: lay what is binned from now on; True when the interaction
@@ -384,6 +398,9 @@ class Simulation:
         self.backend.cleanup(None)
         if self.workdir.exists() and not any(self.workdir.iterdir()):
             self.workdir.rmdir()
+        warning = warning_text(results.group_attrs.get("health", {}))
+        if warning:  # the results stand, but not for the hard-particle limit
+            print(warning, file=sys.stderr)
         failed = results.attrs.get("statistics_failed")
         if failed:  # the run's results are safe; say what is missing from them
             raise EngineError(f"the run finished and its results are in {path}, but these "

@@ -13,6 +13,7 @@ import numpy as np
 from ..analysis.registry import STATISTICS, Context
 from ..analysis.steady import energy_trend, is_steady
 from ..analysis.stress import CollisionalSums, ContactStress, collisional_stress, stress_results
+from ..contact.health import health_results
 from ..io.results import Results, frames_of
 from ..scene import Scene, scene_to_toml
 from .state import RunState
@@ -58,6 +59,9 @@ def run_results(sim: Any, state: RunState, extra: dict[str, Any]) -> Results:
     if sim.measure_stress:
         results.groups["stress"], results.group_attrs["stress"] = _stress(
             sim, state, results, equilibration_end)
+    if state.health:  # soft contacts: how far from the hard-particle limit
+        results.groups["health"], results.group_attrs["health"] = health_results(
+            scene, backend.time_step, state.health, profiles.results)
     if state.log:
         results.groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}
         results.group_attrs["collisions"] = {

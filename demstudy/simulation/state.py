@@ -42,6 +42,8 @@ class RunState:
     momentum_start: dict | None = None
     momentum_end: dict | None = None
     in_production: bool = False
+    # soft-contact engines: the contact health at each production sample (contact.health)
+    health: dict[str, list] = field(default_factory=dict)
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)

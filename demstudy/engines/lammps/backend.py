@@ -24,6 +24,7 @@ import numpy as np
 from ... import __version__
 from ...analysis.base import bin_edges
 from ...analysis.stress import branch_sums
+from ...contact.health import contact_sample, impact_speeds
 from ...effects.bumps import bump_rows
 from ...errors import EngineError
 from ...io.frames import Frame
@@ -32,7 +33,16 @@ from ...scene.initial import build_initial_state
 from ..backend import BackendBase, Capabilities, Needs, frame_mass
 from .deck import build_deck, check_scene, write_deck
 from .deck.effects import TRANSLATIONS, wall_fix_id, wall_force_sources
-from .deck.output import STRESS_COLUMNS, STRESS_IDS, STRESS_PAIRS, WALL_FORCES, sample_steps
+from .deck.output import (
+    HEALTH_COLUMNS,
+    HEALTH_IDS,
+    HEALTH_PAIRS,
+    STRESS_COLUMNS,
+    STRESS_IDS,
+    STRESS_PAIRS,
+    WALL_FORCES,
+    sample_steps,
+)
 from .deck.system import DATA_FILE, data_header, data_rows
 from .library import mpirun_executable
 from .session import LammpsSession, any_rank, quoted
@@ -120,7 +130,8 @@ class LammpsBackend(BackendBase):
         self.nprocs = 1
         self._mobile: np.ndarray | None = None
         self._frame: Frame | None = None
-        self._all: tuple[np.ndarray, np.ndarray] | None = None  # (x, radius) of every atom
+        self._all: tuple[np.ndarray, ...] | None = None  # (x, radius, v) of every atom
+        self._health_keys: np.ndarray | None = None  # the previous sample's touching pairs
         self._initialise = False  # the wall motion changed: LAMMPS sets up again
         self.servo = None
 
@@ -263,12 +274,13 @@ class LammpsBackend(BackendBase):
             self._mobile = session.gather("type", 1, integer=True) == 1
         mobile = self._mobile
         x_all, r_all = session.gather("x", 3), session.gather("radius", 1)
-        self._all = (x_all, r_all)
+        v_all = session.gather("v", 3)
+        self._all = (x_all, r_all, v_all)
         omega = session.gather("omega", 3)[mobile]
         boxlo, boxhi, xy, *_ = session.lmp.extract_box()
         self._frame = Frame(time=self.time, box_lo=np.array(boxlo[:dim]),
                             box_hi=np.array(boxhi[:dim]), position=x_all[mobile, :dim],
-                            velocity=session.gather("v", 3)[mobile, :dim],
+                            velocity=v_all[mobile, :dim],
                             angular_velocity=omega[:, 2:3] if dim == 2 else omega,
                             radius=r_all[mobile], tilt=float(xy))
         return self._frame
@@ -304,7 +316,7 @@ class LammpsBackend(BackendBase):
         (branch to a bump's or a wall's contact point)."""
         session, dim = self.session, self.scene.dimension
         self.frame()  # the positions of every atom, this step
-        x_all, r_all = self._all
+        x_all, r_all, _v = self._all
         mobile = self._mobile
         rows = session.local_array(STRESS_PAIRS, STRESS_COLUMNS)
         ids = session.local_array(STRESS_IDS, 2).astype(np.int64) - 1
@@ -336,6 +348,58 @@ class LammpsBackend(BackendBase):
         period = self.scene.box.size[1] if self.scene.y_periodic else 0.0
         sums = branch_sums(y, y - br[:, 1], f[:, :, None] * br[:, None, :], self.edges, period)
         return session.sum_ranks(sums)
+
+    def health_sample(self) -> dict[str, float]:
+        """The contacts touching now, for :mod:`demstudy.contact.health` (collective): pairs
+        from ``compute pair/local`` gathered from every rank, wall contacts from the wall
+        fixes' per-atom arrays (overlap = radius − distance to the wall's contact point); a
+        bump counts as a wall. Impact speeds are reconstructed for mobile pairs only."""
+        session, scene = self.session, self.scene
+        self.frame()
+        x_all, r_all, v_all = self._all
+        mobile = self._mobile
+        index = np.cumsum(mobile) - 1  # atom index -> mobile particle index
+        local = session.local_array(HEALTH_PAIRS, HEALTH_COLUMNS)
+        ids = session.local_array(HEALTH_IDS, 2)
+        if ids.shape[0] != local.shape[0]:
+            raise EngineError(f"{HEALTH_PAIRS} and {HEALTH_IDS} disagree on the contacts")
+        rows = session.gather_rows(np.hstack([local, ids]))
+        dist, sep = rows[:, 0], rows[:, 1:4]
+        i, j = rows[:, 4].astype(np.int64) - 1, rows[:, 5].astype(np.int64) - 1
+        overlap = r_all[i] + r_all[j] - dist
+        both = mobile[i] & mobile[j]
+        one = mobile[i] != mobile[j]  # a mobile particle on a bump
+        walls = [(np.where(mobile[i[one]], i[one], j[one]), overlap[one])]
+        i, j, sep, dist, pair_overlap = i[both], j[both], sep[both], dist[both], overlap[both]
+        dv = v_all[i] - v_all[j]
+        if scene.shear is not None:  # j's Lees–Edwards image moves by n γ̇ L_y along x
+            ly = scene.box.size[1]
+            image = np.round((x_all[i, 1] - x_all[j, 1] - sep[:, 1]) / ly)
+            dv[:, 0] -= image * scene.shear.rate * ly
+        vn = np.einsum("ij,ij->i", dv, sep) / np.maximum(dist, 1e-300)
+        mass = (2 * r_all) ** scene.dimension  # m = d^dim (frame_mass)
+        speeds = impact_speeds(vn, np.maximum(pair_overlap, 0.0), self.contact.kn,
+                               mass[i] * mass[j] / (mass[i] + mass[j]),
+                               r_all[i] * r_all[j] / (r_all[i] + r_all[j]), scene.soft.model)
+        if scene.walls:
+            nlocal = int(session.lmp.extract_setting("nlocal"))
+            atom_ids = np.array(session.lmp.numpy.extract_atom("id")[:nlocal], dtype=np.int64)
+            local_x = session.local_positions()
+            found = []
+            for wall in scene.walls:
+                contacts = session.fix_atom_array(wall_fix_id(wall.side))
+                if contacts.size == 0:
+                    continue
+                on = contacts[:, 0] != 0
+                gap = np.linalg.norm(local_x[on] - contacts[on, 4:7], axis=1)
+                found.append(np.column_stack([atom_ids[on] - 1, contacts[on, 7] - gap]))
+            wall_rows = session.gather_rows(np.vstack(found) if found else np.zeros((0, 2)))
+            walls.append((wall_rows[:, 0].astype(np.int64), wall_rows[:, 1]))
+        wall_i = np.concatenate([w[0] for w in walls])
+        values, self._health_keys = contact_sample(
+            int(mobile.sum()), index[i], index[j], pair_overlap, index[wall_i],
+            np.concatenate([w[1] for w in walls]), speeds, self._health_keys)
+        return values
 
     # -- checkpoints, MPI, end ------------------------------------------------------------
     def get_state(self) -> dict:

@@ -150,5 +150,20 @@ class LammpsSession:
             raise EngineError(f"MPI_Allreduce failed with code {status}")
         return recv
 
+    def gather_rows(self, rows: np.ndarray) -> np.ndarray:
+        """Every rank's rows of a local array, stacked in rank order, on every rank (an
+        allgather built from two element-wise sums: counts, then a zero-padded buffer in
+        which each rank fills its own slice; meant for the few rows of a sample)."""
+        rows = np.ascontiguousarray(rows, dtype=np.float64)
+        if self.nprocs == 1:
+            return rows.copy()
+        counts = np.zeros(self.nprocs)
+        counts[self.rank] = rows.shape[0]
+        counts = self.sum_ranks(counts).astype(np.int64)
+        start = int(counts[:self.rank].sum())
+        buffer = np.zeros((int(counts.sum()), rows.shape[1]))
+        buffer[start:start + rows.shape[0]] = rows
+        return self.sum_ranks(buffer)
+
     def close(self) -> None:
         self.lmp.close()

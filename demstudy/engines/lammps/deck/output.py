@@ -14,6 +14,10 @@ WALL_FORCES = "wall_forces"
 #: normal force on i (fx fy fz), tangential force on i (p1-p3), x_i - x_j (p10-p12)
 STRESS_PAIRS, STRESS_IDS = "stress_pairs", "stress_ids"
 STRESS_COLUMNS = 9
+#: local computes read by the driver for the contact health (demstudy.contact.health): the
+#: distance and x_i - x_j (p10-p12) of every touching pair, and their atom IDs
+HEALTH_PAIRS, HEALTH_IDS = "health_pairs", "health_ids"
+HEALTH_COLUMNS = 4
 
 
 def sample_steps(scene: Scene, dt: float) -> int:
@@ -41,6 +45,10 @@ def sampling_block(scene: Scene, setup: ContactSetup) -> Block:
         cmds.append(f"compute {STRESS_PAIRS} all pair/local fx fy fz p1 p2 p3 p10 p11 p12 "
                     "cutoff radius")
         cmds.append(f"compute {STRESS_IDS} all property/local patom1 patom2 cutoff radius")
+    # the touching pairs for the contact health, read at the samples only (a local compute
+    # costs nothing between reads)
+    cmds.append(f"compute {HEALTH_PAIRS} all pair/local dist p10 p11 p12 cutoff radius")
+    cmds.append(f"compute {HEALTH_IDS} all property/local patom1 patom2 cutoff radius")
     if scene.shear is not None:
         columns.append("xy")  # the Lees–Edwards tilt
     cmds.append("thermo_style custom " + " ".join(columns))
