@@ -220,6 +220,18 @@ def test_oblique_impacts_follow_walton_sticking_and_sliding(dim, kind):
     assert regimes == {True, False}
 
 
+@pytest.mark.parametrize("kind", ["pair", "wall"])
+def test_hertz_coulomb_mindlin_copy_follows_walton(kind):
+    """Hertz: the Mindlin spring k_t a with the same damping ratio keeps F_t/F_n constant."""
+    K = 0.4
+    rows = calibrate(3, kind, e=0.95, mu=0.3, model="hertz", kn=1e6, speeds=(1.0,),
+                     angles=(10.0, 30.0, 50.0, 70.0))
+    for r in rows:
+        target = walton_beta(0.3, 0.95, 0.95, K, math.tan(math.radians(r.angle)))
+        assert r.beta_target == pytest.approx(target)
+        assert abs(r.beta - target) < 0.02, r
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_spinning_head_on_wall_impact(dim):
     """Head-on, the contact point moves by R W: Walton's rule at |g_t|/|g_n| = R W / v."""

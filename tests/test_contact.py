@@ -192,7 +192,14 @@ def test_walton_mismatch_allows_only_rules_the_spring_follows():
     assert cm.walton_mismatch(0.98, 1.0, "hooke") is None
     for e, b0 in ((0.98, 0.0), (0.8, 1.0), (0.5, None), (0.9, 0.35)):
         assert "beta0" in cm.walton_mismatch(e, b0, "hooke")
-    assert "Hertz" in cm.walton_mismatch(0.9, None, "hertz")
+    assert cm.walton_mismatch(0.9, None, "hertz") is None  # the Mindlin copy
+    assert "Hertz" in cm.walton_mismatch(0.8, None, "hertz")
+    assert "Hertz" in cm.walton_mismatch(0.95, 1.0, "hertz")
+    hertz = cm.make_contact(kn=1e6, e=0.9, m_eff=0.5, K=0.4, mu=0.3, model="hertz", r_eff=0.25,
+                            speed=1.0)
+    assert hertz.mindlin and "tangential mindlin" in granular_args(hertz)
+    assert "tangential linear_history" in granular_args(
+        cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, mu=0.3))
 
 
 def test_peak_forces_reduce_to_elastic_formulas():

@@ -279,6 +279,8 @@ class ContactParameters:
     contact_time: float
     #: LAMMPS tangential damping factor x_gamma_t (eta_t = xt eta_n); 0 = undamped spring
     xt: float = 0.0
+    #: Mindlin spring k_t a (a = contact radius, LAMMPS ``tangential mindlin``): the Hertz copy
+    mindlin: bool = False
 
     def __post_init__(self) -> None:
         if self.model not in ("hooke", "hertz"):
@@ -293,6 +295,8 @@ class ContactParameters:
             raise ValueError(f"unknown tangential model {self.tangential!r}")
         if self.xt < 0.0 or (self.xt and self.tangential != "coulomb"):
             raise ValueError("tangential damping xt >= 0 is only used by 'coulomb' contacts")
+        if self.mindlin and (self.model != "hertz" or self.tangential != "coulomb"):
+            raise ValueError("the Mindlin spring is only used by hertz 'coulomb' contacts")
 
     def timestep(self, steps_per_contact: float) -> float:
         return timestep(self.contact_time, steps_per_contact)
@@ -305,9 +309,10 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
 
     * ``beta`` None or -1 and ``mu`` None: smooth; ``beta`` in (-1, 1] with ``mu`` None: uncapped
       spring; ``mu`` given: Coulomb cap mu with beta0 (default ``default_beta0(e)`` = e, as in
-      scenes; ``beta`` is ignored then). ``beta0 == e`` (Hooke) gives the damped copy of the
-      normal oscillator (``walton_copy``), which follows Walton's rule; any other beta0 a
-      spring with beta = beta0 when uncapped (``walton_mismatch`` says how well it follows).
+      scenes; ``beta`` is ignored then). ``beta0 == e`` gives the damped copy of the normal
+      oscillator (``walton_copy``; a Mindlin spring k_t a for hertz), which follows Walton's
+      rule; any other beta0 a linear spring with beta = beta0 when uncapped
+      (``walton_mismatch`` says whether it follows).
     * hertz needs ``r_eff`` and the normal impact ``speed`` at which t_c (hence beta) is matched.
     """
     if model == "hooke":
@@ -316,13 +321,14 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
         if r_eff is None or speed is None:
             raise ValueError("hertz contacts need r_eff and the impact speed")
         tc = hertz_contact(kn, e, m_eff, r_eff, speed).contact_time
-    xt = 0.0
+    xt, mindlin = 0.0, False
     if mu is not None:
         b0 = default_beta0(e) if beta0 is None else beta0
         if b0 <= -1.0:
             raise ValueError("a Coulomb contact needs beta0 > -1 (a tangential spring)")
-        if model == "hooke" and abs(b0 - e) < 1e-9:
+        if abs(b0 - e) < 1e-9:
             kt, xt = walton_copy(kn, K)
+            mindlin = model == "hertz"
         else:
             kt = tangential_stiffness_for_beta(b0, K, m_eff, tc)
         tangential = "coulomb"
@@ -331,12 +337,13 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
     else:
         kt, tangential = tangential_stiffness_for_beta(beta, K, m_eff, tc), "spring"
     return ContactParameters(model, kn, e, kt, mu, tangential, m_eff, tc,  # type: ignore[arg-type]
-                             xt)
+                             xt, mindlin)
 
 
 def walton_copy(kn: float, K: float) -> tuple[float, float]:
-    """(k_t, x_gamma_t) making the tangential oscillator a scaled copy of the damped Hooke normal
-    one: k_t / m_t = k_n / m_eff and eta_t / m_t = eta_n / m_eff with m_t = K m_eff / (1 + K).
+    """(k_t, x_gamma_t) making the tangential oscillator a scaled copy of the damped normal one:
+    k_t / m_t = k_n / m_eff and eta_t / m_t = eta_n / m_eff with m_t = K m_eff / (1 + K).
+    Hooke: linear spring k_t; Hertz (F_n = k_n a delta): Mindlin spring k_t a, same a.
 
     Then F_t / F_n = K/(1+K) |g_t|/|g_n| at every instant, so a contact sticks throughout (beta
     = e) or slides throughout (Coulomb impulse mu J_n): Walton's rule with beta0 = e, exactly.
@@ -353,21 +360,28 @@ WALTON_TOLERANCE = 0.02
 WALTON_MIN_E = 0.7
 #: lowest e for which beta0 = 1 (undamped spring, omega_t t_c = pi) stays within the tolerance
 WALTON_MIN_E_ELASTIC = 0.9
+#: lowest e for which the Hertz (Mindlin) copy stays within the tolerance (-0.018 at e = 0.9,
+#: pairs at |g| = 1; -0.031 at e = 0.7)
+WALTON_MIN_E_HERTZ = 0.9
 
 
 def walton_mismatch(e: float, beta0: float | None, model: Model) -> str | None:
     """Why the soft Coulomb-capped spring cannot stand for Walton's rule (e, beta0), or None.
 
     It follows Walton only when F_t/F_n stays constant through the contact (tangential and
-    normal oscillators alike): beta0 = e with the damped copy (Hooke, e >= WALTON_MIN_E), or
-    beta0 = 1 for nearly elastic contacts (e >= WALTON_MIN_E_ELASTIC). Any other beta0 gives a
+    normal oscillators alike): beta0 = e with the damped copy (Hooke e >= WALTON_MIN_E, Hertz
+    e >= WALTON_MIN_E_HERTZ), or beta0 = 1 for nearly elastic Hooke contacts
+    (e >= WALTON_MIN_E_ELASTIC). Any other beta0 gives a
     spring that reaches the cap late or lets go early: beta0 = 0, e = 0.98, mu = 0.092 rebounds
     from a wall at 40 deg with 12 % too little spin (beta 0.23 below Walton's at 30 deg).
     """
     b0 = default_beta0(e) if beta0 is None else beta0
     if model == "hertz":
-        return ("a linear tangential spring under a Hertz normal force never keeps F_t/F_n "
-                "constant, so it does not follow Walton's rule (use model 'hooke')")
+        if abs(b0 - e) < 1e-9 and e >= WALTON_MIN_E_HERTZ:
+            return None
+        return (f"with a Hertz normal force only the Mindlin copy (beta0 = e, e >= "
+                f"{WALTON_MIN_E_HERTZ}) follows Walton's rule within {WALTON_TOLERANCE}; "
+                f"beta0 = {b0:g} at e = {e:g} does not (docs/contact.md)")
     if abs(b0 - e) < 1e-9 and e >= WALTON_MIN_E:
         return None
     if b0 == 1.0 and e >= WALTON_MIN_E_ELASTIC:

@@ -52,9 +52,7 @@ def _rule(rule, engine: str, e: float, model: str, where: str) -> dict:
     if rule.model == "coulomb":
         why = mapping.walton_mismatch(e, rule.beta0, model)  # type: ignore[arg-type]
         if why is not None:
-            field = "beta0" if model == "hooke" else "model"
-            value = rule.beta0 if model == "hooke" else "coulomb"
-            raise UnsupportedByEngine(engine, f"{where}.tangential.{field}", value, why)
+            raise UnsupportedByEngine(engine, f"{where}.tangential.beta0", rule.beta0, why)
         return {"mu": rule.mu, "beta0": rule.beta0}
     if rule.model != "campbell-noslip":
         return {"beta": rule.beta}

@@ -23,7 +23,8 @@ def granular_args(p: ContactParameters) -> str:
         return f"{normal} tangential linear_nohistory 0.0 0.0"
     mu = UNCAPPED_MU if p.mu is None else p.mu
     xt = f"{p.xt:.12g}" if p.xt else "0.0"  # tangential damping (the Walton copy, beta0 = e)
-    return f"{normal} tangential linear_history {p.kt:.12g} {xt} {mu:.12g}"
+    law = "mindlin" if p.mindlin else "linear_history"  # Mindlin: k_t a, the Hertz copy
+    return f"{normal} tangential {law} {p.kt:.12g} {xt} {mu:.12g}"
 
 
 def pair_block(scene: Scene, setup: ContactSetup) -> Block:
