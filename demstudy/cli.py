@@ -127,15 +127,45 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from .contact.calibration import format_table
+    from .contact.calibration import CollisionRow, format_motion_table, format_table
+    from .contact.mapping import walton_mismatch
+    from .errors import UnsupportedByEngine
+
+    engine = args.engine
+    if args.beta0 is not None and args.mu is None:
+        raise UnsupportedByEngine(engine, "--beta0", args.beta0, "beta0 is Walton's sticking "
+                                  "restitution: it needs Coulomb friction, --mu")
+    if args.mu is not None and args.beta is not None:
+        raise UnsupportedByEngine(engine, "--beta", args.beta, "with --mu the sticking "
+                                  "restitution is --beta0 (default: e)")
+    sizes = args.sizes or [1.0, 1.0]
+    if args.kind == "wall" and len(sizes) == 2 and sizes[0] != sizes[1]:
+        raise UnsupportedByEngine(engine, "--sizes", " ".join(map(str, sizes)),
+                                  "a wall collision has one particle: give one diameter")
+    try:
+        rows = _calibrate_rows(engine, args, sizes)
+    except UnsupportedByEngine as exc:  # name the command-line option
+        name = exc.field_name if exc.field_name.startswith("--") else f"--{exc.field_name}"
+        raise UnsupportedByEngine(exc.engine, name.replace("steps_per_contact", "steps"),
+                                  exc.value, exc.reason) from exc
+    is_impact = rows and isinstance(rows[0], CollisionRow)
+    print(format_table(rows) if is_impact else format_motion_table(rows))
+    why = (walton_mismatch(args.e, args.beta0, args.model or "hooke")
+           if args.mu is not None else None)
+    if why and args.case == "impact":
+        print(f"note: scenes refuse this rule for soft engines: {why}")
+    return 0
+
+
+def _calibrate_rows(engine: str, args: argparse.Namespace, sizes: list[float]) -> list:
     from .engines import get_backend
 
-    rows = get_backend(args.engine).calibrate(
-        dim=args.dim, kind=args.kind, e=args.e, beta=args.beta,
-        K=args.K if args.K is not None else (0.5 if args.dim == 2 else 0.4), kn=args.kn,
-        steps_per_contact=args.steps, speeds=args.speeds, angles=args.angles)
-    print(format_table(rows))
-    return 0
+    return get_backend(engine).calibrate(
+        case=args.case, dim=args.dim, kind=args.kind, e=args.e,
+        beta=args.beta if args.beta is not None or args.mu is not None else 0.5,
+        mu=args.mu, beta0=args.beta0, K=args.K, kn=args.kn, model=args.model,
+        steps_per_contact=args.steps, speeds=args.speeds, angles=args.angles,
+        sizes=(sizes[0], sizes[-1]), spin=args.spin, alpha=args.alpha, v0=args.speeds[0])
 
 
 def _numbers(option: str, text: str) -> list[float]:
@@ -251,17 +281,38 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_analyze)
 
     soft = [e for e in engines if get_backend(e).capabilities.time_step]
-    p = sub.add_parser("calibrate", help="measure e, beta, t_c of binary soft collisions")
+    p = sub.add_parser("calibrate", help="measure binary soft collisions (e, beta, t_c, peak "
+                                         "force) and wall motions against theory")
     p.add_argument("--engine", default=DEFAULT_ENGINE, choices=soft)
+    p.add_argument("--case", choices=["impact", "rolling", "sliding"], default="impact",
+                   help="impact: binary collisions; rolling: incline (--alpha); sliding: "
+                        "launched at the first --speeds without spin, ends rolling at "
+                        "v0/(1+K)")
     p.add_argument("--dim", type=int, choices=[2, 3], default=3)
-    p.add_argument("--kind", choices=["pair", "wall"], default="pair")
+    p.add_argument("--kind", choices=["pair", "wall"], default=None,
+                   help="impact: two particles or one on a wall (default pair)")
+    p.add_argument("--model", choices=["hooke", "hertz"], default=None,
+                   help="normal force (hertz: kt, dt matched at the largest speed)")
     p.add_argument("--e", type=float, default=0.8)
-    p.add_argument("--beta", type=float, default=0.5)
+    p.add_argument("--beta", type=float, default=None,
+                   help="tangential restitution of an uncapped spring (default 0.5; not with "
+                        "--mu)")
+    p.add_argument("--mu", type=float, default=None, help="Coulomb friction (Walton's rule)")
+    p.add_argument("--beta0", type=float, default=None,
+                   help="Walton's sticking restitution (default: e, as in scenes)")
     p.add_argument("--K", type=float, default=None, help="reduced inertia (default disc/sphere)")
     p.add_argument("--kn", type=float, default=1e5)
     p.add_argument("--steps", type=float, default=200.0, help="steps per contact")
-    p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0, 2.0])
-    p.add_argument("--angles", type=float, nargs="+", default=[0.0, 30.0, 60.0])
+    p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0, 2.0],
+                   help="impact speeds |g| (sliding: the launch speed)")
+    p.add_argument("--angles", type=float, nargs="+", default=[0.0, 30.0, 60.0],
+                   help="impact angles from the normal [deg]")
+    p.add_argument("--spin", type=float, default=0.0,
+                   help="initial angular velocity of particle 1 about the axis normal to the "
+                        "plane of impact")
+    p.add_argument("--sizes", type=float, nargs="+", default=None, metavar="D",
+                   help="diameters of the two particles (masses ∝ d^dim); wall: one")
+    p.add_argument("--alpha", type=float, default=30.0, help="incline angle [deg] (rolling)")
     p.set_defaults(func=_cmd_calibrate)
 
     p = sub.add_parser("cost", parents=[overrides],

@@ -16,7 +16,7 @@ class UnsupportedByEngine(ValueError):
     is allowed instead) are attributes and in the message."""
 
     def __init__(self, engine: str, field_name: str, value: object, reason: str):
-        self.engine, self.field_name, self.value = engine, field_name, value
+        self.engine, self.field_name, self.value, self.reason = engine, field_name, value, reason
         super().__init__(f"unsupported by {engine}: {field_name} = {value!r}: {reason}")
 
 

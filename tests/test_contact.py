@@ -166,3 +166,45 @@ def test_scales_and_helpers():
     assert cm.timestep(0.01, 50) == pytest.approx(2e-4)
     with pytest.raises(ValueError):
         cm.timestep(0.01, 0)
+
+
+# ---------------------------------------------------------------- Walton in a soft contact
+def test_walton_copy_keeps_tangential_and_normal_oscillators_alike():
+    """k_t/m_t = k_n/m_eff with m_t = K m_eff/(1+K); the same for the damping (x_gamma_t)."""
+    for K in (0.4, 0.5):
+        kt, xt = cm.walton_copy(1e5, K)
+        m_eff = 0.5
+        m_t = K * m_eff / (1 + K)
+        assert kt / m_t == pytest.approx(1e5 / m_eff)
+        eta_n = cm.hooke_contact(1e5, 0.7, m_eff).gamma_n
+        assert xt * eta_n / m_t == pytest.approx(eta_n / m_eff)
+        # the default beta0 (= e) picks the copy, an explicit other beta0 an undamped spring
+        p = cm.make_contact(kn=1e5, e=0.7, m_eff=m_eff, K=K, mu=0.3)
+        assert (p.kt, p.xt) == pytest.approx((kt, xt)) and cm.default_beta0(0.7) == 0.7
+        assert cm.make_contact(kn=1e5, e=0.7, m_eff=m_eff, K=K, mu=0.3, beta0=0.5).xt == 0.0
+    with pytest.raises(ValueError, match="xt"):
+        cm.ContactParameters("hooke", 1e5, 0.9, 1.0, None, "spring", 0.5, 0.01, 0.3)
+
+
+def test_walton_mismatch_allows_only_rules_the_spring_follows():
+    assert cm.walton_mismatch(0.9, None, "hooke") is None
+    assert cm.walton_mismatch(0.7, 0.7, "hooke") is None
+    assert cm.walton_mismatch(0.98, 1.0, "hooke") is None
+    for e, b0 in ((0.98, 0.0), (0.8, 1.0), (0.5, None), (0.9, 0.35)):
+        assert "beta0" in cm.walton_mismatch(e, b0, "hooke")
+    assert cm.walton_mismatch(0.9, None, "hertz") is None  # the Mindlin copy
+    assert "Hertz" in cm.walton_mismatch(0.8, None, "hertz")
+    assert "Hertz" in cm.walton_mismatch(0.95, 1.0, "hertz")
+    hertz = cm.make_contact(kn=1e6, e=0.9, m_eff=0.5, K=0.4, mu=0.3, model="hertz", r_eff=0.25,
+                            speed=1.0)
+    assert hertz.mindlin and "tangential mindlin" in granular_args(hertz)
+    assert "tangential linear_history" in granular_args(
+        cm.make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, mu=0.3))
+
+
+def test_peak_forces_reduce_to_elastic_formulas():
+    assert cm.hooke_peak_force(1e5, 1.0, 0.5, 2.0) == pytest.approx(2.0 * math.sqrt(0.5e5))
+    assert cm.hooke_peak_force(1e5, 0.5, 0.5, 2.0) < cm.hooke_peak_force(1e5, 0.99, 0.5, 2.0)
+    h = cm.hertz_contact(1e6, 1.0, 0.5, 0.25, 1.0)
+    dmax = (5 * 0.5 / (4 * 1e6 * math.sqrt(0.25))) ** 0.4
+    assert h.peak_force == pytest.approx(1e6 * math.sqrt(0.25) * dmax**1.5, rel=1e-5)

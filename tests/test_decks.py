@@ -113,7 +113,11 @@ def test_tangential_history_only_for_rough_contacts(make, dim):
     assert "tangential linear_history" in pair
     coulomb = deck_of(make(dim, contact={"tangential": {"model": "coulomb", "mu": 0.3}}))
     (pair,) = with_prefix(coulomb, "pair_coeff")
-    assert pair.endswith(" 0.0 0.3")
+    # default beta0 = e: the damped copy of the normal oscillator, x_gamma_t = K / (1 + K)
+    K = 0.5 if dim == 2 else 0.4
+    kt, xt, mu = (float(x) for x in pair.split()[-3:])
+    assert xt == pytest.approx(K / (1 + K)) and mu == 0.3
+    assert kt == pytest.approx(K / (1 + K) * float(pair.split()[4]))
 
 
 def test_rough_wall_alone_gives_wall_history_only(make):

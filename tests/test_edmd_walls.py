@@ -225,6 +225,24 @@ def test_walton_wall_slides_below_mu_and_sticks_above(dim):
         assert checked >= 10
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_walton_default_beta0_is_each_collisions_e(dim):
+    """beta0_from_e (a scene's unset beta0): sticking impacts restitute g_t like g_n, with the
+    speed-dependent e of that collision (Gutt's law), not the unused beta0 value."""
+    rng = np.random.default_rng(7 + dim)
+    n = np.array([0.0, -1.0, 0.0])
+    rule = {"law": "gutt-piecewise", "e1": 0.9, "e2": 0.3, "crossover_speed": 0.5,
+            "tangential": "coulomb", "mu": 10.0, "beta0": -0.5, "beta0_from_e": True}
+    es = []
+    for _ in range(20):
+        v, w, v2, w2, u, _ = one_wall_collision(rng, dim, "lower", rule, 0.4)
+        g, g2 = contact_velocity(v, w, u, 0.5, n), contact_velocity(v2, w2, u, 0.5, n)
+        gt, e_n = g - (g @ n) * n, -(g2 @ n) / (g @ n)
+        np.testing.assert_allclose(g2 - (g2 @ n) * n, -e_n * gt, atol=1e-12)
+        es.append(e_n)
+    assert max(es) - min(es) > 0.05  # e really varied between collisions
+
+
 # ---- 2. velocity-dependent restitution ------------------------------------------------------
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -100,7 +100,9 @@ def test_event_driven_core_options_only_for_present_effects():
     assert law["pair"]["law"] == "gutt-piecewise" and law["beta"] == -1.0
     coulomb = core_options(scene(contact={"restitution": 0.9, "tangential": {
         "model": "coulomb", "mu": 0.3}}))
-    assert coulomb["pair"] == {"tangential": "coulomb", "mu": 0.3, "beta0": 0.0}
+    # unset beta0 = e of each collision (mapping.default_beta0), in the core as in soft engines
+    assert coulomb["pair"] == {"tangential": "coulomb", "mu": 0.3, "beta0": 0.9,
+                               "beta0_from_e": True}
 
 
 def test_the_campbell_noslip_preset_runs_only_where_it_can():

@@ -31,6 +31,21 @@ Model = Literal["hooke", "hertz"]
 Tangential = Literal["none", "spring", "coulomb"]
 
 
+
+def default_beta0(e: float) -> float:
+    """Walton's sticking tangential restitution when a Coulomb rule leaves beta0 unset: beta0 = e,
+    everywhere (scenes, ``make_contact``, ``calibrate``, the CLI, the event-driven core).
+
+    Why: the contact's tangential compliance is taken to dissipate like its normal one (same
+    damping ratio), so a sticking impact restitutes its tangential velocity as its normal one;
+    e = 1 gives the elastic limit beta0 = 1 (k_t = K/(1+K) k_n, 2/7 k_n for spheres). It is the
+    one beta0 whose soft Coulomb-capped spring *is* Walton's rule: with the tangential oscillator
+    a scaled copy of the normal one (``walton_copy``), F_t/F_n is constant through the contact,
+    so the cap is reached at once (gross sliding, impulse mu J_n) or never (beta = beta0).
+    """
+    return e
+
+
 # ---------------------------------------------------------------- masses, radii, inertia
 def pair_mass(m1: float, m2: float) -> float:
     """Reduced mass m1 m2 / (m1 + m2) of a particle pair (m/2 for equal particles)."""
@@ -81,6 +96,19 @@ def hooke_contact(kn: float, e: float, m_eff: float) -> HookeContact:
     return HookeContact(kn, e, m_eff, gamma, math.pi / math.sqrt(omega_d2))
 
 
+def hooke_peak_force(kn: float, e: float, m_eff: float, v: float) -> float:
+    """Largest total normal force k_n delta + gamma_n delta' of a damped linear contact hit at
+    normal speed v: v sqrt(m_eff k_n) times a factor of e alone (1 at e = 1, where it is the
+    elastic k_n delta_max); the damping force adds at touch-down, the spring later."""
+    z = damping_ratio(e)
+    w0 = 1.0  # scaled units: k_n = m_eff = v = 1
+    wd = math.sqrt(1.0 - z * z)
+    t = np.linspace(0.0, math.pi / wd, 20001)
+    delta = np.exp(-z * w0 * t) * np.sin(wd * t) / wd
+    rate = np.exp(-z * w0 * t) * (np.cos(wd * t) - z / wd * np.sin(wd * t))
+    return float(np.max(delta + 2.0 * z * rate)) * v * math.sqrt(m_eff * kn)
+
+
 def _overlap_factor(e: float) -> float:
     """delta_max / (v sqrt(m_eff/kn)) = exp(-zeta arccos(zeta) / sqrt(1 - zeta^2))."""
     z = damping_ratio(e)
@@ -104,8 +132,8 @@ def hertz_damping_constant(e: float) -> float:
 
 
 @lru_cache(maxsize=256)
-def _hertz_scaled(c: float) -> tuple[float, float, float]:
-    """Solve x'' = -x^1.5 - c x^0.25 x', x(0) = 0, x'(0) = 1: return (e, t_c, x_max)."""
+def _hertz_scaled(c: float) -> tuple[float, float, float, float]:
+    """Solve x'' = -x^1.5 - c x^0.25 x', x(0) = 0, x'(0) = 1: return (e, t_c, x_max, F_max)."""
     from scipy.integrate import solve_ivp  # noqa: PLC0415 - ~0.25 s to import, Hertz only
 
     def rhs(_t: float, y: np.ndarray) -> list[float]:
@@ -122,7 +150,9 @@ def _hertz_scaled(c: float) -> tuple[float, float, float]:
     t_c = float(sol.t_events[0][0])
     e = -float(sol.y_events[0][0][1])
     ts = np.linspace(0.0, t_c, 4001)
-    return e, t_c, float(sol.sol(ts)[0].max())
+    x, xdot = sol.sol(ts)
+    xp = np.maximum(x, 0.0)
+    return e, t_c, float(x.max()), float(np.max(xp**1.5 + c * xp**0.25 * xdot))
 
 
 @dataclass(frozen=True)
@@ -136,6 +166,7 @@ class HertzContact:
     v: float
     contact_time: float
     max_overlap: float
+    peak_force: float
 
 
 def _hertz_scales(kn: float, m_eff: float, r_eff: float, v: float) -> tuple[float, float]:
@@ -150,11 +181,14 @@ def hertz_contact(kn: float, e: float, m_eff: float, r_eff: float, v: float) -> 
     Force ``kn sqrt(r_eff) delta^1.5 + sqrt(5) zeta sqrt(m_eff kn) (r_eff delta)^(1/4) v_n``.
     The ODE's own restitution is returned as ``e`` (it equals the input to ~1e-9, at any v);
     t_c and delta_max scale as v^(-1/5) and v^(4/5).
-    Undamped limit: t_c = 2.9432 delta_max / v, delta_max = (5 m v^2 / (4 kn sqrt R))^(2/5).
+    Undamped limit: t_c = 2.9432 delta_max / v, delta_max = (5 m v^2 / (4 kn sqrt R))^(2/5),
+    peak force kn sqrt(R) delta_max^1.5 (``peak_force``: largest total normal force, damping
+    included, in the force unit m_eff v^2 / delta0).
     """
-    e_ode, tc, xmax = _hertz_scaled(round(hertz_damping_constant(e), 14))
+    e_ode, tc, xmax, fmax = _hertz_scaled(round(hertz_damping_constant(e), 14))
     delta0, tau = _hertz_scales(kn, m_eff, r_eff, v)
-    return HertzContact(kn, e_ode, m_eff, r_eff, v, tc * tau, xmax * delta0)
+    return HertzContact(kn, e_ode, m_eff, r_eff, v, tc * tau, xmax * delta0,
+                        fmax * m_eff * v * v / delta0)
 
 
 def hertz_kn_for_overlap(overlap: float, v: float, m_eff: float, r_eff: float, e: float,
@@ -243,6 +277,10 @@ class ContactParameters:
     tangential: Tangential
     m_eff: float
     contact_time: float
+    #: LAMMPS tangential damping factor x_gamma_t (eta_t = xt eta_n); 0 = undamped spring
+    xt: float = 0.0
+    #: Mindlin spring k_t a (a = contact radius, LAMMPS ``tangential mindlin``): the Hertz copy
+    mindlin: bool = False
 
     def __post_init__(self) -> None:
         if self.model not in ("hooke", "hertz"):
@@ -255,6 +293,10 @@ class ContactParameters:
             raise ValueError("'coulomb' contacts need mu >= 0")
         if self.tangential not in ("none", "spring", "coulomb"):
             raise ValueError(f"unknown tangential model {self.tangential!r}")
+        if self.xt < 0.0 or (self.xt and self.tangential != "coulomb"):
+            raise ValueError("tangential damping xt >= 0 is only used by 'coulomb' contacts")
+        if self.mindlin and (self.model != "hertz" or self.tangential != "coulomb"):
+            raise ValueError("the Mindlin spring is only used by hertz 'coulomb' contacts")
 
     def timestep(self, steps_per_contact: float) -> float:
         return timestep(self.contact_time, steps_per_contact)
@@ -266,7 +308,11 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
     """Contact parameters for a target (e, beta) or a Walton (e, mu, beta0) collision rule.
 
     * ``beta`` None or -1 and ``mu`` None: smooth; ``beta`` in (-1, 1] with ``mu`` None: uncapped
-      spring; ``mu`` given: Coulomb cap mu with kt from ``beta0`` (default: ``beta``, else 1).
+      spring; ``mu`` given: Coulomb cap mu with beta0 (default ``default_beta0(e)`` = e, as in
+      scenes; ``beta`` is ignored then). ``beta0 == e`` gives the damped copy of the normal
+      oscillator (``walton_copy``; a Mindlin spring k_t a for hertz), which follows Walton's
+      rule; any other beta0 a linear spring with beta = beta0 when uncapped
+      (``walton_mismatch`` says whether it follows).
     * hertz needs ``r_eff`` and the normal impact ``speed`` at which t_c (hence beta) is matched.
     """
     if model == "hooke":
@@ -275,13 +321,72 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
         if r_eff is None or speed is None:
             raise ValueError("hertz contacts need r_eff and the impact speed")
         tc = hertz_contact(kn, e, m_eff, r_eff, speed).contact_time
+    xt, mindlin = 0.0, False
     if mu is not None:
-        b0 = beta0 if beta0 is not None else (beta if beta is not None else 1.0)
+        b0 = default_beta0(e) if beta0 is None else beta0
         if b0 <= -1.0:
             raise ValueError("a Coulomb contact needs beta0 > -1 (a tangential spring)")
-        kt, tangential = tangential_stiffness_for_beta(b0, K, m_eff, tc), "coulomb"
+        if abs(b0 - e) < 1e-9:
+            kt, xt = walton_copy(kn, K)
+            mindlin = model == "hertz"
+        else:
+            kt = tangential_stiffness_for_beta(b0, K, m_eff, tc)
+        tangential = "coulomb"
     elif beta is None or beta == -1.0:
         kt, tangential = 0.0, "none"
     else:
         kt, tangential = tangential_stiffness_for_beta(beta, K, m_eff, tc), "spring"
-    return ContactParameters(model, kn, e, kt, mu, tangential, m_eff, tc)  # type: ignore[arg-type]
+    return ContactParameters(model, kn, e, kt, mu, tangential, m_eff, tc,  # type: ignore[arg-type]
+                             xt, mindlin)
+
+
+def walton_copy(kn: float, K: float) -> tuple[float, float]:
+    """(k_t, x_gamma_t) making the tangential oscillator a scaled copy of the damped normal one:
+    k_t / m_t = k_n / m_eff and eta_t / m_t = eta_n / m_eff with m_t = K m_eff / (1 + K).
+    Hooke: linear spring k_t; Hertz (F_n = k_n a delta): Mindlin spring k_t a, same a.
+
+    Then F_t / F_n = K/(1+K) |g_t|/|g_n| at every instant, so a contact sticks throughout (beta
+    = e) or slides throughout (Coulomb impulse mu J_n): Walton's rule with beta0 = e, exactly.
+    """
+    c = K / (1.0 + K)
+    return c * kn, c
+
+
+#: largest |beta_soft - beta_Walton| over impact angles that scenes accept for a Coulomb rule
+WALTON_TOLERANCE = 0.02
+#: lowest e for which the damped copy (beta0 = e) stays within WALTON_TOLERANCE: below, the
+#: attractive end of the damped normal force adds mu |F_n| of tangential impulse (0.015 at
+#: e = 0.7, 0.041 at e = 0.5; docs/contact.md)
+WALTON_MIN_E = 0.7
+#: lowest e for which beta0 = 1 (undamped spring, omega_t t_c = pi) stays within the tolerance
+WALTON_MIN_E_ELASTIC = 0.9
+#: lowest e for which the Hertz (Mindlin) copy stays within the tolerance (-0.018 at e = 0.9,
+#: pairs at |g| = 1; -0.031 at e = 0.7)
+WALTON_MIN_E_HERTZ = 0.9
+
+
+def walton_mismatch(e: float, beta0: float | None, model: Model) -> str | None:
+    """Why the soft Coulomb-capped spring cannot stand for Walton's rule (e, beta0), or None.
+
+    It follows Walton only when F_t/F_n stays constant through the contact (tangential and
+    normal oscillators alike): beta0 = e with the damped copy (Hooke e >= WALTON_MIN_E, Hertz
+    e >= WALTON_MIN_E_HERTZ), or beta0 = 1 for nearly elastic Hooke contacts
+    (e >= WALTON_MIN_E_ELASTIC). Any other beta0 gives a
+    spring that reaches the cap late or lets go early: beta0 = 0, e = 0.98, mu = 0.092 rebounds
+    from a wall at 40 deg with 12 % too little spin (beta 0.23 below Walton's at 30 deg).
+    """
+    b0 = default_beta0(e) if beta0 is None else beta0
+    if model == "hertz":
+        if abs(b0 - e) < 1e-9 and e >= WALTON_MIN_E_HERTZ:
+            return None
+        return (f"with a Hertz normal force only the Mindlin copy (beta0 = e, e >= "
+                f"{WALTON_MIN_E_HERTZ}) follows Walton's rule within {WALTON_TOLERANCE}; "
+                f"beta0 = {b0:g} at e = {e:g} does not (docs/contact.md)")
+    if abs(b0 - e) < 1e-9 and e >= WALTON_MIN_E:
+        return None
+    if b0 == 1.0 and e >= WALTON_MIN_E_ELASTIC:
+        return None
+    return (f"a Coulomb-capped soft spring follows Walton's rule within {WALTON_TOLERANCE} only "
+            f"for beta0 = e with e >= {WALTON_MIN_E} (the default) or beta0 = 1 with e >= "
+            f"{WALTON_MIN_E_ELASTIC}; beta0 = {b0:g} at e = {e:g} misses it by up to ~0.2 near "
+            "the stick/slip crossover (docs/contact.md)")

@@ -45,9 +45,14 @@ class ContactSetup:
     kn: float
 
 
-def _rule(rule, engine: str) -> dict:
-    """make_contact's arguments for a tangential rule (smooth, beta and rough all carry β)."""
+def _rule(rule, engine: str, e: float, model: str, where: str) -> dict:
+    """make_contact's arguments for a tangential rule (smooth, beta and rough all carry β);
+    refuses a Coulomb rule whose soft spring would not follow Walton's rule (``where`` names
+    the scene field: 'contact' or 'walls')."""
     if rule.model == "coulomb":
+        why = mapping.walton_mismatch(e, rule.beta0, model)  # type: ignore[arg-type]
+        if why is not None:
+            raise UnsupportedByEngine(engine, f"{where}.tangential.beta0", rule.beta0, why)
         return {"mu": rule.mu, "beta0": rule.beta0}
     if rule.model != "campbell-noslip":
         return {"beta": rule.beta}
@@ -106,7 +111,8 @@ def contact_setup(scene: Scene, engine: str = "soft contacts") -> ContactSetup:
         speed = max(speed, scene.soft.hardness.impact_speed)  # Hertz t_c shrinks with speed
     extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
     pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
-                                **_rule(scene.contact.tangential, engine), **extra)
+                                **_rule(scene.contact.tangential, engine, e, model, "contact"),
+                                **extra)
     walls = {w.side: _wall_contact(w, kn, K, model, speed, engine) for w in scene.walls}
     dt = mapping.timestep(shortest_contact_time(scene, kn, speed), scene.soft.steps_per_contact)
     return ContactSetup(pair, walls, dt, kn)
@@ -115,4 +121,5 @@ def contact_setup(scene: Scene, engine: str = "soft contacts") -> ContactSetup:
 def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float, engine: str):
     extra = {"r_eff": 0.5, "speed": speed} if model == "hertz" else {}
     return mapping.make_contact(kn=kn, e=wall.restitution, m_eff=1.0, K=K, model=model,
-                                **_rule(wall.tangential, engine), **extra)
+                                **_rule(wall.tangential, engine, wall.restitution, model, "walls"),
+                                **extra)

@@ -90,7 +90,12 @@ class Coulomb(StrictModel):
 
     model: Literal["coulomb"]
     mu: float = Field(ge=0.0, le=1e3)
-    beta0: float = Field(default=0.0, ge=-1.0, le=1.0)
+    beta0: float | None = Field(
+        default=None, ge=-1.0, le=1.0,
+        description="sticking tangential restitution; unset = the contact's normal restitution "
+                    "e (per collision for velocity-dependent e): a tangential compliance that "
+                    "dissipates like the normal one, e = 1 the elastic limit, and the only β₀ a "
+                    "soft Coulomb-capped spring reproduces exactly (docs/contact.md)")
 
 
 class NoSlip(StrictModel):

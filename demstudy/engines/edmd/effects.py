@@ -20,7 +20,11 @@ def collision_rule(restitution: float, rule, law=None, gravity: float | None = N
     """Collision-rule options of the core from a restitution, a tangential rule and a law."""
     out: dict = {"e": float(restitution)}
     if rule.model == "coulomb":
-        out.update(tangential="coulomb", mu=float(rule.mu), beta0=float(rule.beta0))
+        out.update(tangential="coulomb", mu=float(rule.mu))
+        if rule.beta0 is None:  # β₀ = e of each collision (default_beta0)
+            out.update(beta0=float(restitution), beta0_from_e=True)
+        else:
+            out.update(beta0=float(rule.beta0))
     elif rule.model == "campbell-noslip":
         out.update(tangential="noslip")
     else:

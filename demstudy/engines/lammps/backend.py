@@ -115,9 +115,9 @@ class LammpsBackend(BackendBase):
 
     @classmethod
     def calibrate(cls, **settings) -> list:
-        from .calibrate import calibrate
+        from .calibrate import calibrate_case
 
-        return calibrate(**settings)
+        return calibrate_case(**settings)
 
     def __init__(self, scene: Scene, options, workdir: Path):
         super().__init__(scene, options, workdir)

@@ -1,14 +1,17 @@
-"""Measure e, beta and contact time of LAMMPS ``granular`` contacts from isolated collisions.
+"""Measure e, beta, contact time and peak force of LAMMPS ``granular`` contacts from isolated
+collisions, and the slow wall motions (incline rolling, sliding to rolling) of ``motion.py``.
 
-Units: dimensionless particle units, diameter d = 1, mass m = 1 (g = 1 on the incline).
+Units: dimensionless particle units, diameter d = 1, mass m = 1 (masses ∝ d^dim for other
+sizes; g = 1 on the incline and in the sliding case).
 Each collision is a fresh LAMMPS instance (opened with ``open_lammps``) holding
-two equal particles (``kind='pair'``) or one particle above a ``wall/gran granular`` plane
-(``kind='wall'``), stepped one step at a time. Contact-point relative velocities
-``g = v_i - v_j - (R_i w_i + R_j w_j) x n`` (wall: ``v_i - R w_i x n``) are projected on the
-collision normal n, the direction of the total normal impulse sum_k (f_k.n_k) n_k (the line of
-centres turns by ~ g_t t_c / d during an oblique pair contact); e = -g'.n / g.n and
-beta = -g'_t.t / |g_t|, t the unit pre-collision tangential direction. The contact time is the time
-the overlap (hence the force) is positive, from interpolated zero crossings of the overlap.
+two particles (``kind='pair'``, diameters ``sizes``) or one particle above a
+``wall/gran granular`` plane (``kind='wall'``), stepped one step at a time. Contact-point
+relative velocities ``g = v_i - v_j - (R_i w_i + R_j w_j) x n`` (wall: ``v_i - R w_i x n``) are
+projected on the collision normal n, the direction of the total normal impulse
+sum_k (f_k.n_k) n_k (the line of centres turns by ~ g_t t_c / d during an oblique pair
+contact); e = -g'.n / g.n and beta = -g'_t.t / |g_t|, t the unit pre-collision tangential
+direction. The contact time is the time the overlap (hence the force) is positive, from
+interpolated zero crossings of the overlap; the peak force is the largest f.n on particle i.
 """
 
 from __future__ import annotations
@@ -20,12 +23,13 @@ from typing import Literal
 
 import numpy as np
 
-from ...contact.calibration import CollisionRow, incline_acceleration
+from ...contact.calibration import CollisionRow, MotionRow
 from ...contact.mapping import (
     ContactParameters,
     Model,
     hertz_contact,
     hooke_contact,
+    hooke_peak_force,
     inertia_factor,
     make_contact,
     pair_mass,
@@ -33,146 +37,172 @@ from ...contact.mapping import (
     spring_beta,
     walton_beta,
 )
-from .deck.contact import granular_args
-from .library import open_lammps
+from ...errors import UnsupportedByEngine
+from .bodies import Atom, open_bodies, read_state
+from .motion import rolling_acceleration, sliding_to_rolling
+
+__all__ = ["Impact", "calibrate", "calibrate_case", "collide", "impact",
+           "rolling_acceleration", "sliding_to_rolling"]
 
 Kind = Literal["pair", "wall"]
+Case = Literal["impact", "rolling", "sliding"]
 
 
-def _f(x: float) -> str:
-    return repr(float(x))
-
-
-def _open(dim: int, wall: bool, params: ContactParameters, dt: float, d: float, m: float,
-          atoms: Sequence[Sequence[float]], gravity: tuple[float, float] | None = None):
-    """A LAMMPS instance with the given particles (x, y, z, vx, vy, vz) and contact model."""
-    lmp = open_lammps()
-    half = 5.0 * d
-    zlo, zhi = (-0.5 * d, 0.5 * d) if dim == 2 else (-half, half)
-    ylo = -d if wall else -half
-    cmds = [
-        "units lj", f"dimension {dim}", "atom_style sphere",
-        f"boundary p {'f' if wall else 'p'} p", "atom_modify map array sort 0 0.0",
-        "comm_modify vel yes",
-        f"region box block {-half} {half} {ylo} {half} {zlo} {zhi}", "create_box 1 box",
-    ]
-    cmds += [f"create_atoms 1 single {_f(a[0])} {_f(a[1])} {_f(a[2])}" for a in atoms]
-    cmds += [f"set type 1 diameter {_f(d)}", f"set type 1 mass {_f(m)}"]
-    cmds += [f"set atom {i + 1} vx {_f(a[3])} vy {_f(a[4])} vz {_f(a[5])} omega 0 0 0"
-             for i, a in enumerate(atoms)]
-    cmds += ["pair_style granular", f"pair_coeff * * {granular_args(params)}",
-             "neighbor 0.2 bin", "neigh_modify every 1 delay 0 check yes",
-             f"fix integrate all nve/sphere{' disc' if dim == 2 else ''}"]
+def _overlap_normal(x: np.ndarray, wall: bool, r: Sequence[float]) -> tuple[float, np.ndarray]:
     if wall:
-        cmds.append(f"fix wall all wall/gran granular {granular_args(params)} yplane 0.0 NULL")
-    if gravity is not None:
-        cmds.append(f"fix grav all gravity 1.0 vector {_f(gravity[0])} {_f(gravity[1])} 0.0")
-    if dim == 2:
-        cmds.append("fix planar all enforce2d")
-    cmds += [f"timestep {_f(dt)}", "run 0"]
-    lmp.commands_string("\n".join(cmds))
-    return lmp
+        return r[0] - x[0, 1], np.array([0.0, 1.0, 0.0])
+    sep = x[0] - x[1]
+    dist = float(np.linalg.norm(sep))
+    return r[0] + r[1] - dist, sep / dist
 
 
-def _state(lmp, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    order = np.argsort(lmp.numpy.extract_atom("id")[:n])
-    get = lmp.numpy.extract_atom
-    return get("x")[:n][order].copy(), get("v")[:n][order].copy(), get("omega")[:n][order].copy()
-
-
-def _overlap_normal(x: np.ndarray, wall: bool, d: float) -> tuple[float, np.ndarray]:
+def _contact_velocity(v: np.ndarray, w: np.ndarray, n: np.ndarray, wall: bool,
+                      r: Sequence[float]) -> np.ndarray:
     if wall:
-        return 0.5 * d - x[0, 1], np.array([0.0, 1.0, 0.0])
-    r = x[0] - x[1]
-    dist = float(np.linalg.norm(r))
-    return d - dist, r / dist
+        return v[0] - r[0] * np.cross(w[0], n)
+    return v[0] - v[1] - np.cross(r[0] * w[0] + r[1] * w[1], n)
 
 
-def _contact_velocity(v: np.ndarray, w: np.ndarray, n: np.ndarray, wall: bool, d: float):
-    if wall:
-        return v[0] - 0.5 * d * np.cross(w[0], n)
-    return v[0] - v[1] - 0.5 * d * np.cross(w[0] + w[1], n)
+@dataclass(frozen=True)
+class Impact:
+    """One measured collision. States (x, v, omega per particle, id order) before and after;
+    ``normal`` is the collision normal (direction of the total normal impulse)."""
+
+    e: float
+    beta: float
+    contact_time: float
+    spin_after: float
+    peak_force: float
+    normal: np.ndarray
+    masses: np.ndarray
+    diameters: np.ndarray
+    before: tuple[np.ndarray, np.ndarray, np.ndarray]
+    after: tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def collide(dim: int, kind: Kind, params: ContactParameters, speed: float, angle: float,
-            dt: float, d: float = 1.0, m: float = 1.0,
-            phase: float = 0.5) -> tuple[float, float, float, float]:
-    """One isolated collision; returns (e, beta, contact time, max |omega| after).
+def impact(dim: int, kind: Kind, params: ContactParameters, speed: float, angle: float,
+           dt: float, *, sizes: Sequence[float] = (1.0, 1.0), spin: float = 0.0,
+           phase: float = 0.5, masses: Sequence[float] | None = None) -> Impact:
+    """One isolated collision of particle 1 (diameter ``sizes[0]``, spin ``spin`` about z, the
+    axis normal to the plane of impact) with particle 2 (``sizes[1]``, no spin) or a wall.
 
-    The relative velocity has magnitude ``speed`` at ``angle`` degrees from the inward normal;
-    the pair's centre of mass is at rest; spins start at zero; the first overlap arrives
-    ``phase`` steps after the start (0 < phase <= 1). beta is NaN for a head-on impact.
+    The centres' relative velocity has magnitude ``speed`` at ``angle`` degrees from the inward
+    normal (the contact point also moves by the spin); the pair's centre of mass is at rest;
+    masses ∝ d^dim unless given; the first overlap arrives ``phase`` steps after the start.
     """
     if not (0.0 <= angle < 90.0 and speed > 0.0 and 0.0 < phase <= 1.0):
         raise ValueError("need 0 <= angle < 90 degrees, speed > 0 and 0 < phase <= 1")
     wall = kind == "wall"
+    d = [float(s) for s in sizes[: 1 if wall else 2]]
+    m = [di**dim for di in d] if masses is None else [float(x) for x in masses[: len(d)]]
+    r = [0.5 * di for di in d]
     th = math.radians(angle)
     g = np.array([speed * math.sin(th), -speed * math.cos(th), 0.0])  # normal = +y at touch
     t0 = phase * dt
     if wall:
-        atoms = [(0.0, 0.5 * d - g[1] * t0, 0.0, *g)]
+        atoms: list[Atom] = [(0.0, r[0] - g[1] * t0, 0.0, *g, spin, d[0], m[0])]
     else:
-        r0 = np.array([0.0, d, 0.0]) - g * t0
-        atoms = [(*(0.5 * r0), *(0.5 * g)), (*(-0.5 * r0), *(-0.5 * g))]
-    lmp = _open(dim, wall, params, dt, d, m, atoms)
-    n_at = 1 if wall else 2
+        sep, mt = np.array([0.0, r[0] + r[1], 0.0]) - g * t0, m[0] + m[1]
+        atoms = [(*(m[1] / mt * sep), *(m[1] / mt * g), spin, d[0], m[0]),
+                 (*(-m[0] / mt * sep), *(-m[0] / mt * g), 0.0, d[1], m[1])]
+    lmp = open_bodies(dim, wall, params, dt, atoms)
+    n_at = len(atoms)
     try:
-        order = np.argsort(lmp.numpy.extract_atom("id")[:n_at])
-        x, _, _ = _state(lmp, n_at)
-        prev, _ = _overlap_normal(x, wall, d)
+        x, v, w, _ = read_state(lmp, n_at)
+        before = (x, v, w)
+        prev = _overlap_normal(x, wall, r)[0]
         t_in = t_out = None
-        normals = []
-        for step in range(1, 100000):
+        normals, peak = [], 0.0
+        for step in range(1, 1_000_000):
             lmp.command("run 1 pre no post no")
-            x, v, w = _state(lmp, n_at)
-            ov, n = _overlap_normal(x, wall, d)
+            x, v, w, f = read_state(lmp, n_at)
+            ov, n = _overlap_normal(x, wall, r)
             if t_in is None and ov > 0.0:
                 t_in = (step - 1 + -prev / (ov - prev)) * dt
             if ov > 0.0:
-                force = lmp.numpy.extract_atom("f")[:n_at][order][0]
-                normals.append(float(force @ n) * n)
+                fn = float(f[0] @ n)
+                normals.append(fn * n)
+                peak = max(peak, fn)
             elif t_in is not None:
                 t_out = (step - 1 + prev / (prev - ov)) * dt
                 break
             prev = ov
     finally:
         lmp.close()
-    if t_out is None:
+    if t_out is None or t_in is None:
         raise RuntimeError("the particles never separated")
     nc = np.sum(normals, axis=0)
     nc /= np.linalg.norm(nc)
-    g_after = _contact_velocity(v, w, nc, wall, d)
-    gn, gn2 = float(g @ nc), float(g_after @ nc)
-    gt = g - gn * nc
+    g0 = _contact_velocity(before[1], before[2], nc, wall, r)
+    g1 = _contact_velocity(v, w, nc, wall, r)
+    gn, gn2 = float(g0 @ nc), float(g1 @ nc)
+    gt = g0 - gn * nc
     gt_norm = float(np.linalg.norm(gt))
-    beta = -float((g_after - gn2 * nc) @ gt) / gt_norm**2 if gt_norm > 1e-12 * speed else math.nan
-    return -gn2 / gn, beta, t_out - t_in, float(np.abs(w).max())
+    beta = -float((g1 - gn2 * nc) @ gt) / gt_norm**2 if gt_norm > 1e-12 * speed else math.nan
+    return Impact(-gn2 / gn, beta, t_out - t_in, float(np.abs(w).max()), peak, nc,
+                  np.array(m), np.array(d), before, (x, v, w))
 
 
-def _normal_time(params: ContactParameters, r_eff: float, vn: float) -> float:
+def collide(dim: int, kind: Kind, params: ContactParameters, speed: float, angle: float,
+            dt: float, d: float = 1.0, m: float = 1.0,
+            phase: float = 0.5) -> tuple[float, float, float, float]:
+    """(e, beta, contact time, max |omega| after) of one collision of equal particles (mass m,
+    diameter d) without initial spin; see ``impact`` for everything else."""
+    r = impact(dim, kind, params, speed, angle, dt, sizes=(d, d), masses=(m, m), phase=phase)
+    return r.e, r.beta, r.contact_time, r.spin_after
+
+
+def _normal_targets(params: ContactParameters, r_eff: float, vn: float) -> tuple[float, float]:
+    """Contact time and peak normal force of the damped Hooke oscillator or Hertz ODE."""
     if params.model == "hooke":
-        return hooke_contact(params.kn, params.restitution, params.m_eff).contact_time
-    return hertz_contact(params.kn, params.restitution, params.m_eff, r_eff, vn).contact_time
+        tc = hooke_contact(params.kn, params.restitution, params.m_eff).contact_time
+        return tc, hooke_peak_force(params.kn, params.restitution, params.m_eff, vn)
+    h = hertz_contact(params.kn, params.restitution, params.m_eff, r_eff, vn)
+    return h.contact_time, h.peak_force
+
+
+def _beta_target(params: ContactParameters, K: float, tc: float, ratio: float) -> float:
+    """The hard rule the contact stands for, at |g_t|/|g_n| = ratio (NaN head-on)."""
+    if ratio == 0.0:
+        return math.nan
+    if params.tangential == "none":
+        return -1.0
+    b0 = spring_beta(params.kt, K, params.m_eff, tc)
+    if params.tangential == "spring":
+        return b0
+    if params.xt > 0.0:  # the damped copy (beta0 = e): sticks with the normal restitution
+        b0 = params.restitution
+    return walton_beta(params.mu or 0.0, b0, params.restitution, K, ratio)
 
 
 def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None = None,
               mu: float | None = None, beta0: float | None = None, K: float | None = None,
               kn: float = 1e5, steps_per_contact: float = 200,
               speeds: Sequence[float] = (1.0,), angles: Sequence[float] = (0.0, 30.0, 60.0),
-              model: Model = "hooke", d: float = 1.0, m: float = 1.0) -> list[CollisionRow]:
+              model: Model = "hooke", sizes: Sequence[float] = (1.0, 1.0),
+              spin: float = 0.0) -> list[CollisionRow]:
     """Map (e, beta | mu, beta0) to LAMMPS parameters, then measure them in binary collisions.
 
     ``K`` defaults to the LAMMPS body (disc 1/2 in 2D, sphere 2/5 in 3D); another value is
-    refused since LAMMPS fixes the moment of inertia. Hertz parameters (kt, time step) are
-    matched at the largest speed; its beta target at other normal speeds uses that speed's t_c.
-    Coulomb targets use Walton's rule with the impact ratio |g_t| / |g_n| = tan(angle) and, as
-    beta0, the spring's own beta. Targets for e are the input e; for t_c the damped formula.
+    refused since LAMMPS fixes the moment of inertia. ``beta0`` unset = e (``default_beta0``,
+    as in scenes). Hertz parameters (kt, time step) are matched at the largest speed; its beta
+    target at other normal speeds uses that speed's t_c. Coulomb targets use Walton's rule at
+    the contact point's |g_t| / |g_n| (spin included). Targets: e the input; t_c and the peak
+    normal force of the damped Hooke oscillator / Hertz ODE at the normal speed.
+    ``sizes``: the two diameters (a wall collision uses the first); masses ∝ d^dim.
     """
     k_body = inertia_factor(dim)
     if K is not None and abs(K - k_body) > 1e-12:
-        raise ValueError(f"LAMMPS {'discs' if dim == 2 else 'spheres'} have K = {k_body}")
-    m_eff = m if kind == "wall" else pair_mass(m, m)
-    r_eff = 0.5 * d if kind == "wall" else pair_radius(0.5 * d, 0.5 * d)
+        raise UnsupportedByEngine("lammps", "K", K, f"LAMMPS {'discs' if dim == 2 else 'spheres'}"
+                                  f" have K = {k_body}")
+    if kind not in ("pair", "wall"):
+        raise UnsupportedByEngine("lammps", "kind", kind, "use 'pair' or 'wall'")
+    if len(sizes) != 2 or min(sizes) <= 0.0:
+        raise UnsupportedByEngine("lammps", "sizes", tuple(sizes), "two positive diameters")
+    r0, r1 = 0.5 * sizes[0], 0.5 * sizes[1]
+    m0, m1 = sizes[0] ** dim, sizes[1] ** dim
+    m_eff = m0 if kind == "wall" else pair_mass(m0, m1)
+    r_eff = r0 if kind == "wall" else pair_radius(r0, r1)
     v_ref = max(speeds)
     params = make_contact(kn=kn, e=e, m_eff=m_eff, K=k_body, beta=beta, mu=mu, beta0=beta0,
                           model=model, r_eff=r_eff, speed=v_ref)
@@ -180,57 +210,55 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
     rows = []
     for speed in speeds:
         for angle in angles:
-            e_m, b_m, tc_m, spin = collide(dim, kind, params, speed, angle, dt, d, m)
-            vn = speed * math.cos(math.radians(angle))
-            tc = _normal_time(params, r_eff, vn)
-            if angle == 0.0:
-                b_t = math.nan
-            elif params.tangential == "none":
-                b_t = -1.0
-            elif params.tangential == "spring":
-                b_t = spring_beta(params.kt, k_body, m_eff, tc)
-            else:
-                b0 = spring_beta(params.kt, k_body, m_eff, tc)
-                b_t = walton_beta(params.mu or 0.0, b0, e, k_body,
-                                  math.tan(math.radians(angle)))
-            rows.append(CollisionRow(dim, kind, model, angle, speed, e_m, b_m, tc_m, e, b_t, tc,
-                                     spin))
+            hit = impact(dim, kind, params, speed, angle, dt, sizes=sizes, spin=spin)
+            th = math.radians(angle)
+            vn = speed * math.cos(th)
+            tc, f_max = _normal_targets(params, r_eff, vn)
+            ratio = abs(speed * math.sin(th) + r0 * spin) / vn  # contact point: g + R W x
+            rows.append(CollisionRow(dim, kind, model, angle, speed, hit.e, hit.beta,
+                                     hit.contact_time, e, _beta_target(params, k_body, tc, ratio),
+                                     tc, hit.spin_after, hit.peak_force, f_max, spin))
     return rows
 
 
-@dataclass(frozen=True)
-class RollingResult:
-    acceleration: float
-    target: float
-    contact: ContactParameters
+def calibrate_case(case: Case = "impact", **settings) -> list[CollisionRow] | list[MotionRow]:
+    """``demstudy calibrate --case``: ``impact`` (``calibrate``), ``rolling`` (the incline,
+    ``rolling_acceleration``; settings dim, alpha, e, beta, mu, beta0, kn, steps_per_contact)
+    or ``sliding`` (``sliding_to_rolling``; settings dim, v0, mu, e, beta0, kn,
+    steps_per_contact). Options a case cannot use are refused (UnsupportedByEngine, exit 2)."""
+    if case == "impact":
+        settings.pop("alpha", None)
+        settings.pop("v0", None)
+        settings = {k: v for k, v in settings.items() if v is not None}
+        return calibrate(**settings)
+    if case not in ("rolling", "sliding"):
+        raise UnsupportedByEngine("lammps", "case", case, "use impact, rolling or sliding")
+    inert = {"kind": "wall", "model": "hooke", "sizes": (1.0, 1.0), "spin": 0.0}
+    for key, ok in inert.items():
+        if key in settings and settings[key] is not None and _differs(settings[key], ok):
+            raise UnsupportedByEngine("lammps", key, settings[key],
+                                      f"--case {case} is one unit particle on a Hooke wall "
+                                      f"({key} must stay {ok!r})")
+    K = settings.get("K")
+    dim = settings["dim"]
+    if K is not None and abs(K - inertia_factor(dim)) > 1e-12:
+        raise UnsupportedByEngine("lammps", "K", K, f"LAMMPS bodies have K = {inertia_factor(dim)}")
+    common = {k: settings[k] for k in ("e", "mu", "beta0", "kn", "steps_per_contact")
+              if settings.get(k) is not None}
+    if case == "rolling":
+        res = rolling_acceleration(dim, alpha=settings.get("alpha", 30.0),
+                                   beta=settings.get("beta") or 0.9, **common)
+        return [MotionRow(dim, "rolling", "acceleration down the incline [g]",
+                          res.acceleration, res.target)]
+    if settings.get("mu") is None:
+        raise UnsupportedByEngine("lammps", "mu", None, "--case sliding needs friction: --mu")
+    res2 = sliding_to_rolling(dim, v0=settings.get("v0", 1.0), **common)
+    return [MotionRow(dim, "sliding", "final speed [sqrt(g d)]", res2.speed, res2.target),
+            MotionRow(dim, "sliding", "time to start rolling [sqrt(d/g)]", res2.roll_time,
+                      res2.roll_time_target)]
 
 
-def rolling_acceleration(dim: int, alpha: float = 30.0, e: float = 0.5, beta: float = 0.9,
-                         mu: float | None = None, kn: float = 1e5,
-                         steps_per_contact: float = 50, duration: float = 2.0,
-                         samples: int = 40) -> RollingResult:
-    """A disc (2D) or sphere (3D) released at rest on a rough wall, gravity tilted by ``alpha``
-    degrees: fit x(t) = x0 + v0 t + a t^2 / 2 and compare with ``incline_acceleration``.
-
-    Tangential: uncapped spring with ``beta`` (``mu`` None) or Coulomb with ``mu`` and
-    beta0 = ``beta``. The particle starts at its static overlap g cos(alpha) / kn; the unloaded
-    spring then oscillates about the rolling state, which averages out of the fit.
-    """
-    K = inertia_factor(dim)
-    params = make_contact(kn=kn, e=e, m_eff=1.0, K=K, beta=beta, mu=mu, beta0=beta)
-    a = math.radians(alpha)
-    dt = params.timestep(steps_per_contact)
-    y0 = 0.5 - math.cos(a) / kn
-    lmp = _open(dim, True, params, dt, 1.0, 1.0, [(-4.0, y0, 0.0, 0.0, 0.0, 0.0)],
-                gravity=(math.sin(a), -math.cos(a)))
-    chunk = max(1, round(duration / samples / dt))
-    ts, xs = [0.0], [-4.0]
-    try:
-        for i in range(1, samples + 1):
-            lmp.command(f"run {chunk} pre no post no")
-            ts.append(i * chunk * dt)
-            xs.append(float(_state(lmp, 1)[0][0, 0]))
-    finally:
-        lmp.close()
-    coef = np.polyfit(np.array(ts), np.array(xs), 2)
-    return RollingResult(2.0 * float(coef[0]), incline_acceleration(alpha, K, mu), params)
+def _differs(value, allowed) -> bool:
+    if isinstance(allowed, tuple):
+        return tuple(float(x) for x in value) != allowed
+    return value != allowed

@@ -69,6 +69,7 @@ struct Rule {
     int tangential = kBeta;
     double beta = -1.0;         // kBeta (−1: smooth)
     double mu = 0.0, beta0 = 0.0;  // kCoulomb (Walton)
+    bool beta0_from_e = false;     // kCoulomb: β₀ = this collision's e (the default rule)
     // normal restitution at approach speed gn (> 0)
     double restitution(double gn) const;
     // tangential restitution for Walton's rule, given e, K, gn > 0 and |g_t|

@@ -53,7 +53,8 @@ std::size_t rows(const InArr& a, std::size_t cols, const char* name) {
 
 Rule parse_rule(nb::handle h, const char* who) {
     // {"e": .., "law": "constant"|"campbell-exp"|"gutt-piecewise", "speed", "e1", "e2",
-    //  "crossover_speed", "tangential": "beta"|"coulomb"|"noslip", "beta", "mu", "beta0"}
+    //  "crossover_speed", "tangential": "beta"|"coulomb"|"noslip", "beta", "mu", "beta0",
+    //  "beta0_from_e": true -> β₀ = e of each collision}
     Rule r;
     nb::dict d = nb::cast<nb::dict>(h);
     auto num = [&](const char* key, double dflt) {
@@ -78,6 +79,7 @@ Rule parse_rule(nb::handle h, const char* who) {
     r.beta = num("beta", -1.0);
     r.mu = num("mu", 0.0);
     r.beta0 = num("beta0", 0.0);
+    r.beta0_from_e = d.contains("beta0_from_e") && nb::cast<bool>(d["beta0_from_e"]);
     return r;
 }
 

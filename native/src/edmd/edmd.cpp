@@ -372,9 +372,10 @@ double Rule::restitution(double gn) const {
 double Rule::beta_for(double e_n, double k, double gn, double gt) const {
     if (tangential != kCoulomb) return beta;
     // Walton: sticking (β₀) unless the tangential impulse would exceed μ times the normal one
-    if (k <= 0.0 || gt <= 0.0) return beta0;
+    const double b0 = beta0_from_e ? e_n : beta0;  // default β₀ = e (docs/contact.md)
+    if (k <= 0.0 || gt <= 0.0) return b0;
     const double sliding = -1.0 + mu * (1.0 + e_n) * (1.0 + 1.0 / k) * gn / gt;
-    return std::min(beta0, sliding);
+    return std::min(b0, sliding);
 }
 
 void collide(const double n[3], double ri, double rj, double im_i, double im_j,

@@ -22,7 +22,9 @@ def granular_args(p: ContactParameters) -> str:
     if p.tangential == "none":
         return f"{normal} tangential linear_nohistory 0.0 0.0"
     mu = UNCAPPED_MU if p.mu is None else p.mu
-    return f"{normal} tangential linear_history {p.kt:.12g} 0.0 {mu:.12g}"
+    xt = f"{p.xt:.12g}" if p.xt else "0.0"  # tangential damping (the Walton copy, beta0 = e)
+    law = "mindlin" if p.mindlin else "linear_history"  # Mindlin: k_t a, the Hertz copy
+    return f"{normal} tangential {law} {p.kt:.12g} {xt} {mu:.12g}"
 
 
 def pair_block(scene: Scene, setup: ContactSetup) -> Block:
