@@ -33,9 +33,15 @@ class StatisticUnavailable(ValueError):
     wrong dimension): nothing was computed (exit 2 on the command line)."""
 
 
+class NotComparable(ValueError):
+    """Runs that cannot be compared (``demstudy compare``): a file without profiles, an
+    unknown field, different dimensions or profile axes, bins that do not overlap; the
+    message names the files and the field. Nothing was computed (exit 2)."""
+
+
 class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["EngineError", "RunRefused", "RunStopped", "StatisticUnavailable",
+__all__ = ["EngineError", "NotComparable", "RunRefused", "RunStopped", "StatisticUnavailable",
            "UnsupportedByEngine"]
