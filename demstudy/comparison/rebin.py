@@ -11,8 +11,9 @@ mass and the temperatures. Temperatures and kinetic stresses are fluctuations ab
 mean velocity, so a wider bin also holds the spread of the narrower bins' means: the target
 gets Σ_i A_ji ρ_i (u_i − U_j)² (ρ the mass density, U_j the target's mean velocity), which
 makes rebinned and natively coarse profiles the same up to the volume splitting at the
-edges. Errors combine in quadrature as independent bins; the spread term's own error (second
-order in the velocity errors) is neglected.
+edges. Errors combine in quadrature as independent bins; the spread term carries the error
+of the finer bins' mean velocities (linearised), and its bias from their noise,
+Σ_i A_ji ρ_i σ_i² (1 − A_ji ρ_i / Σ A ρ), is taken off.
 """
 
 from __future__ import annotations
@@ -72,11 +73,15 @@ class _Mover:
         self.prof = prof
         u = np.asarray(prof["velocity"], float).reshape(len(phi), -1)
         self.u = u
+        self.u_err = np.asarray(prof.get("velocity_err", np.zeros_like(u)), float).reshape(
+            u.shape)
         self.u_mean = self.mean(u, np.zeros_like(u), "mass")[0]
 
     def mean(self, q: np.ndarray, err: np.ndarray, weight: str,
-             extra: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Σ_i A_ji w_i q_i (+ extra_j) over Σ_i A_ji w_i, and its error in quadrature."""
+             extra: tuple[np.ndarray, np.ndarray] | None = None
+             ) -> tuple[np.ndarray, np.ndarray]:
+        """Σ_i A_ji w_i q_i (+ extra_j) over Σ_i A_ji w_i, and its error in quadrature;
+        ``extra``: (value, variance) of a spread term."""
         w = self.a * self.weights[weight][None, :]
         total = w.sum(1)
         shape = q.shape
@@ -85,19 +90,39 @@ class _Mover:
         with np.errstate(divide="ignore", invalid="ignore"):
             coef = w / total[:, None]
             val = coef @ q2
+            var = (coef**2) @ (e2**2)
             if extra is not None:
-                val = val + extra.reshape(val.shape) / total[:, None]
-            out_err = np.sqrt((coef**2) @ (e2**2))
+                val = val + extra[0].reshape(val.shape) / total[:, None]
+                var = var + extra[1].reshape(var.shape) / total[:, None] ** 2
+            out_err = np.sqrt(var)
         val[total <= 0] = np.nan
         out_err[total <= 0] = np.nan
         return val.reshape((len(total), *shape[1:])), out_err.reshape((len(total), *shape[1:]))
 
-    def spread(self, q: np.ndarray, q_mean: np.ndarray, a: int, b: int) -> np.ndarray:
-        """Σ_i A_ji ρ_i (q_ia − Q_ja)(q_ib − Q_jb): the bins' mean-flow spread in target j."""
+    def spread(self, q: np.ndarray, q_err: np.ndarray, q_mean: np.ndarray, a: int, b: int
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """(value, variance) of Σ_i A_ji ρ_i (q_ia − Q_ja)(q_ib − Q_jb), the bins' mean-flow
+        spread in target j: debiased, with the linearised error of the q_i (the derivative
+        through Q_j vanishes: Σ_i A_ji ρ_i (q_i − Q_j) = 0)."""
         w = self.a * self.weights["mass"][None, :]
-        qa = np.nan_to_num(q[None, :, a] - q_mean[:, None, a])
-        qb = np.nan_to_num(q[None, :, b] - q_mean[:, None, b])
-        return (w * qa * qb).sum(1)
+        da = np.nan_to_num(q[None, :, a] - q_mean[:, None, a])
+        db = np.nan_to_num(q[None, :, b] - q_mean[:, None, b])
+        ea, eb = (np.nan_to_num(q_err[None, :, k]) for k in (a, b))
+        val = (w * da * db).sum(1)
+        if a == b:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                share = np.nan_to_num(w / w.sum(1)[:, None])
+            val = val - (w * ea**2 * (1.0 - share)).sum(1)
+            var = ((2.0 * w * da * ea) ** 2).sum(1)
+        else:
+            var = (w**2 * ((db * ea) ** 2 + (da * eb) ** 2)).sum(1)
+        return val, var
+
+
+def _add(*terms: tuple[np.ndarray, np.ndarray], scale: float = 1.0
+         ) -> tuple[np.ndarray, np.ndarray]:
+    """scale × the sum of spread terms (value, variance), taken as independent."""
+    return scale * sum(t[0] for t in terms), scale**2 * sum(t[1] for t in terms)
 
 
 def rebin_profiles(prof: dict[str, np.ndarray], dst: np.ndarray, dim: int,
@@ -105,7 +130,7 @@ def rebin_profiles(prof: dict[str, np.ndarray], dst: np.ndarray, dim: int,
     """The profiles (with ``_err``) on the target edges ``dst``, and the names that could not
     be rebinned (no rule, e.g. Malik's cell temperatures)."""
     mv = _Mover(prof, dst, dim)
-    u, u_mean = mv.u, mv.u_mean
+    u, u_err, u_mean = mv.u, mv.u_err, mv.u_mean
     out: dict[str, np.ndarray] = {"edges": dst, "y": 0.5 * (dst[1:] + dst[:-1])}
     left: list[str] = []
     rules: dict[str, Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]] = {
@@ -124,20 +149,23 @@ def rebin_profiles(prof: dict[str, np.ndarray], dst: np.ndarray, dim: int,
         if rule in rules:
             val, err = rules[rule](q, e)
         elif rule == "temperature":  # + the mean-flow spread per component (over dim: T)
-            comps = [mv.spread(u, u_mean, k, k) for k in range(u.shape[1])]
-            extra = np.stack(comps, 1) if q.ndim == 2 else sum(comps) / dim
+            comps = [mv.spread(u, u_err, u_mean, k, k) for k in range(u.shape[1])]
+            extra = (np.stack([c[0] for c in comps], 1), np.stack([c[1] for c in comps], 1)) \
+                if q.ndim == 2 else _add(*comps, scale=1.0 / dim)
             val, err = mv.mean(q, e, "number", extra)
         elif rule == "rotational":  # I (ω_i − Ω)² per rotational degree of freedom
             if "spin" not in prof:
                 left.append(name)
                 continue
             w = np.asarray(prof["spin"], float).reshape(len(u), -1)
+            w_err = np.asarray(prof.get("spin_err", np.zeros_like(w)), float).reshape(w.shape)
             w_mean = mv.mean(w, np.zeros_like(w), "mass")[0]
             j = inertia_factor / 4.0  # I/m of a particle of d = 1
-            extra = j * sum(mv.spread(w, w_mean, k, k) for k in range(w.shape[1])) / w.shape[1]
+            extra = _add(*(mv.spread(w, w_err, w_mean, k, k) for k in range(w.shape[1])),
+                         scale=j / w.shape[1])
             val, err = mv.mean(q, e, "number", extra)
         else:  # covariance of u and v about the target's mean
-            val, err = mv.mean(q, e, "mass", mv.spread(u, u_mean, 0, 1))
+            val, err = mv.mean(q, e, "mass", mv.spread(u, u_err, u_mean, 0, 1))
         out[name], out[f"{name}_err"] = val, err
     return out, left
 
@@ -154,10 +182,12 @@ def rebin_stress(stress: dict[str, np.ndarray], prof: dict[str, np.ndarray],
         if name not in stress or f"{name}_err" not in stress:
             continue
         q, e = np.asarray(stress[name], float), np.asarray(stress[f"{name}_err"], float)
-        k = q.shape[1]
-        extra = np.stack([np.stack([mv.spread(mv.u, mv.u_mean, a, b) if a < mv.u.shape[1]
-                                    and b < mv.u.shape[1] else np.zeros(len(dst) - 1)
-                                    for b in range(k)], -1) for a in range(k)], 1)
+        k, n_out = q.shape[1], len(dst) - 1
+        val, var = np.zeros((n_out, k, k)), np.zeros((n_out, k, k))
+        for a in range(min(k, mv.u.shape[1])):
+            for b in range(min(k, mv.u.shape[1])):
+                val[:, a, b], var[:, a, b] = mv.spread(mv.u, mv.u_err, mv.u_mean, a, b)
+        extra = (val, var)
         out[name], out[f"{name}_err"] = mv.mean(q, e, "volume", extra)
     return out
 
