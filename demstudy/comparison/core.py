@@ -79,6 +79,10 @@ class FieldComparison:
         if self.resolved:
             return (f"DIFFERS: rel. L2 {self.rel_l2_debiased:.3g} beyond noise "
                     f"(p = {self.p:.2g} < {self.level:.2g})")
+        if self.reference_is_zero:  # a relative bound means nothing: the absolute one
+            err = self.delta_err if self.compared is None else self.delta_err[self.compared]
+            rms = float(np.sqrt(np.mean(err**2)))
+            return f"agrees within errors (rms Δ ≲ {rms:.2g} {self.units})"
         return f"agrees within errors (rel. L2 ≲ {self.rel_l2_floor:.3g})"
 
 
@@ -254,19 +258,20 @@ def _field(name: str, y: np.ndarray, r: np.ndarray, er: np.ndarray, o: np.ndarra
 
 def _on_grid(res: Results, edges: np.ndarray | None, dim: int
              ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray] | None, list[str]]:
-    """The run's profiles and stress group on ``edges`` (``None``: as stored)."""
+    """The run's profiles and stress group on ``edges`` (``None``: as stored), and what
+    could not be put there."""
     prof, stress = res.profiles, _stress(res)
+    left: list[str] = []
+    if stress is not None and (stress["edges"].shape != prof["edges"].shape or
+                               not np.allclose(stress["edges"], prof["edges"])):
+        stress, left = None, ["stress (on other bins than the profiles)"]
     if edges is None:
-        return prof, stress, []
+        return prof, stress, left
     k = float(res.profile_attrs.get("inertia_factor", 0.5 if dim == 2 else 0.4))
-    moved, left = rebin_profiles(prof, edges, dim, k)
+    moved, rest = rebin_profiles(prof, edges, dim, k)
     if stress is not None:
-        if stress["edges"].shape != prof["edges"].shape:  # stress on other bins: skip
-            stress = None
-            left.append("stress")
-        else:
-            stress = rebin_stress(stress, prof, edges, dim)
-    return moved, stress, left
+        stress = rebin_stress(stress, prof, edges, dim)
+    return moved, stress, left + [f"{name} (not rebinned)" for name in rest]
 
 
 def _units(dataset: str, dim: int) -> str:
@@ -316,9 +321,9 @@ def compare_pair(ref: Results, other: Results, fields: Sequence[str] | None = No
         if any(splits_bins(e, grid) for e in (e_ref, e_oth)):
             notes.append("the grids do not nest: bins split between common bins are taken "
                          "as uniform inside")
-        left = sorted(set(parts[0][2]) | set(parts[1][2]))
-        if left:
-            notes.append(f"not rebinned, not compared: {', '.join(left)}")
+    left = sorted(set(parts[0][2]) | set(parts[1][2]))
+    if left:
+        notes.append(f"not compared: {', '.join(left)}")
     split = [_split_fields(p, s) for p, s, _ in parts]
     names = _select(fields, split[0], split[1], labels, notes)
     y = parts[0][0]["y"] if "y" in parts[0][0] else \
