@@ -50,7 +50,8 @@ def _short(f: FieldComparison) -> str:
         return "nothing compared"
     if f.resolved:
         return f"differs: L2 {f.rel_l2_debiased:.2g}, max|z| {f.max_z:.1f}"
-    return f"agrees: L2 ≲ {f.rel_l2_floor:.2g}"
+    shared = "  (> 2× floor)" if f.rel_l2 > 2 * f.rel_l2_floor else ""
+    return f"agrees: L2 ≲ {max(f.rel_l2_floor, f.rel_l2):.2g}{shared}"
 
 
 def plot_comparison(comparisons: Sequence[Comparison] | Comparison, out: str | os.PathLike,
@@ -87,19 +88,18 @@ def plot_comparison(comparisons: Sequence[Comparison] | Comparison, out: str | o
             if f is None:
                 continue
             color = f"C{i}"
+            use = f.compared if f.compared is not None else np.isfinite(f.delta)
             if not any(g.shape == f.y.shape and np.allclose(g, f.y) for g in grids):
-                shown = np.isfinite(f.reference)
+                shown = use  # the compared bins: empty ones (0 ± 0 in both) left out
                 h = top.errorbar(f.y[shown], f.reference[shown], yerr=f.reference_err[shown],
                                  color="k", marker="o", ms=3, capsize=2, lw=1,
                                  ls="-" if not f.rebinned else ":")
                 handles.setdefault(f"reference: {c.reference}" + (", rebinned" if f.rebinned
                                                                   else ""), h)
                 grids.append(f.y)
-            shown = np.isfinite(f.other)
-            h = top.errorbar(f.y[shown], f.other[shown], yerr=f.other_err[shown], color=color,
+            h = top.errorbar(f.y[use], f.other[use], yerr=f.other_err[use], color=color,
                              marker="s", ms=3, capsize=2, lw=1, ls="--", mfc="none")
             handles.setdefault(f"({i + 1}) {c.other}", h)
-            use = f.compared if f.compared is not None else np.isfinite(f.delta)
             bottom.fill_between(f.y, -np.where(use, f.delta_err, np.nan),
                                 np.where(use, f.delta_err, np.nan), color=color, alpha=0.15,
                                 lw=0, step="mid")
