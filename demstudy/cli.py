@@ -1,4 +1,4 @@
-"""Command line: ``demstudy validate | deck | run | plot | analyze | calibrate | cost``.
+"""Command line: ``demstudy validate | deck | run | plot | analyze | compare | calibrate | cost``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
@@ -123,6 +123,23 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
             results.group_attrs[f"statistics/{name}"] = attrs
     write_results(out, results)
     print(f"results: {out} ({', '.join(what)})")
+    return 0
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from .comparison import compare, plot_comparison
+    from .errors import NotComparable
+
+    fields = [f.strip() for f in args.fields.split(",") if f.strip()] if args.fields else None
+    try:
+        comparisons = compare(*args.results, fields=fields, sigma=args.sigma,
+                              min_solid_fraction=args.min_solid_fraction)
+    except OSError as exc:  # not a readable HDF5 file: nothing was compared
+        raise NotComparable(f"cannot read the results: {exc}") from exc
+    for comparison in comparisons:
+        print(comparison.table(), end="\n\n")
+    if args.out != "none":
+        print(f"figure: {plot_comparison(comparisons, args.out, fields)}")
     return 0
 
 
@@ -280,6 +297,27 @@ def build_parser() -> argparse.ArgumentParser:
                    help="auto: the numpy fast path for demstudy's dumps, MDAnalysis otherwise")
     p.set_defaults(func=_cmd_analyze)
 
+    p = sub.add_parser("compare", help="profiles and stresses of runs against a reference, "
+                                       "within their statistical errors",
+                       description="The first file is the reference; every other file is "
+                                   "compared with it bin by bin (Δ, σ_Δ, z), one table row per "
+                                   "field (relative L2 error, its noise floor, max |z|, "
+                                   "whether the difference is resolved) and one figure "
+                                   "(docs/compare.md). Different bins are rebinned to a "
+                                   "common grid, said so.")
+    p.add_argument("results", nargs="+", metavar="RUN.h5",
+                   help="the reference, then the runs compared with it")
+    p.add_argument("-o", "--out", default="compare.png",
+                   help="figure file (default compare.png; none: no figure)")
+    p.add_argument("--fields", metavar="F1,F2,...",
+                   help="fields to compare, e.g. temperature,velocity[x],stress/xy, or a "
+                        "dataset for all its components (velocity, stress); default all")
+    p.add_argument("--sigma", type=float, default=3.0,
+                   help="significance of each field's family test, in σ (default 3)")
+    p.add_argument("--min-solid-fraction", type=float, default=0.0, metavar="NU",
+                   help="leave out bins more dilute than this in either run (default 0)")
+    p.set_defaults(func=_cmd_compare)
+
     soft = [e for e in engines if get_backend(e).capabilities.time_step]
     p = sub.add_parser("calibrate", help="measure binary soft collisions (e, beta, t_c, peak "
                                          "force) and wall motions against theory")
@@ -341,6 +379,7 @@ def main(argv: list[str] | None = None) -> int:
     from .errors import (
         BadOption,
         EngineError,
+        NotComparable,
         RunRefused,
         RunStopped,
         StatisticUnavailable,
@@ -358,7 +397,7 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, RunStopped):
             return 3  # checkpoint written: run again with --resume
         refused = (SceneError | UnsupportedByEngine | RunRefused | StatisticUnavailable
-                   | BadOption)
+                   | BadOption | NotComparable)
         return 2 if isinstance(exc, refused) else 1  # 2: nothing ran or was computed
     except KeyboardInterrupt:  # outside a run loop (which checkpoints and stops by itself)
         print("error: interrupted", file=sys.stderr)

@@ -43,9 +43,16 @@ class BadOption(ValueError):
         super().__init__(f"{option} = {value!r}: {allowed}")
 
 
+class NotComparable(ValueError):
+    """Runs that cannot be compared (``demstudy compare``): a file without profiles, an
+    unknown field, different dimensions or profile axes, bins that do not overlap; the
+    message names the files and the field. Nothing was computed (exit 2)."""
+
+
 class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["BadOption", "EngineError", "RunRefused", "RunStopped", "StatisticUnavailable",
+__all__ = ["BadOption", "EngineError", "NotComparable", "RunRefused", "RunStopped",
+           "StatisticUnavailable",
            "UnsupportedByEngine"]

@@ -10,7 +10,9 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
         hard, soft = ds.run(scene, engine="edmd"), ds.run(scene, engine="lammps")
         assert_profiles_agree(hard, soft, fields=["solid_fraction", "temperature"])
 
-Each bin's difference is divided by its combined standard error √(σ_a² + σ_b²). The
+The test is :mod:`demstudy.comparison.stats` (shared with ``demstudy compare``, which also
+rebins and summarises whole fields). Each bin's difference is divided by its combined
+standard error √(σ_a² + σ_b²). The
 comparison as a whole fails with the probability of a two-sided ``sigma``-σ event (0.27 % at
 3σ) when the two runs sample the same state: with n compared values each one is held to the
 Šidák-corrected level, so a profile of 40 bins does not fail by chance one time in ten. The
@@ -34,8 +36,8 @@ from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
-from scipy.stats import t as student_t
 
+from .comparison.stats import block_dof, sidak_level, z_test
 from .io.results import Results, read_results
 
 __all__ = ["ProfileComparison", "Row", "assert_profiles_agree", "compare_profiles"]
@@ -128,8 +130,7 @@ def compare_profiles(a: Results | str | os.PathLike, b: Results | str | os.PathL
                 (pb["solid_fraction"] >= min_solid_fraction)
     y = pa.get("y", 0.5 * (pa["edges"][1:] + pa["edges"][:-1]))
     # degrees of freedom of each run's errors: jackknife over n_blocks blocks
-    dof_a, dof_b = (max(1, int(r.profile_attrs.get("n_blocks", 0)) - 1)
-                    if r.profile_attrs.get("n_blocks") else math.inf for r in (ra, rb))
+    dof_a, dof_b = (block_dof(r.profile_attrs) for r in (ra, rb))
     rows, skipped = [], 0
     for name in fields:
         missing = [_label(r) for r, p in ((ra, pa), (rb, pb))
@@ -149,27 +150,15 @@ def compare_profiles(a: Results | str | os.PathLike, b: Results | str | os.PathL
                     skipped += 1
                     continue
                 rows.append(_row(label, i, float(y[i]), a, sa, b, sb, dof_a, dof_b))
-    # Šidák: each of n tests at 1 − (1 − p)^(1/n) keeps the family's false alarms at p
-    family = math.erfc(sigma / math.sqrt(2.0))
-    each = -math.expm1(math.log1p(-family) / max(1, len(rows)))
+    each = sidak_level(sigma, len(rows))
     return ProfileComparison(sigma, each, rows, skipped)
 
 
 def _row(label: str, i: int, y: float, a: float, sa: float, b: float, sb: float,
          dof_a: float, dof_b: float) -> Row:
-    """One compared value, its z-score and two-sided p-value (Student's t with the
-    Welch–Satterthwaite degrees of freedom; normal when both errors are exact)."""
-    var = sa * sa + sb * sb
-    diff = a - b
-    if var == 0:
-        z = 0.0 if diff == 0 else math.copysign(math.inf, diff)
-        return Row(label, i, y, a, sa, b, sb, z, math.inf, 1.0 if diff == 0 else 0.0)
-    z = diff / math.sqrt(var)
-    parts = (sa**4 / dof_a if math.isfinite(dof_a) else 0.0) + \
-            (sb**4 / dof_b if math.isfinite(dof_b) else 0.0)
-    dof = var * var / parts if parts > 0 else math.inf
-    p = math.erfc(abs(z) / math.sqrt(2.0)) if math.isinf(dof) else \
-        float(2.0 * student_t.sf(abs(z), dof))
+    """One compared value, its z-score and two-sided p-value
+    (:func:`demstudy.comparison.stats.z_test`)."""
+    z, dof, p = (float(v) for v in z_test(a - b, sa, sb, dof_a, dof_b))
     return Row(label, i, y, a, sa, b, sb, z, dof, p)
 
 

@@ -38,7 +38,7 @@ def _base(spec: RunSpec, res: Results) -> dict:
 
 
 def _error_columns(row: dict, reference: Results, res: Results) -> dict:
-    from ..compare import compare
+    from ..comparison import compare
 
     err = analyze.run_error(compare(reference, res)[0])
     row.update(error=err.error, field=err.field, rel_l2=err.rel_l2, floor=err.floor,
