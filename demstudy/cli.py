@@ -133,17 +133,17 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def _cmd_forecast(args: argparse.Namespace) -> int:
-    from .simulation.forecast import cpu_model, load_rates, measure_rate, rates_path
+    from .simulation.forecast import cpu_model, load_rates, measure_costs, rates_path
 
     for engine in args.engine or ["lammps", "edmd"]:
         for dim in args.dim or [2, 3]:
             for model in (args.model or ["hooke"]) if engine == "lammps" else [None]:
-                measure_rate(engine, dim, model, remeasure=args.measure)
+                measure_costs(engine, dim, model, remeasure=args.measure)
     rates = load_rates()
     print(f"machine rates ({cpu_model()}), cached in {rates_path()}:")
     for key, entry in sorted(rates.items()):
-        unit = "events/s" if key.startswith("edmd") else "atom-steps/s"
-        print(f"  {key}: {entry['rate']:.4g} {unit} ({entry['what']}; {entry['measured']})")
+        costs = ", ".join(f"{k} {v:.3g} s" for k, v in entry["costs"].items())
+        print(f"  {key} ({entry['measured']}): {costs}\n    benchmarks: {entry['what']}")
     return 0
 
 

@@ -79,9 +79,10 @@ def needs_pilot(scene: Scene, backend: Any) -> bool:
 
 
 def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
-             rate: float | None = None) -> RunPlan:
+             costs: dict[str, float] | None = None) -> RunPlan:
     """The pilot (cached), the soft contacts and the forecast of ``scene`` in ``backend``
-    (a backend class); ``rate`` overrides the machine's measured speed. A forecast that
+    (a backend class); ``costs`` override the machine's measured ones
+    (:func:`demstudy.simulation.forecast.measure_costs`). A forecast that
     cannot be made (the benchmark failed) is a warning, never a refused run."""
     pilot = options.pilot
     if pilot is None and needs_pilot(scene, backend):
@@ -93,7 +94,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
     if backend.name in FORECAST_ENGINES:
         try:
             forecast = forecast_run(scene, backend, setup.timestep if setup else None,
-                                    pilot, rate)
+                                    pilot, costs)
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     n = scene.n_particles
