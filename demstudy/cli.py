@@ -1,4 +1,4 @@
-"""Command line: ``demstudy validate | deck | run | plot | calibrate``.
+"""Command line: ``demstudy validate | deck | run | plot | analyze | forecast | calibrate``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
