@@ -29,7 +29,7 @@ def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
         resume: bool = False, keep_frames: bool | None = None,
         wall_limit: float | None = None, checkpoint_interval: float | None = None,
         dump: str | os.PathLike | None = None, progress: bool | None = None,
-        **engine_options: Any) -> Results:
+        dry_run: bool = False, **engine_options: Any) -> Results | dict[str, Any]:
     """Run ``scene`` (a Scene, a scene file or a preset name) in ``engine`` (default: the
     CLI's default, ``demstudy.engines.DEFAULT_ENGINE``; see ``demstudy.engines.backend_names``)
     (or a backend class) and return its :class:`Results`, also written to ``out`` (default
@@ -42,9 +42,14 @@ def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
     every production frame (default: the scene's ``measure.keep_frames``); ``progress``
     shows a progress bar (default: when stderr is a terminal). Engine options go as keywords,
     e.g. ``tc=1e-4`` for the event-driven engine. Everything the engine cannot do is
-    refused before it starts (``UnsupportedByEngine``)."""
+    refused before it starts (``UnsupportedByEngine``).
+
+    ``dry_run``: run nothing and write nothing; return the run's plan as a dict: engine, N,
+    the soft contacts (``kn``, ``timestep``, ``contact_time``, ``steps_per_contact``,
+    ``stiffness_basis``), the pilot's impact speeds and collision rate, and the wall-time
+    forecast (``forecast_seconds``, ``forecast_basis``), as ``demstudy run --dry-run``."""
     from .engines import DEFAULT_ENGINE, get_backend
-    from .simulation import RunOptions, run_scene
+    from .simulation import RunOptions, check_run, plan_run, run_scene
 
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
@@ -56,6 +61,9 @@ def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
                          checkpoint_interval=checkpoint_interval, isolate=isolate,
                          wall_limit=wall_limit, extra=engine_options,
                          progress=sys.stderr.isatty() if progress is None else progress)
+    if dry_run:
+        check_run(backend, scene, options)
+        return plan_run(scene, backend, options).as_dict()
     return read_results(run_scene(scene, backend, options))
 
 

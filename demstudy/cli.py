@@ -1,4 +1,5 @@
-"""Command line: ``demstudy validate | deck | run | plot | analyze | compare | calibrate | cost``.
+"""Command line: ``demstudy validate | deck | run | plot | analyze | compare | forecast |
+calibrate | cost``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
@@ -46,7 +47,8 @@ def _engine_options(args: argparse.Namespace) -> dict:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .simulation import RunOptions, run_scene
+    from .engines import get_backend
+    from .simulation import RunOptions, check_run, plan_run, run_scene
 
     scene = load_scene(args.scene, args.set)
     name = Path(args.scene).stem
@@ -55,6 +57,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
                          progress=not args.quiet, keep_frames=args.keep_frames or None,
                          isolate=True, wall_limit=args.wall_limit,
                          extra=_engine_options(args))
+    if args.dry_run:  # the settings and the forecast; nothing runs, nothing is written
+        backend = get_backend(args.engine)
+        check_run(backend, scene, options)
+        print(plan_run(scene, backend, options).describe())
+        return 0
     path = run_scene(scene, args.engine, options)
     print(f"results: {path}")
     return 0
@@ -140,6 +147,21 @@ def _cmd_compare(args: argparse.Namespace) -> int:
         print(comparison.table(), end="\n\n")
     if args.out != "none":
         print(f"figure: {plot_comparison(comparisons, args.out, fields)}")
+    return 0
+
+
+def _cmd_forecast(args: argparse.Namespace) -> int:
+    from .simulation.forecast import cpu_model, load_rates, measure_costs, rates_path
+
+    for engine in args.engine or ["lammps", "edmd"]:
+        for dim in args.dim or [2, 3]:
+            for model in (args.model or ["hooke"]) if engine == "lammps" else [None]:
+                measure_costs(engine, dim, model, remeasure=args.measure)
+    rates = load_rates()
+    print(f"machine rates ({cpu_model()}), cached in {rates_path()}:")
+    for key, entry in sorted(rates.items()):
+        costs = ", ".join(f"{k} {v:.3g} s" for k, v in entry["costs"].items())
+        print(f"  {key} ({entry['measured']}): {costs}\n    benchmarks: {entry['what']}")
     return 0
 
 
@@ -249,6 +271,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--wall-limit", type=float, metavar="SECONDS",
                    help="checkpoint and stop after this much wall-clock time (then --resume)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the settings (k_n, dt, stiffness basis, the pilot's impacts) "
+                        "and the wall-time forecast, then stop without running")
     owners: dict[str, list] = {}  # each engine option once, whichever engines have it
     for engine in engines:
         for name, option in get_backend(engine).options.items():
@@ -317,6 +342,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--min-solid-fraction", type=float, default=0.0, metavar="NU",
                    help="leave out bins more dilute than this in either run (default 0)")
     p.set_defaults(func=_cmd_compare)
+
+    p = sub.add_parser("forecast", help="this machine's measured speed for the wall-time "
+                                        "forecasts (docs/forecast.md)")
+    p.add_argument("--measure", "--remeasure", action="store_true", dest="measure",
+                   help="run the benchmarks again (default: show the cached rates, measuring "
+                        "the missing ones)")
+    p.add_argument("--engine", action="append", choices=["lammps", "edmd"],
+                   help="engines to measure (default both; repeatable)")
+    p.add_argument("--dim", type=int, action="append", choices=[2, 3],
+                   help="dimensions (default 2 and 3; repeatable)")
+    p.add_argument("--model", action="append", choices=["hooke", "hertz"],
+                   help="soft contact models (default hooke; repeatable)")
+    p.set_defaults(func=_cmd_forecast)
 
     soft = [e for e in engines if get_backend(e).capabilities.time_step]
     p = sub.add_parser("calibrate", help="measure binary soft collisions (e, beta, t_c, peak "

@@ -3,22 +3,42 @@ soft-contact engine.
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise the wall speed
 or shear rate sets the time unit τ). k_n is a force per length, m/τ², for Hooke contacts and a
-force per length^3/2 for Hertz; by default it is chosen so that an impact at the scene's
-reference speed (``reference_speed``) overlaps by DEFAULT_OVERLAP.
+force per length^3/2 for Hertz. Without ``soft.stiffness`` or ``soft.hardness`` it is chosen
+automatically (``stiffness_basis``):
+
+* "pilot": from an event-driven pilot run (:mod:`demstudy.contact.pilot`, passed explicitly
+  as ``contact_setup(scene, pilot=...)``; ``demstudy run`` does so): the largest overlap at
+  the DESIGN_QUANTILE of the measured pair and wall impact speeds (never below the initial
+  state's own approach speeds) stays below TARGET_OVERLAP, and the contact time below
+  TARGET_CONTACT_RATIO × the measured free-flight time;
+* "estimate": without a (usable) pilot, an impact at the guessed ``reference_speed``
+  overlaps by DEFAULT_OVERLAP (``demstudy deck``, and scenes the event-driven engine cannot
+  run).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..errors import UnsupportedByEngine
 from ..scene import Scene
 from ..scene.schema import Wall
 from . import mapping
+from .pilot import PilotResult
 
 #: Default hardness: at most this overlap (in d) at the reference speed.
 DEFAULT_OVERLAP = 0.005
+
+# -- targets of the automatic ("pilot") settings, in one place (docs/contact.md); the cost
+# study tunes them: a softer contact is cheaper (dt ∝ t_c ∝ k_n^-1/2) but overlaps more
+#: largest overlap δ/d allowed at the design impact speed
+TARGET_OVERLAP = DEFAULT_OVERLAP
+#: the design impact speed: this quantile of the pilot's normal impact speeds
+DESIGN_QUANTILE = 0.999
+#: largest contact time as a fraction of the free-flight time between impacts (binary,
+#: instantaneous collisions: the hard-particle limit the soft run should stay near)
+TARGET_CONTACT_RATIO = 0.05
 
 
 def reference_speed(scene: Scene) -> float:
@@ -39,10 +59,44 @@ def reference_speed(scene: Scene) -> float:
 
 @dataclass(frozen=True)
 class ContactSetup:
+    """The soft contacts of a scene and how k_n was chosen: ``basis`` is "stiffness" or
+    "hardness" (given), "pilot" (measured impacts) or "estimate" (guessed reference speed);
+    ``speed``: the design impact speed (the largest of pair and wall; NaN when k_n was
+    given); ``pilot``: the pilot's result when one was passed."""
+
     pair: mapping.ContactParameters
     walls: dict[str, mapping.ContactParameters]
     timestep: float
     kn: float
+    basis: str = "stiffness"
+    speed: float = math.nan
+    pilot: PilotResult | None = field(default=None, compare=False)
+
+    @property
+    def steps_per_contact(self) -> float:
+        return self.pair.contact_time / self.timestep
+
+    def note(self) -> str:
+        """One line: how k_n and dt were chosen (the deck's comment, the run's start)."""
+        why = {"stiffness": "soft.stiffness", "hardness": "soft.hardness",
+               "pilot": f"overlap ≤ {TARGET_OVERLAP:g} d at the q{DESIGN_QUANTILE:g} "
+                        f"impact speed {self.speed:.4g}, t_c/τ_flight ≤ "
+                        f"{TARGET_CONTACT_RATIO:g}",
+               "estimate": f"overlap {DEFAULT_OVERLAP:g} d at the guessed "
+                           f"reference speed {self.speed:.4g} (no pilot)"}[self.basis]
+        return (f"k_n = {self.kn:.6g}, dt = {self.timestep:.6g}, t_c = "
+                f"{self.pair.contact_time:.6g} (stiffness_basis = {self.basis}: {why})")
+
+    def attrs(self) -> dict:
+        """Root attributes of a soft run's results file."""
+        out = {"stiffness_basis": self.basis, "kn": self.kn, "timestep": self.timestep,
+               "contact_time": self.pair.contact_time,
+               "steps_per_contact": self.steps_per_contact, "design_speed": self.speed,
+               "contact_settings": self.note()}
+        if self.pilot is not None:
+            out["pilot"] = self.pilot.to_json()
+            out["pilot_summary"] = self.pilot.summary()
+        return out
 
 
 def _rule(rule, engine: str, e: float, model: str, where: str) -> dict:
@@ -100,22 +154,60 @@ def shortest_contact_time(scene: Scene, kn: float, speed: float) -> float:
     return min(mapping.hooke_contact(kn, e, m).contact_time for e, m, _ in cases)
 
 
-def contact_setup(scene: Scene, engine: str = "soft contacts") -> ContactSetup:
+def _kn_for_overlap(model: str, overlap: float, speed: float, m_eff: float, r_eff: float,
+                    e: float) -> float:
+    if model == "hertz":
+        return mapping.hertz_kn_for_overlap(overlap, speed, m_eff, r_eff, e)
+    return mapping.hooke_kn_for_overlap(overlap, speed, m_eff, e)
+
+
+def pilot_stiffness(scene: Scene, pilot: PilotResult) -> tuple[float, float]:
+    """(k_n, design speed) from a usable pilot: the stiffest of (a) the pair contact
+    (m_eff = m/2) and every wall's (m_eff = m) overlapping TARGET_OVERLAP at their
+    DESIGN_QUANTILE impact speed, (b) the contact time TARGET_CONTACT_RATIO × τ_flight."""
+    model = scene.soft.model
+    v_pair = pilot.speed("pair", DESIGN_QUANTILE)
+    v_wall = pilot.speed("wall", DESIGN_QUANTILE)
+    speed = max(v_pair, v_wall if scene.walls else 0.0)
+    kn = _kn_for_overlap(model, TARGET_OVERLAP, v_pair, 0.5, 0.25, scene.contact.restitution)
+    for w in scene.walls:
+        kn = max(kn, _kn_for_overlap(model, TARGET_OVERLAP, v_wall, 1.0, 0.5, w.restitution))
+    if math.isfinite(pilot.tau_flight):
+        # t_c ∝ k_n^(-1/2) (Hooke) or k_n^(-2/5) (Hertz, at fixed speed): scale up to the target
+        tc = shortest_contact_time(scene, kn, speed)
+        target = TARGET_CONTACT_RATIO * pilot.tau_flight
+        if tc > target:
+            kn *= (tc / target) ** (2.0 if model == "hooke" else 2.5)
+    return kn, speed
+
+
+def contact_setup(scene: Scene, engine: str = "soft contacts",
+                  pilot: PilotResult | None = None) -> ContactSetup:
     """Pair (m_eff = m/2) and per-wall (m_eff = m) contacts with a common time step;
     ``engine`` names the soft-contact engine in refusals (a hardness target that defines no
-    stiffness for the contact model)."""
+    stiffness for the contact model). Deterministic and cheap: a pilot is used only when
+    passed (``pilot``) and k_n is not given; without one an automatic k_n is an estimate."""
     K, e, model = scene.inertia_k, scene.contact.restitution, scene.soft.model
-    kn = choose_stiffness(scene, e, 0.5, engine)
+    soft = scene.soft
     speed = reference_speed(scene)
-    if scene.soft.hardness is not None and scene.soft.hardness.impact_speed is not None:
-        speed = max(speed, scene.soft.hardness.impact_speed)  # Hertz t_c shrinks with speed
+    basis = "stiffness" if soft.stiffness is not None else \
+        "hardness" if soft.hardness is not None else "estimate"
+    if basis == "estimate" and pilot is not None and pilot.usable and \
+            max(pilot.speed("pair", DESIGN_QUANTILE), pilot.speed("wall", DESIGN_QUANTILE)) > 0:
+        basis = "pilot"
+        kn, speed = pilot_stiffness(scene, pilot)
+    else:
+        kn = choose_stiffness(scene, e, 0.5, engine)
+    if soft.hardness is not None and soft.hardness.impact_speed is not None:
+        speed = max(speed, soft.hardness.impact_speed)  # Hertz t_c shrinks with speed
     extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
     pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
                                 **_rule(scene.contact.tangential, engine, e, model, "contact"),
                                 **extra)
     walls = {w.side: _wall_contact(w, kn, K, model, speed, engine) for w in scene.walls}
     dt = mapping.timestep(shortest_contact_time(scene, kn, speed), scene.soft.steps_per_contact)
-    return ContactSetup(pair, walls, dt, kn)
+    shown = speed if basis in ("pilot", "estimate") else math.nan
+    return ContactSetup(pair, walls, dt, kn, basis, shown, pilot)
 
 
 def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float, engine: str):

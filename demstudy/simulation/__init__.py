@@ -3,21 +3,26 @@ child process that isolates a run.
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. :func:`run_scene` is
 what the CLI and :func:`demstudy.run` call: refuse what cannot run, then run the scene in a
-child process (``isolate``, or MPI with ``np > 1``) or in this one.
+child process (``isolate``, or MPI with ``np > 1``) or in this one, after its plan
+(:func:`plan_run`: the pilot for automatic soft contacts and the wall-time forecast, printed
+at the start and stored in the results file).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import sys
 from pathlib import Path
 from typing import Any
 
 from ..scene import Scene
 from .loop import Simulation
 from .options import RunOptions, check_run, check_run_options, work_folder
+from .plan import RunPlan, plan_run
 from .state import RunState
 
-__all__ = ["RunOptions", "RunState", "Simulation", "check_run", "check_run_options",
-           "run_scene", "work_folder"]
+__all__ = ["RunOptions", "RunPlan", "RunState", "Simulation", "check_run",
+           "check_run_options", "plan_run", "run_scene", "work_folder"]
 
 
 def run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
@@ -29,6 +34,15 @@ def run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
     from .isolation import in_worker, launch_child
 
     backend = get_backend(engine) if isinstance(engine, str) else engine
+    if options.plan and not in_worker():
+        check_run(backend, scene, options)  # refused before the pilot runs
+        plan = plan_run(scene, backend, options)
+        options = dataclasses.replace(options, plan=False, pilot=plan.pilot,
+                                      forecast=plan.forecast)
+        if plan.setup is not None:
+            print(f"{backend.name}: {plan.setup.note()}", file=sys.stderr)
+        if plan.forecast is not None:
+            print(plan.forecast.line(), file=sys.stderr, flush=True)
     if (options.isolate or options.np > 1) and not in_worker():
         check_run(backend, scene, options)
         return launch_child(backend, scene, options)

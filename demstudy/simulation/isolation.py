@@ -68,6 +68,8 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
         "wall_limit": options.wall_limit,
         "np": options.np,
         "extra": options.extra,
+        "pilot": options.pilot.to_json() if options.pilot is not None else None,
+        "forecast": dataclasses.asdict(options.forecast) if options.forecast else None,
     }
     out = Path(payload["out"])
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -201,13 +203,19 @@ def worker(job: str) -> int:
     sys.path[:0] = [p for p in payload["sys_path"] if p not in sys.path]
     register_backend(payload["backend"], payload["engine"])
     error = Path(job).with_suffix(".error")
+    from ..contact.pilot import PilotResult
+    from .forecast import Forecast
+
     scene = validate_scene(payload["scene"], source=job)
+    pilot, forecast = payload.get("pilot"), payload.get("forecast")
     options = RunOptions(out=Path(payload["out"]), np=payload["np"],
                          dump=Path(payload["dump"]) if payload["dump"] else None,
                          resume=payload["resume"], progress=payload["progress"],
                          keep_frames=payload["keep_frames"],
                          checkpoint_interval=payload["checkpoint_interval"],
-                         wall_limit=payload["wall_limit"], extra=payload["extra"])
+                         wall_limit=payload["wall_limit"], extra=payload["extra"],
+                         plan=False, pilot=PilotResult.from_json(pilot) if pilot else None,
+                         forecast=Forecast(**forecast) if forecast else None)
     return run_in_child(get_backend(payload["engine"]), scene, options, error)
 
 

@@ -339,6 +339,8 @@ class Simulation:
                 self._loop(state, started)
                 state.wall_seconds += time.perf_counter() - started
                 extra = backend.result_attrs()
+                if self.options.forecast is not None:  # next to wall_seconds: forecast vs actual
+                    extra.update(self.options.forecast.attrs())
         except KeyboardInterrupt:  # no handler (not the main thread): keep the last checkpoint
             raise EngineError("interrupted: run again with --resume to continue from the last "
                               "checkpoint (if any)") from None

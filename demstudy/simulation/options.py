@@ -21,7 +21,11 @@ class RunOptions:
     production frame (None: the scene's ``measure.keep_frames``); ``checkpoint_interval``
     (None: the scene's); ``isolate``: run the engine in a child process (a crash becomes
     ``EngineError``); ``wall_limit``: seconds, then checkpoint and stop; ``extra``: the
-    engine's own options (``Backend.options``, e.g. ``tc`` of the event-driven engine)."""
+    engine's own options (``Backend.options``, e.g. ``tc`` of the event-driven engine);
+    ``plan``: run the pilot and the forecast before the run (:func:`plan_run`; False for
+    benchmarks); ``pilot`` / ``forecast``: their results, set by the plan (the soft-contact
+    engine takes its automatic stiffness from ``pilot``; the results file stores
+    ``forecast``)."""
 
     out: Path
     np: int = 1
@@ -33,6 +37,9 @@ class RunOptions:
     isolate: bool = False
     wall_limit: float | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    plan: bool = True
+    pilot: Any = None  # demstudy.contact.pilot.PilotResult
+    forecast: Any = None  # demstudy.simulation.forecast.Forecast
 
 
 def work_folder(out: Path, engine: str) -> Path:

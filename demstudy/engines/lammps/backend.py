@@ -89,7 +89,7 @@ class LammpsBackend(BackendBase):
 
     @classmethod
     def check(cls, scene: Scene, options) -> None:
-        check_scene(scene)
+        check_scene(scene, getattr(options, "pilot", None))
 
     @staticmethod
     def launcher(np_ranks: int) -> list[str]:
@@ -121,7 +121,7 @@ class LammpsBackend(BackendBase):
 
     def __init__(self, scene: Scene, options, workdir: Path):
         super().__init__(scene, options, workdir)
-        self.contact = check_scene(scene)
+        self.contact = check_scene(scene, getattr(options, "pilot", None))
         self.time_step = self.contact.timestep
         self.n_sample = sample_steps(scene, self.time_step)
         self.dump = Path(options.dump).resolve() if options.dump else None
@@ -432,7 +432,8 @@ class LammpsBackend(BackendBase):
         return any_rank(flag, self.nprocs)  # also after close: the loop's last barrier
 
     def result_attrs(self) -> dict:
-        return {"engine_version": f"LAMMPS {self.session.lmp.version()}",
+        return {**self.contact.attrs(),
+                "engine_version": f"LAMMPS {self.session.lmp.version()}",
                 "timestep": self.time_step, "deck": self.deck.render(self.scene.meta.name),
                 "approximations": "\n".join(self.deck.notes)}
 

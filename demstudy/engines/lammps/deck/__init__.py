@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ....contact.pilot import PilotResult
 from ....contact.stiffness import ContactSetup, contact_setup
 from ....effects import apply_effects, check_effects
 from ....effects.bumps import bump_rows
@@ -26,14 +27,15 @@ from .system import DATA_FILE, data_file, groups_block, integrate_block, setup_b
 __all__ = ["Block", "Deck", "build_deck", "check_scene", "write_deck"]
 
 
-def check_scene(scene: Scene) -> ContactSetup:
+def check_scene(scene: Scene, pilot: PilotResult | None = None) -> ContactSetup:
     """Refuse what LAMMPS cannot run (``UnsupportedByEngine``): collision-counted runs and
-    effects without a LAMMPS translation; return the soft-contact set-up."""
+    effects without a LAMMPS translation; return the soft-contact set-up (automatic k_n from
+    ``pilot`` when given, else estimated: ``contact_setup``)."""
     if scene.run.unit != "time":
         raise UnsupportedByEngine("lammps", "run.unit", scene.run.unit,
                                   "soft contacts have no collision count: give times")
     check_effects(scene, "lammps", TRANSLATIONS)
-    return contact_setup(scene, "lammps")
+    return contact_setup(scene, "lammps", pilot)
 
 
 def build_deck(scene: Scene, state: InitialState | None = None, dump: str | None = None,

@@ -48,7 +48,8 @@ class Deck:
         ]
         lines += [f"# NOTE: {n}" for n in self.notes]
         for block in self.blocks:
-            lines += ["", f"# --- {block.effect}: {block.comment}"]
+            first, *more = block.comment.split("\n")  # every comment line stays a comment
+            lines += ["", f"# --- {block.effect}: {first}", *(f"# {m}" for m in more)]
             lines += block.commands
         return "\n".join(lines) + "\n"
 

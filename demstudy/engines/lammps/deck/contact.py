@@ -43,5 +43,6 @@ def pair_block(scene: Scene, setup: ContactSetup) -> Block:
         f"{p.model} contacts, k_n = {p.kn:.6g}, e = {p.restitution:g}, "
         f"t_c = {p.contact_time:.6g} (m_eff = m/2)"
         + ("" if p.tangential == "none" else f", k_t = {p.kt:.6g}, {p.tangential} tangential")
+        + f"\n{setup.note()}"
     )
     return Block("contact", comment, cmds)

@@ -1,0 +1,253 @@
+"""The event-driven pilot: a short hard-particle run of a scene that measures its impacts, so
+that the automatic soft-contact stiffness and time step fit the flow instead of a guess.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
+or the shear rate sets the time unit τ). Speeds are normal impact speeds |(v_i − v_j)·n| (pairs)
+and |(v_i − u_wall)·n| (walls) just before each collision, in d/τ; the collision rate is
+impacts per particle per τ, τ_flight its inverse.
+
+:func:`run_pilot` runs the scene in the event-driven core (in this process, no results file)
+with every collision logged, until the first of: the scene's own duration (equilibration +
+production), ``PILOT_COLLISIONS`` pair collisions per particle, or ``PILOT_SECONDS`` of wall
+time. It adds the initial state's own impacts as a floor (the largest approach speed of
+neighbouring particles and the walls' speeds), so particles fired at each other are seen even
+when the pilot stops first. Results are cached by the scene's TOML (and its particles file)
+in ``pilot_cache_dir()``. Where the event-driven engine refuses the scene (soft-only
+features) the result is unusable (``usable`` False, ``reason`` says why) and the stiffness
+falls back to :func:`demstudy.contact.stiffness.reference_speed` with a warning.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import os
+import tempfile
+import time
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..scene import Scene, scene_to_toml
+
+__all__ = ["PILOT_COLLISIONS", "PILOT_SECONDS", "PilotResult", "PilotWarning",
+           "cache_dir", "initial_floor", "pilot_cache_path", "run_pilot"]
+
+#: pilot stops after this many pair collisions per particle ...
+PILOT_COLLISIONS = 20.0
+#: ... or this many seconds of wall time (whichever comes first; also the scene's duration)
+PILOT_SECONDS = 5.0
+#: impacts slower than this fraction of the design speed are resting contacts (TC hops,
+#: chatter in a bed), not flights: they are not counted in the collision rate
+RESTING_FRACTION = 0.01
+#: quantiles kept in the summary (the design quantile is ``stiffness.DESIGN_QUANTILE``)
+QUANTILES = (0.5, 0.99, 0.999)
+PILOT_VERSION = 1  # part of the cache key: a changed pilot measures again
+
+
+class PilotWarning(UserWarning):
+    """The pilot could not measure the scene: the stiffness comes from an estimate."""
+
+
+@dataclass(frozen=True)
+class PilotResult:
+    """What the pilot measured (speeds in d/τ, rate in impacts per particle per τ).
+
+    ``pair`` / ``wall``: normal impact speed quantiles {"q0.5", "q0.99", "q0.999", "max"}
+    (empty when none was seen); ``floor``: the initial state's largest approach speed (and
+    wall speeds); ``rate``: non-resting impacts per particle per τ (pair impacts count for
+    both partners), 0 when none; ``usable`` False with ``reason`` when the pilot could not run.
+    """
+
+    usable: bool
+    reason: str = ""
+    pair: dict[str, float] = dataclasses.field(default_factory=dict)
+    wall: dict[str, float] = dataclasses.field(default_factory=dict)
+    floor: float = 0.0
+    rate: float = 0.0
+    pair_collisions: int = 0
+    wall_collisions: int = 0
+    simulated_time: float = 0.0
+    wall_seconds: float = 0.0
+    events: int = 0
+    stopped_by: str = ""
+    n_particles: int = 0
+
+    @property
+    def tau_flight(self) -> float:
+        """Mean free-flight time between impacts (inf: no impact seen)."""
+        return 1.0 / self.rate if self.rate > 0 else math.inf
+
+    def speed(self, kind: str, quantile: float) -> float:
+        """The design impact speed of ``kind`` ("pair" or "wall"): its ``quantile`` of the
+        measured speeds, never below the initial state's floor."""
+        measured = (self.pair if kind == "pair" else self.wall).get(f"q{quantile:g}", 0.0)
+        return max(measured, self.floor)
+
+    def summary(self) -> str:
+        """One line for the run's start and the results file."""
+        if not self.usable:
+            return f"no pilot ({self.reason})"
+        parts = [f"{k} impacts: " + ", ".join(f"{q} {v:.3g}" for q, v in s.items())
+                 for k, s in (("pair", self.pair), ("wall", self.wall)) if s]
+        return (f"event-driven pilot over t = {self.simulated_time:.3g} ({self.stopped_by}, "
+                f"{self.wall_seconds:.2g} s): " + "; ".join(parts or ["no impacts"]) +
+                f"; initial floor {self.floor:.3g}; {self.rate:.3g} impacts per particle "
+                f"per time unit (τ_flight = {self.tau_flight:.3g})")
+
+    def to_json(self) -> str:
+        return json.dumps(dataclasses.asdict(self))
+
+    @classmethod
+    def from_json(cls, text: str) -> PilotResult:
+        return cls(**json.loads(text))
+
+
+# -- cache ----------------------------------------------------------------------------------
+def cache_dir() -> Path:
+    """demstudy's cache folder: $XDG_CACHE_HOME/demstudy (default ~/.cache/demstudy)."""
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "demstudy"
+
+
+def pilot_cache_path(scene: Scene) -> Path:
+    """The cache file of ``scene``'s pilot: keyed by its TOML, its particles file's content
+    (placement = 'file') and the pilot's caps and version."""
+    key = hashlib.sha256(scene_to_toml(scene).encode())
+    key.update(f"{PILOT_VERSION} {PILOT_COLLISIONS} {PILOT_SECONDS} {RESTING_FRACTION}".encode())
+    if scene.initial.placement == "file":
+        key.update(Path(scene.initial.path).read_bytes())
+    return cache_dir() / "pilot" / f"{key.hexdigest()[:24]}.json"
+
+
+def _store(path: Path, result: PilotResult) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as f:
+        f.write(result.to_json())
+    os.replace(f.name, path)  # atomic: a concurrent reader sees the old file or the new
+
+
+# -- the initial state's own impacts --------------------------------------------------------
+def initial_floor(scene: Scene, position: np.ndarray, velocity: np.ndarray) -> float:
+    """The largest normal approach speed of neighbouring particles (centres within 3 d) in the
+    initial state, the largest speed of a particle towards a wall, and the walls' speeds."""
+    from scipy.spatial import cKDTree
+
+    speeds = [abs(w.velocity) for w in scene.walls] + [0.0]
+    if scene.walls:
+        speeds.append(float(np.abs(velocity[:, 1]).max(initial=0.0)))
+    pairs = cKDTree(position).query_pairs(3.0, output_type="ndarray")
+    if len(pairs):
+        branch = position[pairs[:, 1]] - position[pairs[:, 0]]
+        relative = velocity[pairs[:, 0]] - velocity[pairs[:, 1]]
+        approach = np.einsum("ij,ij->i", relative, branch) / np.linalg.norm(branch, axis=1)
+        speeds.append(float(approach.max()))
+    return max(speeds)
+
+
+# -- the run --------------------------------------------------------------------------------
+def run_pilot(scene: Scene, *, cache: bool = True, seconds: float = PILOT_SECONDS,
+              collisions: float = PILOT_COLLISIONS) -> PilotResult:
+    """The pilot of ``scene`` (from the cache when it ran before, unless ``cache`` is False).
+    Warns (``PilotWarning``) and returns an unusable result when the event-driven engine
+    cannot run the scene."""
+    path = pilot_cache_path(scene)
+    if cache and path.is_file():
+        try:
+            return PilotResult.from_json(path.read_text())
+        except (ValueError, TypeError):
+            pass  # an older or damaged cache file: measure again
+    result = _measure(scene, seconds, collisions)
+    if not result.usable:
+        warnings.warn(f"no event-driven pilot: {result.reason}; the soft-contact stiffness "
+                      "comes from the estimated reference speed (stiffness_basis = "
+                      "'estimate'); give soft.stiffness or soft.hardness to choose it",
+                      PilotWarning, stacklevel=2)
+    if cache:
+        _store(path, result)
+    return result
+
+
+def _measure(scene: Scene, seconds: float, collisions: float) -> PilotResult:
+    from ..engines.backend import Needs
+    from ..engines.edmd import EdmdBackend
+    from ..errors import EngineError, UnsupportedByEngine
+    from ..simulation.options import RunOptions
+
+    if scene.run.unit != "time":
+        return PilotResult(False, "run.unit = 'collisions': soft contacts need times")
+    with tempfile.TemporaryDirectory(prefix="demstudy-pilot-") as tmp:
+        options = RunOptions(out=Path(tmp) / "pilot.h5", progress=False)
+        try:
+            EdmdBackend.check(scene, options)
+            backend = EdmdBackend(scene, options, Path(tmp))
+            backend.setup(Needs(log_every=1), None, None)
+        except UnsupportedByEngine as exc:
+            return PilotResult(False, f"the event-driven engine cannot run the scene ({exc})")
+        try:
+            return _advance(scene, backend, seconds, collisions)
+        except EngineError as exc:
+            return PilotResult(False, f"the event-driven pilot failed ({exc})")
+        finally:
+            backend.close()
+
+
+def _advance(scene: Scene, backend, seconds: float, collisions: float) -> PilotResult:
+    core, n = backend.core, backend.n_particles
+    frame = backend.frame()
+    floor = initial_floor(scene, frame.position, frame.velocity)
+    t_end = scene.run.equilibration + scene.run.production
+    target = math.ceil(collisions * n)
+    chunk = max(n, 100)  # pair collisions between two wall-clock checks
+    started = time.perf_counter()
+    speeds: dict[str, list[np.ndarray]] = {"pair": [], "wall": []}
+
+    def over_time() -> bool:
+        return time.perf_counter() - started > seconds
+
+    stopped_by = "the scene's duration"
+    while True:
+        reached = backend.advance(t_end, min(core.collisions + chunk, target), over_time)
+        log = backend.take_collision_log()
+        if log is not None and len(log["time"]):
+            vn = np.abs(np.einsum("ij,ij->i", log["velocity"], log["normal"]))
+            speeds["pair"].append(vn[log["kind"] == 0])
+            speeds["wall"].append(vn[log["kind"] != 0])
+        if reached:
+            break
+        if core.collisions >= target:
+            stopped_by = f"{collisions:g} collisions per particle"
+            break
+        if over_time():
+            stopped_by = f"{seconds:g} s wall-time cap"
+            break
+    pair = np.concatenate(speeds["pair"] or [np.zeros(0)])
+    wall = np.concatenate(speeds["wall"] or [np.zeros(0)])
+    t = core.time
+    from .stiffness import DESIGN_QUANTILE  # one place for the targets
+
+    design = max(_quantile(pair, DESIGN_QUANTILE), _quantile(wall, DESIGN_QUANTILE), floor)
+    resting = RESTING_FRACTION * design
+    impacts = 2 * np.count_nonzero(pair > resting) + np.count_nonzero(wall > resting)
+    return PilotResult(
+        True, pair=_summary(pair), wall=_summary(wall), floor=floor,
+        rate=impacts / (n * t) if t > 0 else 0.0, pair_collisions=len(pair),
+        wall_collisions=len(wall), simulated_time=t,
+        wall_seconds=time.perf_counter() - started, events=int(core.events),
+        stopped_by=stopped_by, n_particles=n)
+
+
+def _quantile(speeds: np.ndarray, q: float) -> float:
+    return float(np.quantile(speeds, q)) if len(speeds) else 0.0
+
+
+def _summary(speeds: np.ndarray) -> dict[str, float]:
+    if not len(speeds):
+        return {}
+    out = {f"q{q:g}": _quantile(speeds, q) for q in QUANTILES}
+    out["max"] = float(speeds.max())
+    return out

@@ -1,0 +1,318 @@
+"""Wall-time forecast of a run, from this machine's measured speed (docs/forecast.md).
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
+or the shear rate sets the time unit τ); durations in τ, wall time in seconds.
+
+The wall time is a sum of measured costs (seconds per unit) times counts of the run:
+
+* soft-contact (time-stepped) engines: ``step`` × steps + ``atom_step`` × atoms × steps +
+  ``contact_step`` × atoms × steps × ν (contacts grow with the solid fraction ν; 0.5 for a
+  bed under gravity) + ``atom_sample`` × atoms × samples (gathering and binning) +
+  ``sample`` × samples (a segment's fixed cost) +
+  ``shear_atom_step`` × atoms × steps under Lees–Edwards shear + ``history_atom_step`` ×
+  atoms × steps with tangential springs + ``wall_step`` × steps × walls, atoms = particles
+  + wall bumps, steps = duration / dt;
+* event-driven engines: ``event`` × events + ``atom_sample`` × N × samples + ``sample`` ×
+  samples. The events come from the pilot's measured events per particle per τ (× N ×
+  duration), or, with no pilot, from the Enskog collision frequency at T = (reference
+  speed)² with ``EVENTS_PER_COLLISION`` events (collisions and cell crossings) per pair
+  collision; a run counted in collisions (``run.unit = 'collisions'``) knows its count.
+
+The costs of each engine, contact model and dimension are measured once by a few short
+benchmark runs through the same simulation loop (a least-squares fit with non-negative
+costs, ``scipy.optimize.nnls``) and cached in ``machine-rates.json`` of demstudy's cache
+folder ($XDG_CACHE_HOME/demstudy, default ~/.cache/demstudy) with the CPU model; another
+CPU, ``demstudy forecast --measure`` or ``measure_costs(..., remeasure=True)`` measures
+again. The forecast covers the simulation loop (the results file's ``wall_seconds``), not
+the engine's start-up nor the pilot.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..contact.pilot import PilotResult, cache_dir
+from ..scene import Scene, validate_scene
+
+__all__ = ["EVENTS_PER_COLLISION", "UNCERTAINTY", "Forecast", "cpu_model", "event_counts",
+           "forecast_run", "load_rates", "measure_costs", "predict", "rate_key", "rates_path",
+           "soft_counts"]
+
+#: the forecast's stated relative uncertainty (the goal: within ±30 % of the actual time)
+UNCERTAINTY = 0.3
+#: event-driven events per pair collision without a pilot (collisions + cell crossings)
+EVENTS_PER_COLLISION = 3.0
+RATES_FILE = "machine-rates.json"
+#: the cost model's version: cached costs of another version are measured again
+COST_MODEL = 4
+
+
+@dataclass(frozen=True)
+class Forecast:
+    """A wall-time forecast: ``seconds`` ± ``uncertainty`` (relative), and what it is
+    computed from (``basis``)."""
+
+    seconds: float
+    basis: str
+    uncertainty: float = UNCERTAINTY
+
+    def line(self) -> str:
+        return (f"forecast: {_duration(self.seconds)} (±{self.uncertainty:.0%}) from "
+                f"{self.basis}").replace("%", " %")
+
+    def attrs(self) -> dict[str, Any]:
+        return {"forecast_seconds": self.seconds, "forecast_basis": self.basis,
+                "forecast_uncertainty": self.uncertainty}
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.3g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.3g} min"
+    return f"{seconds / 3600:.3g} h"
+
+
+# -- machine costs --------------------------------------------------------------------------
+def cpu_model() -> str:
+    """The CPU's model name (/proc/cpuinfo on Linux) and its logical core count."""
+    name = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                name = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{name} ({os.cpu_count()} logical cores)"
+
+
+def rates_path() -> Path:
+    return cache_dir() / RATES_FILE
+
+
+def rate_key(engine: str, dim: int, model: str | None = None) -> str:
+    """Cache key of a cost set: "lammps-hooke-2d" (soft contacts), "edmd-3d" (event-driven)."""
+    return f"{engine}-{model}-{dim}d" if model else f"{engine}-{dim}d"
+
+
+def load_rates() -> dict[str, dict]:
+    """The cached costs measured on this CPU (empty when none, or measured on another)."""
+    try:
+        data = json.loads(rates_path().read_text())
+    except (OSError, ValueError):
+        return {}
+    return data.get("rates", {}) if data.get("cpu") == cpu_model() else {}
+
+
+def _store_rate(key: str, entry: dict) -> None:
+    rates = load_rates()
+    rates[key] = entry
+    path = rates_path()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = json.dumps({"units": "wall-clock seconds per unit of each count (docs/forecast.md)",
+                       "cpu": cpu_model(), "rates": rates}, indent=1)
+    with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as f:
+        f.write(text)
+    os.replace(f.name, path)
+
+
+def measure_costs(engine: str, dim: int, model: str | None = None, *,
+                  remeasure: bool = False) -> dict[str, float]:
+    """This machine's costs (seconds per count, :func:`soft_counts` / :func:`event_counts`)
+    for ``engine``, ``dim`` and contact ``model``: cached, or measured now by benchmark runs
+    (~10 s in all; ``remeasure``: measure again)."""
+    key = rate_key(engine, dim, model)
+    cached = load_rates().get(key)
+    if cached is not None and cached.get("model") == COST_MODEL and not remeasure:
+        return {k: float(v) for k, v in cached["costs"].items()}
+    costs, what = _benchmark(engine, dim, model)
+    _store_rate(key, {"model": COST_MODEL, "costs": costs, "what": what,
+                      "measured": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())})
+    return costs
+
+
+#: benchmark cases: (N, ν, duration, sample interval, sheared, rough) with times in soft
+#: time steps (soft) or τ (event-driven); each count dominates one case
+SOFT_CASES = ((1000, 0.1, 30000, 3000, False, False), (1000, 0.45, 30000, 3000, False, False),
+              (20, 0.3, 80000, 8000, False, False), (1000, 0.1, 4000, 2, False, False),
+              (1000, 0.1, 30000, 3000, True, False), (1000, 0.1, 30000, 3000, False, True),
+              (20, 0.3, 80000, 8000, "wall", True), (20, 0.3, 4000, 4, False, False))
+EVENT_CASES = ((1000, 0.4, 60.0, 2.0, True, True), (1000, 0.4, 4.0, 0.005, True, True),
+               (20, 0.4, 40.0, 0.01, True, True))
+
+
+def _benchmark_scene(dim: int, n: int, phi: float, duration: float, interval: float,
+                     model: str | None, sheared: bool | str = True,
+                     rough: bool = True) -> Scene:
+    """A gas of ``n`` smooth or rough (β = 0.5) particles (solid fraction ``phi``, T0 = 1),
+    sheared or not (Lees–Edwards, γ̇ = 1); soft contacts at δ/d = 0.005 for impacts at 3."""
+    phi = min(phi, 0.3) if dim == 3 else phi
+    volume = n * (math.pi / 4 if dim == 2 else math.pi / 6) / phi
+    length = max(volume ** (1 / dim), 3.2)
+    data: dict[str, Any] = {
+        "dimension": dim, "box": {"size": [length] * dim}, "particles": {"count": n},
+        "contact": {"restitution": 0.9, "tangential": {"model": "beta", "beta": 0.5}
+                    if rough else {"model": "smooth"}},
+        "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+        "run": {"equilibration": 0.0, "production": duration, "sample_interval": interval,
+                "seed": 1},
+    }
+    if sheared == "wall":  # a chute's fixed costs per step: a rough wall fix and gravity
+        data["walls"] = [{"side": "lower", "restitution": 0.9,
+                          "tangential": {"model": "beta", "beta": 0.5}}]
+        data["gravity"] = {"angle": 20.0}
+    elif sheared:
+        data["shear"] = {"rate": 1.0}
+        data["initial"]["velocity"]["profile"] = "linear"
+    if model is not None:
+        data["soft"] = {"model": model, "hardness": {"overlap": 0.005, "impact_speed": 3.0}}
+    return validate_scene(data, "forecast benchmark")
+
+
+def _benchmark(engine: str, dim: int, model: str | None) -> tuple[dict[str, float], str]:
+    """Run the benchmark cases and fit the costs (non-negative least squares, relative
+    residuals: every case weighs the same)."""
+    import numpy as np
+    from scipy.optimize import nnls
+
+    from ..contact.stiffness import contact_setup
+    from ..engines import get_backend
+    from ..io.results import read_results
+    from . import RunOptions, run_scene
+
+    backend = get_backend(engine)
+    soft = backend.capabilities.time_step
+    rows, seconds, what = [], [], []
+    for n, phi, duration, interval, sheared, rough in SOFT_CASES if soft else EVENT_CASES:
+        scene = _benchmark_scene(dim, n, phi, 1.0, 1.0, model, sheared, rough)
+        dt = contact_setup(scene).timestep if soft else 1.0
+        scene = _benchmark_scene(dim, n, phi, duration * dt, interval * dt, model, sheared,
+                                 rough)
+        with tempfile.TemporaryDirectory(prefix="demstudy-benchmark-") as tmp:
+            options = RunOptions(out=Path(tmp) / "bench.h5", progress=False, isolate=True,
+                                 plan=False)  # no forecast of the benchmark itself
+            attrs = read_results(run_scene(scene, backend, options)).attrs
+        counts = soft_counts(scene, dt) if soft else event_counts(scene, int(attrs["events"]))
+        rows.append(counts)
+        seconds.append(float(attrs["wall_seconds"]))
+        what.append(f"N {n}, ν {scene.solid_fraction:.2g}"
+                    f"{', ' + str(sheared).replace('True', 'sheared') if sheared else ''}"
+                    f"{', rough' if rough else ''}: {float(attrs['wall_seconds']):.3g} s")
+    names = list(rows[0])
+    a = np.array([[r[k] for k in names] for r in rows], float)
+    b = np.array(seconds)
+    coef, _ = nnls(a / b[:, None], np.ones(len(b)))
+    return dict(zip(names, map(float, coef), strict=True)), "; ".join(what)
+
+
+# -- forecasts ------------------------------------------------------------------------------
+def _atoms(scene: Scene) -> int:
+    from ..effects.bumps import bump_rows
+
+    return scene.n_particles + sum(len(row.centres) for row in bump_rows(scene))
+
+
+def _contact_density(scene: Scene) -> float:
+    """ν for the contact cost: the solid fraction, or 0.5 (a bed) under gravity, where the
+    box's own fraction (an open top) says little."""
+    return 0.5 if scene.gravity is not None else min(scene.solid_fraction, 0.6)
+
+
+def _samples(scene: Scene) -> int:
+    run = scene.run
+    return max(1, round((run.equilibration + run.production) / run.sample_interval))
+
+
+def soft_counts(scene: Scene, timestep: float) -> dict[str, float]:
+    """The counts a time-stepped run's costs multiply (see the module docstring)."""
+    atoms = _atoms(scene)
+    steps = math.ceil((scene.run.equilibration + scene.run.production) / timestep - 1e-9)
+    return {"step": steps, "atom_step": atoms * steps,
+            "contact_step": atoms * steps * _contact_density(scene),
+            "atom_sample": atoms * _samples(scene),
+            "sample": _samples(scene),  # a segment's fixed cost: run command, observables
+            # Lees–Edwards: the deforming box and its fast particles rebuild neighbour lists
+            "shear_atom_step": atoms * steps if scene.shear is not None else 0,
+            # tangential springs: contact histories (fix neigh/history)
+            "history_atom_step": atoms * steps if _history(scene) else 0,
+            # a wall fix's fixed cost per step (and gravity's, which comes with walls)
+            "wall_step": steps * len(scene.walls)}
+
+
+def _history(scene: Scene) -> bool:
+    """Whether the soft contacts carry tangential histories (anything but smooth)."""
+    rules = [scene.contact.tangential, *(w.tangential for w in scene.walls)]
+    return any(r.model != "smooth" and getattr(r, "beta", 0.0) != -1.0 for r in rules)
+
+
+def event_counts(scene: Scene, events: float) -> dict[str, float]:
+    """The counts an event-driven run's costs multiply (see the module docstring)."""
+    samples = _samples(scene)
+    return {"event": events, "atom_sample": scene.n_particles * samples, "sample": samples}
+
+
+def predict(costs: dict[str, float], counts: dict[str, float]) -> float:
+    """Σ cost × count (seconds); a count without a measured cost is an error."""
+    missing = set(counts) - set(costs)
+    if missing:
+        raise ValueError(f"no measured cost for {sorted(missing)} (have {sorted(costs)}): "
+                         "run `demstudy forecast --measure`")
+    return float(sum(costs[k] * v for k, v in counts.items()))
+
+
+def expected_events(scene: Scene, pilot: PilotResult | None = None) -> tuple[float, str]:
+    """An event-driven run's events, and where the number comes from: the collision count
+    of ``run.unit = 'collisions'``, the pilot's events per particle per τ, or Enskog."""
+    n, duration = scene.n_particles, scene.run.equilibration + scene.run.production
+    per_collision = EVENTS_PER_COLLISION
+    if pilot is not None and pilot.usable and pilot.pair_collisions > 0:
+        per_collision = pilot.events / pilot.pair_collisions
+    if scene.run.unit == "collisions":
+        return (duration * n * per_collision,
+                f"{duration * n:.4g} pair collisions × {per_collision:.3g} events each")
+    if pilot is not None and pilot.usable and pilot.simulated_time > 0:
+        per = pilot.events / (pilot.n_particles * pilot.simulated_time)
+        return per * n * duration, (f"the pilot's {per:.3g} events per particle per τ × {n} "
+                                    f"× {duration:g} τ")
+    from ..contact.stiffness import reference_speed
+    from ..theory import collision_frequency
+
+    temperature = reference_speed(scene) ** 2
+    omega = float(collision_frequency(min(scene.solid_fraction, 0.6), temperature,
+                                      scene.dimension))
+    return omega * n * duration / 2 * per_collision, (
+        f"Enskog ω = {omega:.3g} at T = {temperature:.3g} × {n} × {duration:g} τ / 2 × "
+        f"{per_collision:g} events per collision")
+
+
+def forecast_run(scene: Scene, backend: Any, timestep: float | None = None,
+                 pilot: PilotResult | None = None,
+                 costs: dict[str, float] | None = None) -> Forecast:
+    """The forecast of ``scene`` in ``backend`` (a backend class): time-stepped engines need
+    the ``timestep``; ``costs`` (seconds per count) override the machine's measured ones
+    (measured now if not cached)."""
+    model = scene.soft.model if backend.capabilities.time_step else None
+    key = rate_key(backend.name, scene.dimension, model)
+    where = key if costs is None else "given costs"
+    if costs is None:
+        costs = measure_costs(backend.name, scene.dimension, model)
+    if backend.capabilities.time_step:
+        if timestep is None:
+            raise ValueError("a time-stepped engine's forecast needs its time step")
+        counts = soft_counts(scene, timestep)
+        basis = (f"{_atoms(scene)} atoms × {counts['step']} steps (dt = {timestep:.4g}), "
+                 f"{_samples(scene)} samples, ν = {_contact_density(scene):.3g}")
+    else:
+        events, source = expected_events(scene, pilot)
+        counts = event_counts(scene, events)
+        basis = f"{events:.4g} events ({source}), {_samples(scene)} samples"
+    return Forecast(predict(costs, counts), f"{basis}; costs of {where}")

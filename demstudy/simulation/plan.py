@@ -1,0 +1,101 @@
+"""What happens before a run starts: the pilot (automatic soft-contact settings) and the
+wall-time forecast; ``demstudy run --dry-run`` shows them and stops there.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
+or the shear rate sets the time unit τ). The pilot runs (or comes from its cache) when a
+soft-contact engine must choose k_n itself (no ``soft.stiffness``, no ``soft.hardness``), and
+for the event-driven engine's forecast; never for a resumed run's forecast alone.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+from ..contact.pilot import PilotResult, run_pilot
+from ..contact.stiffness import ContactSetup, contact_setup
+from ..scene import Scene
+from .forecast import Forecast, forecast_run
+from .options import RunOptions
+
+__all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
+
+#: engines with a benchmark (``forecast.measure_rate``): the others get no forecast
+FORECAST_ENGINES = ("lammps", "edmd")
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """A run's settings before it starts: the engine, N, the soft contacts (time-stepped
+    engines), the pilot and the forecast (None when there is none)."""
+
+    engine: str
+    n_particles: int
+    setup: ContactSetup | None
+    pilot: PilotResult | None
+    forecast: Forecast | None
+
+    def as_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"engine": self.engine, "n_particles": self.n_particles}
+        if self.setup is not None:
+            s = self.setup
+            out.update(kn=s.kn, timestep=s.timestep, contact_time=s.pair.contact_time,
+                       steps_per_contact=s.steps_per_contact, stiffness_basis=s.basis,
+                       design_speed=s.speed)
+        if self.pilot is not None:
+            out.update(pilot_usable=self.pilot.usable, pilot_summary=self.pilot.summary(),
+                       pair_impact_speeds=dict(self.pilot.pair),
+                       wall_impact_speeds=dict(self.pilot.wall),
+                       initial_floor_speed=self.pilot.floor,
+                       collision_rate=self.pilot.rate, tau_flight=self.pilot.tau_flight)
+        if self.forecast is not None:
+            out.update(self.forecast.attrs())
+        return out
+
+    def describe(self) -> str:
+        lines = [f"engine: {self.engine}, {self.n_particles} particles"]
+        if self.setup is not None:
+            s = self.setup
+            lines.append(f"contacts: {s.pair.model}, k_n = {s.kn:.6g}, dt = {s.timestep:.6g}, "
+                         f"t_c = {s.pair.contact_time:.6g}, {s.steps_per_contact:.4g} steps "
+                         f"per contact, stiffness basis: {s.basis}")
+            if math.isfinite(s.speed):
+                lines.append(f"design impact speed: {s.speed:.4g}")
+        if self.pilot is not None:
+            lines.append(f"pilot: {self.pilot.summary()}")
+        lines.append(self.forecast.line() if self.forecast is not None else
+                     f"forecast: none for the {self.engine} engine")
+        return "\n".join(lines)
+
+
+def needs_pilot(scene: Scene, backend: Any) -> bool:
+    """A soft-contact engine choosing k_n itself, or the event-driven engine's forecast
+    (runs counted in time)."""
+    if backend.capabilities.time_step:
+        return scene.soft.stiffness is None and scene.soft.hardness is None
+    return backend.name == "edmd" and scene.run.unit == "time"
+
+
+def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
+             costs: dict[str, float] | None = None) -> RunPlan:
+    """The pilot (cached), the soft contacts and the forecast of ``scene`` in ``backend``
+    (a backend class); ``costs`` override the machine's measured ones
+    (:func:`demstudy.simulation.forecast.measure_costs`). A forecast that
+    cannot be made (the benchmark failed) is a warning, never a refused run."""
+    pilot = options.pilot
+    if pilot is None and needs_pilot(scene, backend):
+        pilot = run_pilot(scene)
+    setup = None
+    if backend.capabilities.time_step:
+        setup = contact_setup(scene, backend.name, pilot)
+    forecast = None
+    if backend.name in FORECAST_ENGINES:
+        try:
+            forecast = forecast_run(scene, backend, setup.timestep if setup else None,
+                                    pilot, costs)
+        except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
+            warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
+    n = scene.n_particles
+    return RunPlan(backend.name, n, setup, pilot, forecast)
