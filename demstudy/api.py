@@ -63,7 +63,7 @@ def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
                          progress=sys.stderr.isatty() if progress is None else progress)
     if dry_run:
         check_run(backend, scene, options)
-        return plan_run(scene, backend, options).as_dict()
+        return plan_run(scene, backend, options, dry_run=True).as_dict()
     return read_results(run_scene(scene, backend, options))
 
 

@@ -60,7 +60,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if args.dry_run:  # the settings and the forecast; nothing runs, nothing is written
         backend = get_backend(args.engine)
         check_run(backend, scene, options)
-        print(plan_run(scene, backend, options).describe())
+        print(plan_run(scene, backend, options, dry_run=True).describe())
         return 0
     path = run_scene(scene, args.engine, options)
     print(f"results: {path}")

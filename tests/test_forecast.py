@@ -102,6 +102,11 @@ def test_costs_are_cached_per_cpu_and_remeasured_on_demand(monkeypatch):
         return {"event": 1e-6 * len(calls)}, "fake"
 
     monkeypatch.setattr(fc, "_benchmark", bench)
+    monkeypatch.setenv(fc.MEASURE_ENV, "0")  # measuring inside a run forbidden: refused
+    with pytest.raises(fc.RatesNotMeasured, match="demstudy forecast"):
+        fc.measure_costs("edmd", 2)
+    assert not calls
+    monkeypatch.setenv(fc.MEASURE_ENV, "1")
     assert fc.measure_costs("edmd", 2) == {"event": 1e-6}
     assert fc.measure_costs("edmd", 2) == {"event": 1e-6} and len(calls) == 1
     data = json.loads(fc.rates_path().read_text())

@@ -51,6 +51,14 @@ UNCERTAINTY = 0.3
 #: event-driven events per pair collision without a pilot (collisions + cell crossings)
 EVENTS_PER_COLLISION = 3.0
 RATES_FILE = "machine-rates.json"
+#: set to "0" to forbid benchmarking inside a run (the test suite does: its timings would
+#: measure a loaded machine); forecasts then come from the cache or are skipped
+MEASURE_ENV = "DEMSTUDY_MEASURE_RATES"
+
+
+class RatesNotMeasured(LookupError):
+    """The machine's costs are not cached and measuring them now is forbidden."""
+
 #: the cost model's version: cached costs of another version are measured again
 COST_MODEL = 4
 
@@ -134,6 +142,9 @@ def measure_costs(engine: str, dim: int, model: str | None = None, *,
     cached = load_rates().get(key)
     if cached is not None and cached.get("model") == COST_MODEL and not remeasure:
         return {k: float(v) for k, v in cached["costs"].items()}
+    if os.environ.get(MEASURE_ENV, "1") == "0" and not remeasure:
+        raise RatesNotMeasured(f"this machine's {key} costs are not measured yet ({MEASURE_ENV}"
+                               "=0 forbids measuring them now): run `demstudy forecast`")
     costs, what = _benchmark(engine, dim, model)
     _store_rate(key, {"model": COST_MODEL, "costs": costs, "what": what,
                       "measured": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())})

@@ -17,7 +17,7 @@ from typing import Any
 from ..contact.pilot import PilotResult, run_pilot
 from ..contact.stiffness import ContactSetup, contact_setup
 from ..scene import Scene
-from .forecast import Forecast, forecast_run
+from .forecast import Forecast, RatesNotMeasured, forecast_run
 from .options import RunOptions
 
 __all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
@@ -65,27 +65,33 @@ class RunPlan:
                 lines.append(f"design impact speed: {s.speed:.4g}")
         if self.pilot is not None:
             lines.append(f"pilot: {self.pilot.summary()}")
-        lines.append(self.forecast.line() if self.forecast is not None else
-                     f"forecast: none for the {self.engine} engine")
+        if self.forecast is not None:
+            lines.append(self.forecast.line())
+        elif self.engine in FORECAST_ENGINES:
+            lines.append("forecast: none (this machine's speed is not measured yet: "
+                         "demstudy forecast)")
+        else:
+            lines.append(f"forecast: none for the {self.engine} engine")
         return "\n".join(lines)
 
 
-def needs_pilot(scene: Scene, backend: Any) -> bool:
-    """A soft-contact engine choosing k_n itself, or the event-driven engine's forecast
-    (runs counted in time)."""
+def needs_pilot(scene: Scene, backend: Any, dry_run: bool = False) -> bool:
+    """A soft-contact engine choosing k_n itself; the event-driven engine's forecast only on
+    ``--dry-run`` (a run forecasts its events from the Enskog rate instead: a pilot of up to
+    seconds would multiply the fixed cost of short event-driven runs)."""
     if backend.capabilities.time_step:
         return scene.soft.stiffness is None and scene.soft.hardness is None
-    return backend.name == "edmd" and scene.run.unit == "time"
+    return dry_run and backend.name == "edmd" and scene.run.unit == "time"
 
 
 def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
-             costs: dict[str, float] | None = None) -> RunPlan:
+             costs: dict[str, float] | None = None, dry_run: bool = False) -> RunPlan:
     """The pilot (cached), the soft contacts and the forecast of ``scene`` in ``backend``
     (a backend class); ``costs`` override the machine's measured ones
     (:func:`demstudy.simulation.forecast.measure_costs`). A forecast that
     cannot be made (the benchmark failed) is a warning, never a refused run."""
     pilot = options.pilot
-    if pilot is None and needs_pilot(scene, backend):
+    if pilot is None and needs_pilot(scene, backend, dry_run):
         pilot = run_pilot(scene)
     setup = None
     if backend.capabilities.time_step:
@@ -95,6 +101,8 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
         try:
             forecast = forecast_run(scene, backend, setup.timestep if setup else None,
                                     pilot, costs)
+        except RatesNotMeasured:
+            pass  # said by describe(): no forecast
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     n = scene.n_particles
