@@ -174,7 +174,9 @@ def _cmd_engine_map(args: argparse.Namespace) -> int:
         settings = MapSettings(**QUICK["settings"], ratio=args.ratio, timeout=args.timeout)
         fractions = fractions or QUICK["fractions"]
         restitutions = restitutions if args.restitutions else QUICK["restitutions"]
-    result = engine_map(dims, fractions, restitutions, settings, out=args.out,
+    # a quick map never lands where ``demstudy cost`` reads the map from
+    out = args.out or (Path("results") / "engine-map-quick" if args.quick else None)
+    result = engine_map(dims, fractions, restitutions, settings, out=out,
                         workers=args.workers)
     print("outputs: " + ", ".join(str(p) for p in result.written))
     return 0
@@ -316,10 +318,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="soft contact time t_c = R x the mean free-flight time (default 0.05)")
     p.add_argument("--timeout", type=float, default=20.0, metavar="SECONDS",
                    help="event-driven runs longer than this are impractical (default 20)")
-    p.add_argument("--workers", type=int, default=1, help="local processes (default 1)")
-    p.add_argument("--out", help="folder (default results/engine-map/)")
+    p.add_argument("--workers", type=int, help="local processes (default: the cores)")
+    p.add_argument("--out", help="folder (default results/engine-map/, with --quick "
+                                 "results/engine-map-quick/)")
     p.add_argument("--quick", action="store_true",
-                   help="two points (fraction 0.3, e = 0.7 and 0.9) of very short runs")
+                   help="two points per dimension (fraction 0.3, e = 0.7 and 0.9), very "
+                        "short runs, one repeat")
     p.set_defaults(func=_cmd_engine_map)
     return parser
 

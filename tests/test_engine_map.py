@@ -66,7 +66,7 @@ def test_tiny_map_end_to_end(tmp_path):
     temperature (2D: ω = 2 n d g0 √(π T/m), g0 = (1 − 7ν/16)/(1 − ν)²) within 20 %."""
     settings = em.MapSettings(production=40.0, min_strain=1.0, max_strain=5.0,
                               soft_strain=0.2, soft_steps=1000, ratio=0.05, repeats=2)
-    result = em.engine_map((2,), (0.3,), (0.7, 0.9), settings, out=tmp_path,
+    result = em.engine_map((2,), (0.3,), (0.7, 0.9), settings, out=tmp_path, workers=1,
                            progress=lambda _: None)
     names = sorted(p.name for p in result.written)
     assert names == ["engine_map.csv", "engine_map.json", "engine_map.png"]

@@ -342,15 +342,16 @@ def grid(dims: Sequence[int], fractions: Sequence[float] | None = None,
 def engine_map(dims: Sequence[int] = (2, 3), fractions: Sequence[float] | None = None,
                restitutions: Sequence[float] = RESTITUTIONS,
                settings: MapSettings | None = None, out: str | os.PathLike | None = None,
-               workers: int = 1, figure: bool = True,
+               workers: int | None = None, figure: bool = True,
                progress: Callable[[str], Any] = print) -> EngineMap:
-    """Measure every grid point (``workers`` processes) and write ``engine_map.csv``,
-    ``engine_map.json`` (atomically) and ``engine_map.png`` into ``out`` (default
-    ``results/engine-map/``)."""
+    """Measure every grid point (``workers`` processes, default: the cores) and write
+    ``engine_map.csv``, ``engine_map.json`` (atomically) and ``engine_map.png`` into ``out``
+    (default ``results/engine-map/``)."""
     from .execute import _start_method, _worker_start
 
     settings = settings or MapSettings()
     settings.check()
+    workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise BadOption("--workers", workers, "at least 1")
     points = grid(dims, fractions, restitutions)
