@@ -1,5 +1,5 @@
 """Command line: ``demstudy validate | deck | run | plot | analyze | compare | forecast |
-calibrate | cost``.
+calibrate | cost | engine-map``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
@@ -230,6 +230,26 @@ def _cmd_cost(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_engine_map(args: argparse.Namespace) -> int:
+    from .cost.engine_map import QUICK, RESTITUTIONS, MapSettings, engine_map
+
+    settings = MapSettings(ratio=args.ratio, timeout=args.timeout)
+    dims = _numbers("--dim", args.dim)
+    fractions = _numbers("--fractions", args.fractions) if args.fractions else None
+    restitutions = (_numbers("--restitutions", args.restitutions) if args.restitutions
+                    else RESTITUTIONS)
+    if args.quick:
+        settings = MapSettings(**QUICK["settings"], ratio=args.ratio, timeout=args.timeout)
+        fractions = fractions or QUICK["fractions"]
+        restitutions = restitutions if args.restitutions else QUICK["restitutions"]
+    # a quick map never lands where ``demstudy cost`` reads the map from
+    out = args.out or (Path("results") / "engine-map-quick" if args.quick else None)
+    result = engine_map(dims, fractions, restitutions, settings, out=out,
+                        workers=args.workers)
+    print("outputs: " + ", ".join(str(p) for p in result.written))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .analysis.registry import STATISTICS
     from .engines import DEFAULT_ENGINE, backend_names, get_backend
@@ -410,6 +430,27 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a tiny ladder of short runs (k* 1e2,1e3,1e4, 10 steps/contact, "
                         "hooke)")
     p.set_defaults(func=_cmd_cost)
+
+    p = sub.add_parser("engine-map",
+                       help="which engine is cheaper at 2 %% accuracy, over solid fraction "
+                            "and restitution in Lees-Edwards shear (docs/accuracy-cost.md)")
+    p.add_argument("--dim", default="2,3", metavar="2,3", help="dimensions (default 2,3)")
+    p.add_argument("--fractions", metavar="F1,F2,...",
+                   help="solid fractions (default: 0.1,0.3,0.5,0.65,0.75 for discs, "
+                        "0.1,0.3,0.45,0.55,0.6 for spheres)")
+    p.add_argument("--restitutions", metavar="E1,E2,...",
+                   help="restitutions (default 0.5,0.7,0.9,0.99)")
+    p.add_argument("--ratio", type=float, default=0.05, metavar="R",
+                   help="soft contact time t_c = R x the mean free-flight time (default 0.05)")
+    p.add_argument("--timeout", type=float, default=20.0, metavar="SECONDS",
+                   help="event-driven runs longer than this are impractical (default 20)")
+    p.add_argument("--workers", type=int, help="local processes (default: the cores)")
+    p.add_argument("--out", help="folder (default results/engine-map/, with --quick "
+                                 "results/engine-map-quick/)")
+    p.add_argument("--quick", action="store_true",
+                   help="two points per dimension (fraction 0.3, e = 0.7 and 0.9), very "
+                        "short runs, one repeat")
+    p.set_defaults(func=_cmd_engine_map)
     return parser
 
 

@@ -60,7 +60,8 @@ def summary(study) -> dict:
             "error_rule": "worst field's rel_l2 minus its noise floor rel_l2_floor (>= 0)",
             "tolerance": study.tolerance, "reference": study.reference["name"],
             "choice": study.choice["name"] if study.choice else None,
-            "recommendation": study.recommendation, "fits": fits, "notes": study.notes,
+            "recommendation": study.recommendation, "engine_map": study.map_hint,
+            "fits": fits, "notes": study.notes,
             "runs": clean}
 
 
@@ -92,5 +93,7 @@ def text_report(study) -> str:
                                         if isinstance(fit, ConvergenceFit) else fit))
     lines += [f"note: {n}" for n in study.notes]
     lines.append(f"recommendation: {study.recommendation}")
+    if study.map_hint:
+        lines.append(study.map_hint)
     lines.append(f"outputs: {study.folder}/ladder.csv, ladder.json, pareto.png")
     return "\n".join(lines)

@@ -52,6 +52,8 @@ class CostStudy:
     skipped: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     scale_label: str = "$k^*$"
+    #: the engine map's line for this scene (nearest grid point), None without a map
+    map_hint: str | None = None
     #: seconds spent: "runs" (executing, as the workers saw it: task_seconds summed),
     #: "ladder" (running everything), "analysis" (comparisons, fits, outputs)
     timings: dict[str, float] = field(default_factory=dict)
@@ -163,6 +165,12 @@ def _assemble(study: CostStudy, scene: Scene, refs: list[RunSpec],
     study.recommendation = analyze.recommend(study.choice, reference["wall_seconds"],
                                              study.tolerance, floor)
     study.fits = _fits(rows)
+    from .map_output import map_hint
+
+    try:  # the map is advice: a study never fails on it
+        study.map_hint = map_hint(scene)
+    except (OSError, ValueError, KeyError) as exc:
+        study.map_hint = f"engine map unreadable: {exc}"
 
 
 def _fits(rows: list[dict]) -> dict[str, Any]:

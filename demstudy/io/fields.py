@@ -100,6 +100,8 @@ _TIMESERIES = {
     "wall_velocity_upper": (SPEED, "servo: x speed of the upper wall"),
     "collisions": (COUNT, "pair collisions since t = 0 (event-driven)"),
     "wall_collisions": (COUNT, "wall and bump collisions since t = 0 (event-driven)"),
+    "elastic_tc_collisions": (COUNT, "pair collisions the TC model made elastic since t = 0 "
+                                     "(event-driven)"),
     "dissipated_energy": (ENERGY, "energy dissipated in collisions since t = 0 "
                                   "(event-driven; translational + rotational)"),
     "gravity_work": (ENERGY, "work done by gravity on the particles since t = 0"),

@@ -181,6 +181,7 @@ class EdmdBackend(BackendBase):
             "rotational_energy": core.rotational_energy,
             "collisions": core.collisions,
             "wall_collisions": core.wall_collisions,
+            "elastic_tc_collisions": core.elastic_tc_collisions,
             "dissipated_energy": core.dissipated,
         }
         if scene.gravity is not None:
