@@ -97,8 +97,11 @@ def test_written_deck_runs_in_bare_lammps(tmp_path, ranks):
 def test_calibrate_prints_measured_restitution(capsys):
     code = main(["calibrate", "--dim", "2", "--kind", "wall", "--e", "0.8", "--beta", "0.0",
                  "--speeds", "1.0", "--angles", "0", "30"])
-    rows = [line.split() for line in capsys.readouterr().out.splitlines()[2:]]
+    lines = capsys.readouterr().out.splitlines()
+    header = lines[0].split()
+    rows = [line.split() for line in lines if line.strip()[:1].isdigit()]  # the table rows
     assert code == 0 and len(rows) == 2
+    assert header[6:10] == ["e_tgt", "e_meas", "b_tgt", "b_meas"]
     assert all(abs(float(r[6]) - 0.8) < 5e-3 for r in rows)  # measured e
     assert abs(float(rows[1][8])) < 1e-2  # measured β at 30° (target 0)
 
