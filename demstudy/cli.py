@@ -200,6 +200,15 @@ def _numbers(option: str, text: str) -> list[float]:
         raise BadOption(option, text, "comma-separated numbers, e.g. 1e3,1e4") from None
 
 
+def _whole(option: str, text: str | None) -> int | None:
+    from .errors import BadOption
+
+    try:
+        return None if text is None else int(text)
+    except ValueError:
+        raise BadOption(option, text, "a whole number of runs >= 1 is allowed") from None
+
+
 def _cmd_cost(args: argparse.Namespace) -> int:
     from .cost.report import text_report
     from .cost.study import DEFAULT_KSTARS, DEFAULT_MODELS, DEFAULT_STEPS, cost
@@ -209,8 +218,9 @@ def _cmd_cost(args: argparse.Namespace) -> int:
                  steps=_numbers("--steps", args.steps) if args.steps else DEFAULT_STEPS,
                  models=([m.strip() for m in args.models.split(",") if m.strip()]
                          if args.models else DEFAULT_MODELS),
-                 workers=args.workers, dask=args.dask, out=args.out, replicas=args.replicas,
-                 reference_replicas=args.reference_replicas)
+                 workers=args.workers, dask=args.dask, out=args.out,
+                 replicas=_whole("--replicas", args.replicas),
+                 reference_replicas=_whole("--reference-replicas", args.reference_replicas))
     print(text_report(study))
     return 0
 
@@ -379,11 +389,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="local processes (default: the cores)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead")
     p.add_argument("--out", help="ladder folder (default results/cost/<scene>/)")
-    p.add_argument("--replicas", type=int, default=1, metavar="R",
+    p.add_argument("--replicas", default="1", metavar="R",
                    help="make every run R times (seeds seed, seed+1, ...; files -r0, -r1, "
                         "...): errors from the replicas' scatter, cost the SUM of their wall "
                         "times (default 1)")
-    p.add_argument("--reference-replicas", type=int, metavar="R_REF",
+    p.add_argument("--reference-replicas", metavar="R_REF",
                    help="replicas of the event-driven reference (default: --replicas)")
     p.add_argument("--quick", action="store_true",
                    help="a tiny ladder of short runs (k* 1e2,1e3,1e4, 10 steps/contact, "

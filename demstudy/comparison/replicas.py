@@ -92,19 +92,23 @@ def _check_same_run(runs: list[Results], names: list[str]) -> None:
                                     f"different {label} (replicas are combined bin by bin)")
 
 
-def _mean_and_error(values: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def _mean_and_error(values: list[np.ndarray], errors: list[np.ndarray]
+                    ) -> tuple[np.ndarray, np.ndarray]:
     """Mean over the replicas and its standard error std/√n (n the replicas with a finite
-    value in that bin; fewer than 2: NaN). Values equal in every replica (an exactly known
-    quantity, the mean mass of equal particles) keep that value and error 0 exactly, so that
-    ``compare`` still recognises them."""
+    value in that bin; fewer than 2: NaN). Values known exactly in every replica (error 0)
+    and equal to round-off (the mean mass of equal particles) keep the first value and error
+    0, so that ``compare`` still recognises them as exact."""
     stack = np.stack([np.asarray(v, float) for v in values])
+    quoted = np.stack([np.asarray(e, float) for e in errors])
     n = np.sum(np.isfinite(stack), axis=0)
     with np.errstate(invalid="ignore", divide="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # bins empty in every replica
         mean = np.nanmean(stack, axis=0)
         err = np.nanstd(stack, axis=0, ddof=1) / np.sqrt(n)
     err = np.where(n >= 2, err, np.nan)
-    same = np.all(stack == stack[0], axis=0)
+    same = np.all(stack == stack[0], axis=0) | (
+        np.all(quoted == 0, axis=0) & np.all(np.isclose(stack, stack[0], rtol=1e-9, atol=0),
+                                             axis=0))
     return np.where(same, stack[0], mean), np.where(same, 0.0, err)
 
 
@@ -121,7 +125,8 @@ def _combine_group(groups: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]
         if len(values) != len(groups) or any(np.shape(v) != np.shape(value) for v in values):
             continue  # not in every replica (or of another shape): not combined
         if f"{name}_err" in first:
-            out[name], out[f"{name}_err"] = _mean_and_error(values)
+            out[name], out[f"{name}_err"] = _mean_and_error(
+                values, [g.get(f"{name}_err", np.nan) for g in groups])
         elif all(np.array_equal(v, value) for v in values) or \
                 not np.issubdtype(np.asarray(value).dtype, np.number):
             out[name] = value

@@ -7,9 +7,9 @@ zero within its errors, such as u_y, have no relative error and are left out) th
 module gives the relative L2 difference rel_l2_f, its noise floor rel_l2_floor_f (what the
 statistical errors alone produce) and the debiased difference
 sqrt(max(rel_l2_f² − rel_l2_floor_f², 0)); the run's error is the worst field's debiased
-difference. The table of every field is ``demstudy compare``'s. A run meets a tolerance X when that error ≤ X; when the
-noise floor of the chosen run (or, with none chosen, of the quietest run) exceeds X, the runs
-are too short to tell, and the recommendation says so.
+difference. The table of every field is ``demstudy compare``'s. A run meets a tolerance X
+when that error ≤ X; when the noise floor of the chosen run (or, with none chosen, of the
+quietest run) exceeds X, the runs are too short to tell, and the recommendation says so.
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 """
 
