@@ -138,11 +138,24 @@ def _load(source: Results | str | os.PathLike) -> Results:
     return read_results(path, skip=("frames", "collisions"))
 
 
+def _brace(names: Sequence[str]) -> str:
+    """Replica files in shell brace form: ``a-r{0,1,2}.h5`` (the full list when they share
+    nothing)."""
+    prefix = os.path.commonprefix(list(names))
+    rest = [n[len(prefix):] for n in names]
+    suffix = os.path.commonprefix([r[::-1] for r in rest])[::-1]
+    middle = [r[:len(r) - len(suffix)] for r in rest]
+    if not (prefix or suffix) or not all(middle):
+        return ",".join(names)
+    return f"{prefix}{{{','.join(middle)}}}{suffix}"
+
+
 def _label(res: Results) -> str:
     engine = res.attrs.get("engine", "?")
     if res.profile_attrs.get("error_method") == "replicas":  # a replica mean
-        return f"{res.attrs.get('replica_files', '?')} ({engine}, mean of " \
-               f"{res.profile_attrs.get('replicas')} replicas)"
+        files = str(res.attrs.get("replica_files", "?")).split(",")
+        return f"{_brace(files)} ({engine}, mean of {res.profile_attrs.get('replicas')} " \
+               "replicas)"
     name = res.path.name if res.path is not None else res.attrs.get("scene_name", "?")
     return f"{name} ({engine})"
 
