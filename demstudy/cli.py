@@ -138,8 +138,14 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from .errors import NotComparable
 
     fields = [f.strip() for f in args.fields.split(",") if f.strip()] if args.fields else None
+    # A,B,C: replicas of one run (other seeds), combined before the comparison
+    groups = [[p for p in arg.split(",") if p.strip()] for arg in args.results]
+    empty = [arg for arg, group in zip(args.results, groups, strict=True) if not group]
+    if empty:
+        raise NotComparable(f"RUN.h5 = {empty[0]!r}: a results file, or replicas of one run "
+                            "as A.h5,B.h5,... are allowed")
     try:
-        comparisons = compare(*args.results, fields=fields, sigma=args.sigma,
+        comparisons = compare(*groups, fields=fields, sigma=args.sigma,
                               min_solid_fraction=args.min_solid_fraction)
     except OSError as exc:  # not a readable HDF5 file: nothing was compared
         raise NotComparable(f"cannot read the results: {exc}") from exc
@@ -216,6 +222,15 @@ def _numbers(option: str, text: str) -> list[float]:
         raise BadOption(option, text, "comma-separated numbers, e.g. 1e3,1e4") from None
 
 
+def _whole(option: str, text: str | None) -> int | None:
+    from .errors import BadOption
+
+    try:
+        return None if text is None else int(text)
+    except ValueError:
+        raise BadOption(option, text, "a whole number of runs >= 1 is allowed") from None
+
+
 def _cmd_cost(args: argparse.Namespace) -> int:
     from .cost.report import text_report
     from .cost.study import DEFAULT_KSTARS, DEFAULT_MODELS, DEFAULT_STEPS, cost
@@ -225,7 +240,9 @@ def _cmd_cost(args: argparse.Namespace) -> int:
                  steps=_numbers("--steps", args.steps) if args.steps else DEFAULT_STEPS,
                  models=([m.strip() for m in args.models.split(",") if m.strip()]
                          if args.models else DEFAULT_MODELS),
-                 workers=args.workers, dask=args.dask, out=args.out)
+                 workers=args.workers, dask=args.dask, out=args.out,
+                 replicas=_whole("--replicas", args.replicas),
+                 reference_replicas=_whole("--reference-replicas", args.reference_replicas))
     print(text_report(study))
     return 0
 
@@ -349,9 +366,13 @@ def build_parser() -> argparse.ArgumentParser:
                                    "field (relative L2 error, its noise floor, max |z|, "
                                    "whether the difference is resolved) and one figure "
                                    "(docs/compare.md). Different bins are rebinned to a "
-                                   "common grid, said so.")
+                                   "common grid, said so. A comma-separated group "
+                                   "(a1.h5,a2.h5,a3.h5) is replicas of one run with other "
+                                   "seeds: their mean is compared, with the standard error "
+                                   "across them (R - 1 degrees of freedom).")
     p.add_argument("results", nargs="+", metavar="RUN.h5",
-                   help="the reference, then the runs compared with it")
+                   help="the reference, then the runs compared with it; A.h5,B.h5,...: "
+                        "replicas of one run, combined first")
     p.add_argument("-o", "--out", default="compare.png",
                    help="figure file (default compare.png; none: no figure)")
     p.add_argument("--fields", metavar="F1,F2,...",
@@ -426,6 +447,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="local processes (default: the cores)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead")
     p.add_argument("--out", help="ladder folder (default results/cost/<scene>/)")
+    p.add_argument("--replicas", default="1", metavar="R",
+                   help="make every run R times (seeds seed, seed+1, ...; files -r0, -r1, "
+                        "...): errors from the replicas' scatter, cost the SUM of their wall "
+                        "times (default 1)")
+    p.add_argument("--reference-replicas", metavar="R_REF",
+                   help="replicas of the event-driven reference (default: --replicas)")
     p.add_argument("--quick", action="store_true",
                    help="a tiny ladder of short runs (k* 1e2,1e3,1e4, 10 steps/contact, "
                         "hooke)")

@@ -94,6 +94,43 @@ def test_ladder_resumes_and_skips_what_was_done(tmp_path):
     assert set(longer.executed) == {"ref-edmd-tc1e-05", "soft-hooke-k100-s10"}
 
 
+def test_replicas_make_one_file_per_replica_and_resume(tmp_path):
+    """--replicas 2: every run twice with successive seeds (files -r0, -r1), one row per
+    setting whose cost is the sum of its replicas' wall times and whose errors come from
+    their scatter; a rerun reuses every replica, a lost replica alone is redone, and more
+    reference replicas add only the missing ones."""
+    out = tmp_path / "ladder"
+    ladder = {**LADDER, "kstars": [1e2]}
+    first = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=2, replicas=2,
+                    **ladder)
+    names = {f"{stem}-r{i}" for stem in ("ref-edmd-tc1e-05", "soft-hooke-k100-s10")
+             for i in (0, 1)}
+    assert set(first.executed) == names and {p.stem for p in out.glob("*.h5")} == names
+    runs = {n: read_results(out / f"{n}.h5", skip=("frames",)) for n in names}
+    seeds = {n: r.scene.run.seed for n, r in runs.items()}
+    assert seeds["soft-hooke-k100-s10-r1"] == seeds["soft-hooke-k100-s10-r0"] + 1
+    assert seeds["ref-edmd-tc1e-05-r1"] == seeds["ref-edmd-tc1e-05-r0"] + 1
+    assert not np.array_equal(runs["ref-edmd-tc1e-05-r0"].profiles["temperature"],
+                              runs["ref-edmd-tc1e-05-r1"].profiles["temperature"])
+    assert [r["name"] for r in first.rows] == ["ref-edmd-tc1e-05", "soft-hooke-k100-s10"]
+    for row in first.rows:
+        assert row["replicas"] == 2
+        assert row["wall_seconds"] == pytest.approx(sum(
+            runs[f"{row['name']}-r{i}"].attrs["wall_seconds"] for i in (0, 1)))
+    assert first.reference["results"].profile_attrs["n_blocks"] == 2  # 1 dof
+    assert any("SUM of their wall times" in n for n in first.notes)
+    summary = json.loads((out / "ladder.json").read_text())
+    assert summary["runs"][1]["replicas"] == 2 and "SUM" in summary["replicas_rule"]
+    (out / "soft-hooke-k100-s10-r1.h5").unlink()
+    again = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=1, replicas=2,
+                    **ladder)
+    assert again.executed == ["soft-hooke-k100-s10-r1"]
+    assert set(again.skipped) == names - {"soft-hooke-k100-s10-r1"}
+    more = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=1, replicas=2,
+                   reference_replicas=3, **ladder)
+    assert more.executed == ["ref-edmd-tc1e-05-r2"] and more.rows[0]["replicas"] == 3
+
+
 def test_a_ladder_killed_after_its_first_runs_resumes_with_the_rest(tmp_path):
     import os
     import signal
@@ -139,6 +176,10 @@ def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
     (["--steps", "5"], "--steps"),
     (["--tolerance", "0"], "--tolerance"),
     (["--models", "hooke,jkr"], "--models"),
+    (["--replicas", "0"], "--replicas"),
+    (["--replicas", "-2"], "--replicas"),
+    (["--replicas", "two"], "--replicas"),
+    (["--replicas", "2", "--reference-replicas", "0"], "--reference-replicas"),
 ])
 def test_cli_refuses_bad_input_naming_the_option(argv, named, capsys, tmp_path):
     code = main(["cost", "shear/lees-edwards-2d", "--out", str(tmp_path), *argv])

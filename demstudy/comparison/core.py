@@ -138,9 +138,49 @@ def _load(source: Results | str | os.PathLike) -> Results:
     return read_results(path, skip=("frames", "collisions"))
 
 
+def _brace(names: Sequence[str]) -> str:
+    """Replica files in shell brace form: ``a-r{0,1,2}.h5`` (the full list when they share
+    nothing)."""
+    prefix = os.path.commonprefix(list(names))
+    rest = [n[len(prefix):] for n in names]
+    suffix = os.path.commonprefix([r[::-1] for r in rest])[::-1]
+    middle = [r[:len(r) - len(suffix)] for r in rest]
+    if not (prefix or suffix) or not all(middle):
+        return ",".join(names)
+    return f"{prefix}{{{','.join(middle)}}}{suffix}"
+
+
 def _label(res: Results) -> str:
+    engine = res.attrs.get("engine", "?")
+    if res.profile_attrs.get("error_method") == "replicas":  # a replica mean
+        files = str(res.attrs.get("replica_files", "?")).split(",")
+        return f"{_brace(files)} ({engine}, mean of {res.profile_attrs.get('replicas')} " \
+               "replicas)"
     name = res.path.name if res.path is not None else res.attrs.get("scene_name", "?")
-    return f"{name} ({res.attrs.get('engine', '?')})"
+    return f"{name} ({engine})"
+
+
+def _replica_note(res: Results, role: str) -> str | None:
+    """What the table says of a replica mean: its errors come from the replicas' scatter."""
+    if res.profile_attrs.get("error_method") != "replicas":
+        return None
+    r = int(res.profile_attrs.get("replicas", 0))
+    ratio = float(res.profile_attrs.get("scatter_to_quoted_error", math.nan))
+    return (f"{role}: mean of {r} replicas (other seeds); errors: the standard error across "
+            f"them (std/√{r}, {r - 1} degrees of freedom)" +
+            (f"; they scatter {ratio:.2g}× their own quoted errors (median over fields)"
+             if math.isfinite(ratio) else ""))
+
+
+def _load_group(source) -> Results:
+    """A run, or a list of replicas of one run (combined: ``combine_replicas``)."""
+    if isinstance(source, list | tuple):
+        if len(source) == 1:
+            return _load(source[0])
+        from .replicas import combine_replicas
+
+        return combine_replicas(source)
+    return _load(source)
 
 
 def _dim(res: Results) -> int | None:
@@ -290,7 +330,7 @@ def compare_pair(ref: Results, other: Results, fields: Sequence[str] | None = No
                  sigma: float = 3.0, min_solid_fraction: float = 0.0) -> Comparison:
     """One run against the reference (:func:`compare`)."""
     labels = (_label(ref), _label(other))
-    notes: list[str] = []
+    notes = [n for n in (_replica_note(ref, "reference"), _replica_note(other, "other")) if n]
     for lab, res in zip(labels, (ref, other), strict=True):
         if not res.profiles or "edges" not in res.profiles or "solid_fraction" not in \
                 res.profiles:
@@ -362,14 +402,20 @@ def compare_pair(ref: Results, other: Results, fields: Sequence[str] | None = No
     return Comparison(labels[0], labels[1], out, notes, sigma, rebinned)
 
 
-def compare(reference: Results | str | os.PathLike, *others: Results | str | os.PathLike,
+Source = Results | str | os.PathLike
+
+
+def compare(reference: Source | Sequence[Source], *others: Source | Sequence[Source],
             fields: Sequence[str] | None = None, sigma: float = 3.0,
             min_solid_fraction: float = 0.0) -> list[Comparison]:
     """Every other run against ``reference`` (results or files), one :class:`Comparison`
-    each (see the module doc). ``fields``: labels (``temperature``, ``velocity[x]``,
-    ``stress/xy``) or dataset names for all their components (``velocity``, ``stress``);
-    default every field both runs hold. ``sigma``: the significance of each field's family
-    test. ``min_solid_fraction``: leave out bins more dilute than this in either run.
+    each (see the module doc). Any argument may be a list of independent replicas of one
+    run (other seeds): they are combined first (:func:`~.replicas.combine_replicas`: their
+    mean, with the standard error across them), and the table's notes say so. ``fields``:
+    labels (``temperature``, ``velocity[x]``, ``stress/xy``) or dataset names for all their
+    components (``velocity``, ``stress``); default every field both runs hold. ``sigma``:
+    the significance of each field's family test. ``min_solid_fraction``: leave out bins
+    more dilute than this in either run.
     :class:`~demstudy.errors.NotComparable` (a ``ValueError``) naming the files for a missing
     file, runs of different dimension or profile axis, a file without profiles, bins that do
     not overlap or an unknown field."""
@@ -377,5 +423,6 @@ def compare(reference: Results | str | os.PathLike, *others: Results | str | os.
         raise NotComparable("compare needs a reference and at least one other run")
     if not (isinstance(sigma, int | float) and sigma > 0):
         raise NotComparable(f"sigma = {sigma!r}: must be > 0")
-    ref = _load(reference)
-    return [compare_pair(ref, _load(o), fields, sigma, min_solid_fraction) for o in others]
+    ref = _load_group(reference)
+    return [compare_pair(ref, _load_group(o), fields, sigma, min_solid_fraction)
+            for o in others]

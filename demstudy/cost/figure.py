@@ -72,7 +72,10 @@ def pareto_figure(study, path: Path) -> Path:
     ax.errorbar([], [], yerr=[], color="0.5", capsize=2, label="error bar: noise floor")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("wall time of the run (s, this machine)")
+    reps = sorted({int(r.get("replicas", 1)) for r in study.rows if r["engine"] != "edmd"})
+    ax.set_xlabel("wall time of the run (s, this machine)" if reps in ([], [1]) else
+                  f"wall time, sum over the {'/'.join(map(str, reps))} replicas of a run "
+                  "(s, this machine)")
     ax.set_ylabel("error: worst profile rel. L2 beyond noise (-)")
     ax.set_title(f"accuracy vs cost: {Path(study.folder).name}", fontsize=10)
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)

@@ -10,11 +10,15 @@ Stiffness axis, per scene (``stiffness_scale``): with a shear rate γ̇, k* = k_
 k* = k_n/(m g/d); otherwise k* = k_n/(m v²/d²) with v the scene's reference speed (the wall
 speed of a Couette cell). k* gives the Hooke k_n; the Hertz run of the same k* has the Hertz
 k_n that reaches the same largest overlap at the reference impact speed.
+
+Replicas (``--replicas R``): every run is made R times with seeds seed, seed + 1, …, its file
+name ending in ``-r0``, ``-r1``, …; the ladder then rates the settings by the replicas' mean,
+with errors from their scatter (``demstudy.comparison.combine_replicas``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..contact import mapping
 from ..contact.stiffness import reference_speed
@@ -53,13 +57,15 @@ def stiffness_scale(scene: Scene) -> StiffnessScale:
 @dataclass(frozen=True)
 class RunSpec:
     """One run of the ladder: the reference (``engine = 'edmd'``, ``tc``) or a soft run
-    (``engine = 'lammps'``, ``model``, ``kstar``, ``steps`` per contact)."""
+    (``engine = 'lammps'``, ``model``, ``kstar``, ``steps`` per contact); ``replica`` i of
+    several: the scene's seed + i (``None``: the run alone, the scene's seed)."""
 
     engine: str
     model: str | None = None
     kstar: float | None = None
     steps: float | None = None
     tc: float | None = None
+    replica: int | None = None
 
     @property
     def soft(self) -> bool:
@@ -67,7 +73,13 @@ class RunSpec:
 
     @property
     def name(self) -> str:
-        """File stem encoding the settings, e.g. ``soft-hooke-k1e+04-s50``, ``ref-edmd-tc1e-05``."""
+        """File stem encoding the settings, e.g. ``soft-hooke-k1e+04-s50``, ``ref-edmd-tc1e-05``,
+        ``soft-hooke-k100-s10-r1`` (replica 1)."""
+        return self.settings + ("" if self.replica is None else f"-r{self.replica}")
+
+    @property
+    def settings(self) -> str:
+        """The name without the replica suffix: one row of the ladder."""
         if self.soft:
             return f"soft-{self.model}-k{self.kstar:.3g}-s{self.steps:g}".replace("+0", "+")
         return f"ref-{self.engine}-tc{self.tc:.3g}"
@@ -89,12 +101,24 @@ def soft_kn(scene: Scene, model: str, kstar: float) -> float:
 
 
 def scene_for(base: Scene, spec: RunSpec) -> Scene:
-    """The scene ``spec`` runs: ``base`` with the soft section replaced (soft runs)."""
+    """The scene ``spec`` runs: ``base`` with the soft section replaced (soft runs) and the
+    seed moved on by the replica's index."""
+    if spec.replica:
+        run = base.run.model_copy(update={"seed": base.run.seed + spec.replica})
+        base = base.model_copy(update={"run": run})
     if not spec.soft:
         return base
     soft = Soft(model=spec.model, stiffness=soft_kn(base, spec.model, spec.kstar),
                 steps_per_contact=spec.steps)
     return base.model_copy(update={"soft": soft})
+
+
+def replicate(specs: list[RunSpec], replicas: int) -> list[RunSpec]:
+    """Each run ``replicas`` times (replica 0, 1, …); one replica: the runs themselves (the
+    file names of a ladder without replicas)."""
+    if replicas == 1:
+        return list(specs)
+    return [replace(s, replica=i) for s in specs for i in range(replicas)]
 
 
 def soft_ladder(kstars: list[float], steps: list[float], models: list[str]) -> list[RunSpec]:

@@ -16,8 +16,8 @@ from ..io.results import write_atomically
 from .analyze import ConvergenceFit
 
 COLUMNS = ("name", "engine", "model", "kstar", "kn", "steps_per_contact", "tc", "dt", "steps",
-           "wall_seconds", "error", "field", "rel_l2", "floor", "resolved", "max_overlap",
-           "tc_flight", "tc_shear", "healthy", "meets_tolerance")
+           "replicas", "wall_seconds", "error", "field", "rel_l2", "floor", "resolved",
+           "max_overlap", "tc_flight", "tc_shear", "healthy", "meets_tolerance")
 SHOWN = (("name", 24, "s"), ("wall_seconds", 9, ".3g"), ("steps", 10, "d"),
          ("error", 9, ".3g"), ("field", 22, "s"), ("floor", 8, ".2g"),
          ("max_overlap", 9, ".2g"), ("tc_flight", 9, ".2g"), ("tc_shear", 9, ".2g"),
@@ -33,14 +33,18 @@ def _cell(value, fmt: str) -> str:
 
 
 def table(study) -> str:
-    """The terminal table: one line per run (reference first, marked *)."""
-    head = "  ".join(f"{n:>{w}}" if i else f"{n:<{w}}" for i, (n, w, _) in enumerate(SHOWN))
+    """The terminal table: one line per run (reference first, marked *); with replicas, their
+    number (wall time and steps are then their sums)."""
+    shown = SHOWN
+    if any(row.get("replicas", 1) > 1 for row in study.rows):
+        shown = (SHOWN[0], ("replicas", 8, "d"), *SHOWN[1:])
+    head = "  ".join(f"{n:>{w}}" if i else f"{n:<{w}}" for i, (n, w, _) in enumerate(shown))
     lines = [head]
     for row in study.rows:
-        cells = [_cell(row.get(n), f) for n, _, f in SHOWN]
+        cells = [_cell(row.get(n), f) for n, _, f in shown]
         cells[0] = ("*" if row.get("reference") else " ") + cells[0]
         lines.append("  ".join(f"{c:>{w}}" if i else f"{c:<{w}}"
-                               for i, (c, (_, w, _)) in enumerate(zip(cells, SHOWN, strict=True))))
+                               for i, (c, (_, w, _)) in enumerate(zip(cells, shown, strict=True))))
     return "\n".join(lines)
 
 
@@ -58,6 +62,9 @@ def summary(study) -> dict:
              for row in study.rows]
     return {"units": UNITS_NOTE + "; wall times in seconds", "stiffness": study.scale,
             "error_rule": "worst field's rel_l2 minus its noise floor rel_l2_floor (>= 0)",
+            "replicas_rule": "a run of R > 1 replicas (seeds seed, seed+1, ...): error of their "
+                             "mean with the standard error across them; wall_seconds and "
+                             "steps: the SUM over the replicas",
             "tolerance": study.tolerance, "reference": study.reference["name"],
             "choice": study.choice["name"] if study.choice else None,
             "recommendation": study.recommendation, "engine_map": study.map_hint,

@@ -1,12 +1,16 @@
 """One table row per run of the ladder, read from its results file: cost (wall time, steps),
 health figures of soft runs (when the results carry a ``health`` group) and the error against
-the reference (``analyze.run_error``). Dimensionless particle units: d = 1, m = 1, g = 1 when
-gravity acts."""
+the reference (``analyze.run_error``). A run made as R replicas (other seeds) is one row: its
+error from the replicas' mean with errors from their scatter
+(``demstudy.comparison.combine_replicas``), its cost the SUM of their wall times and steps.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
+
+import numpy as np
 
 from ..io.results import Results, read_results
 from . import analyze
@@ -18,6 +22,35 @@ HEALTH = ("max_overlap", "tc_flight", "tc_shear", "healthy")
 
 def _read(path: Path) -> Results:
     return read_results(path, skip=("frames", "collisions"))
+
+
+def _read_group(folder: Path, specs: list[RunSpec]) -> tuple[Results, list[Results]]:
+    """(the run, or its replicas combined; the replicas' own results)."""
+    runs = [_read(folder / f"{spec.name}.h5") for spec in specs]
+    if len(runs) == 1:
+        return runs[0], runs
+    from ..comparison import combine_replicas
+
+    return combine_replicas(runs), runs
+
+
+def _group_row(specs: list[RunSpec], runs: list[Results]) -> dict:
+    """One row for the replicas of one run: wall time and steps summed (the cost of the
+    settings at this precision), health the worst overlap, mean contact-time ratios, healthy
+    only when all were; ``path``: the replicas' files, comma-separated."""
+    rows = [_base(spec, res) for spec, res in zip(specs, runs, strict=True)]
+    row = {**rows[0], "name": specs[0].settings, "replicas": len(rows)}
+    if len(rows) == 1:
+        return row
+    row.update(wall_seconds=sum(r["wall_seconds"] for r in rows),
+               steps=sum(r["steps"] for r in rows), path=",".join(r["path"] for r in rows))
+    with_health = [r for r in rows if isinstance(r.get("healthy"), bool | np.bool_)]
+    if len(with_health) == len(rows):
+        row.update(max_overlap=max(r["max_overlap"] for r in rows),
+                   tc_flight=float(np.mean([r["tc_flight"] for r in rows])),
+                   tc_shear=float(np.mean([r["tc_shear"] for r in rows])),
+                   healthy=all(bool(r["healthy"]) for r in rows))
+    return row
 
 
 def _base(spec: RunSpec, res: Results) -> dict:
@@ -46,21 +79,27 @@ def _error_columns(row: dict, reference: Results, res: Results) -> dict:
     return row
 
 
-def soft_row(folder: Path, spec: RunSpec, scene, kn: float, reference: dict) -> dict:
-    """The row of a soft run, its error against ``reference`` (the reference's row)."""
-    res = _read(folder / f"{spec.name}.h5")
-    row = _base(spec, res)
+def soft_row(folder: Path, specs: list[RunSpec], kn: float, reference: dict) -> dict:
+    """The row of a soft run (``specs``: it, or its replicas), its error against
+    ``reference`` (the reference's row)."""
+    res, runs = _read_group(folder, specs)
+    row = _group_row(specs, runs)
     row["kn"] = kn
     return _error_columns(row, reference["results"], res)
 
 
-def choose_reference(folder: Path, refs: list[RunSpec], notes: list[str]
+def choose_reference(folder: Path, refs: list[list[RunSpec]], notes: list[str]
                      ) -> tuple[dict, list[dict]]:
-    """The converged reference among the t_c ladder ``refs`` (largest t_c first): the
-    largest t_c whose profiles agree with the smallest t_c's (no field resolved), else the
-    smallest. Returns (its row with its ``results``, the rows of every reference run)."""
-    runs = [(spec, _read(folder / f"{spec.name}.h5")) for spec in refs]
-    rows = [_base(spec, res) for spec, res in runs]
+    """The converged reference among the t_c ladder ``refs`` (largest t_c first; each entry
+    the run or its replicas): the largest t_c whose profiles agree with the smallest t_c's
+    (no field resolved), else the smallest. Returns (its row with its ``results``, the rows
+    of every reference run)."""
+    runs = []
+    rows = []
+    for specs in refs:
+        res, replicas = _read_group(folder, specs)
+        runs.append((specs[0], res))
+        rows.append(_group_row(specs, replicas))
     chosen = len(runs) - 1
     if len(runs) > 1:
         finest = runs[-1][1]
@@ -68,7 +107,7 @@ def choose_reference(folder: Path, refs: list[RunSpec], notes: list[str]
             _error_columns(rows[i], finest, res)
         agree = [i for i, row in enumerate(rows[:-1]) if not row["resolved"]]
         chosen = agree[0] if agree else chosen
-        notes.append(f"reference: t_c = {refs[chosen].tc:g} "
+        notes.append(f"reference: t_c = {refs[chosen][0].tc:g} "
                      + ("(agrees with the smallest t_c)" if agree else
                         "(the smallest t_c: the larger ones differ resolvably)"))
     for i, row in enumerate(rows):

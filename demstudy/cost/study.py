@@ -1,7 +1,9 @@
 """``cost(scene, ...)``: the whole accuracy-versus-cost study of one scene (docs/cost.md).
 
 The event-driven reference runs first (with a t_c ladder when its TC model acted), then the
-soft ladder; every run is one results file in the ladder folder, reused on a rerun.
+soft ladder; every run is one results file in the ladder folder, reused on a rerun. With
+``replicas`` every run is made that many times with successive seeds, and the ladder rates
+each setting by the replicas' mean, errors from their scatter, cost the sum of their times.
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise the shear rate
 or wall speed sets the time unit).
 """
@@ -21,7 +23,14 @@ from ..errors import BadOption
 from ..scene import Scene, load_scene, scene_to_toml
 from . import analyze
 from .execute import Task, execute, pending
-from .plan import RunSpec, reference_ladder, scene_for, soft_kn, soft_ladder, stiffness_scale
+from .plan import (
+    RunSpec,
+    reference_ladder,
+    replicate,
+    soft_kn,
+    soft_ladder,
+    stiffness_scale,
+)
 
 DEFAULT_KSTARS = (1e3, 1e4, 1e5, 1e6)
 DEFAULT_STEPS = (10.0, 50.0, 200.0)
@@ -67,11 +76,18 @@ def _check(name: str, values: Sequence[float], low: float = 0.0) -> list[float]:
     return values
 
 
+def _count(name: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise BadOption(name, value, "a whole number of runs >= 1 is allowed")
+    return value
+
+
 def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_KSTARS,
          steps: Sequence[float] = DEFAULT_STEPS, models: Sequence[str] = DEFAULT_MODELS,
          tolerance: float = 0.02, workers: int | None = None, dask: Any = None,
          out: str | os.PathLike | None = None, overrides: Sequence[str] = (),
          quick: bool = False, tc_ladder: bool | None = None, figure: bool = True,
+         replicas: int = 1, reference_replicas: int | None = None,
          progress=print) -> CostStudy:
     """Run (or resume) the cost ladder of ``scene`` and write its table, summary and figure
     into ``out`` (default ``results/cost/<scene name>/``). ``kstars``: dimensionless
@@ -79,7 +95,14 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_
     hooke and/or hertz; ``workers`` local processes (default: the machine's cores) or
     ``dask`` (a scheduler address or a ``distributed.Client``). ``quick``: a tiny ladder of
     short runs. ``tc_ladder``: force (True) or forbid (False) the reference's t_c ladder
-    (default: when its TC model acted). ``progress``: called with one line per event."""
+    (default: when its TC model acted). ``replicas``: make every soft run that many times
+    (seeds seed, seed + 1, …; files ``…-r0.h5``, ``…-r1.h5``): errors from the replicas'
+    scatter, cost the sum of their wall times; ``reference_replicas``: the same for the
+    reference (default ``replicas``; the event-driven reference is cheap). ``progress``:
+    called with one line per event."""
+    replicas = _count("--replicas", replicas)
+    reference_replicas = _count("--reference-replicas", replicas if reference_replicas is None
+                                else reference_replicas)
     if quick:
         kstars, steps, models = QUICK["kstars"], QUICK["steps"], QUICK["models"]
     kstars, steps = _check("--kstar", kstars), _check("--steps", steps, 9.999)
@@ -117,16 +140,24 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_
 
     from ..engines.edmd.core import DEFAULT_TC
 
-    refs = reference_ladder(DEFAULT_TC)
-    run_all(refs[:1])
-    if tc_ladder or (tc_ladder is None and _tc_active(folder / f"{refs[0].name}.h5")):
+    if max(replicas, reference_replicas) > 1:
+        top = scene.run.seed + max(replicas, reference_replicas) - 1
+        if top >= 2**31:
+            raise BadOption("--replicas", max(replicas, reference_replicas),
+                            f"seeds run.seed ({scene.run.seed}) + i must stay below 2^31")
+        study.notes.append(f"replicas: {reference_replicas} per reference, {replicas} per soft "
+                           f"run (seeds {scene.run.seed}, {scene.run.seed + 1}, …); errors "
+                           "from their scatter, cost = the SUM of their wall times")
+    refs = [replicate([r], reference_replicas) for r in reference_ladder(DEFAULT_TC)]
+    run_all(refs[0])
+    if tc_ladder or (tc_ladder is None and _tc_active(folder / f"{refs[0][0].name}.h5")):
         study.notes.append("reference t_c laddered (" + (
             "asked for)" if tc_ladder else "its TC model acted)"))
-        run_all(refs[1:])
+        run_all([s for group in refs[1:] for s in group])
     else:
         refs = refs[:1]
-    softs = soft_ladder(kstars, steps, list(models))
-    run_all(softs)
+    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, list(models))]
+    run_all([s for group in softs for s in group])
     started = time.perf_counter()
     _assemble(study, scene, refs, softs)
     from .report import write_outputs
@@ -149,14 +180,15 @@ def _tc_active(path: Path) -> bool:
     return count > TC_ACTIVE_FRACTION * max(int(attrs.get("events", 0)), 1)
 
 
-def _assemble(study: CostStudy, scene: Scene, refs: list[RunSpec],
-              softs: list[RunSpec]) -> None:
+def _assemble(study: CostStudy, scene: Scene, refs: list[list[RunSpec]],
+              softs: list[list[RunSpec]]) -> None:
+    """The rows: one per run (its replicas combined), reference first."""
     from .rows import choose_reference, soft_row
 
     reference, ref_rows = choose_reference(study.folder, refs, study.notes)
     study.reference = reference
-    rows = [soft_row(study.folder, s, scene_for(scene, s), soft_kn(scene, s.model, s.kstar),
-                     reference) for s in softs]
+    rows = [soft_row(study.folder, group, soft_kn(scene, group[0].model, group[0].kstar),
+                     reference) for group in softs]
     study.rows = ref_rows + rows
     study.choice = analyze.pick_cheapest(rows, study.tolerance)
     # the noise that limits the verdict: the chosen run's, else the quietest run's
