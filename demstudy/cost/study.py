@@ -207,7 +207,8 @@ def _assemble(study: CostStudy, scene: Scene, refs: list[list[RunSpec]],
 
 def _fits(rows: list[dict]) -> dict[str, Any]:
     """error(k*) per model at its largest steps per contact, and error(t_c/τ_flight) over
-    every run with health figures: fitted where enough runs have an error > 0."""
+    the runs with health figures at the ladder's largest steps per contact: fitted where
+    enough runs have an error > 0."""
     fits: dict[str, Any] = {}
     for model in sorted({r["model"] for r in rows}):
         mine = [r for r in rows if r["model"] == model]
@@ -219,7 +220,11 @@ def _fits(rows: list[dict]) -> dict[str, Any]:
                                                 [r["error"] for r in mine])
         except (ValueError, RuntimeError) as exc:
             fits[key] = f"not fitted: {exc}"
-    flight = [r for r in rows if math.isfinite(r.get("tc_flight", math.nan))]
+    # at the most steps per contact only: fewer steps add an integration error of their own
+    # (10 steps per contact: the rotational temperature off by ~15 % at any stiffness)
+    top = max((r["steps_per_contact"] for r in rows), default=math.nan)
+    flight = [r for r in rows if math.isfinite(r.get("tc_flight", math.nan))
+              and r["steps_per_contact"] == top]
     if flight:
         try:  # error = a (t_c/τ)^p + floor: fitted as a function of τ/t_c
             fits["error(t_c/tau_flight)"] = analyze.fit_convergence(
