@@ -48,8 +48,8 @@ Weights: a variance of m blocks has relative variance 2/(m − 1). The exponenti
 unless the power law fits better by Δχ² > 2. An output is *converged* when the exponential
 fits and τ_int ≤ n/20; otherwise (a power law, a longer τ, or a trend such as a transient
 that outlasts the equilibration) it is flagged, with the reason, and its factor is at most
-what τ_int = n/20 would give (beyond that the fit cannot be checked and diverges: the slow
-part cancels from the run's own curve). Correlations much longer than the run are invisible
+what τ_int = n/5 would give (beyond that the fit is unconstrained and diverges: the slow part
+cancels from the run's own curve). Correlations much longer than the run are invisible
 to it altogether: only replicas measure them (docs/results-format.md, "Statistical
 errors", with the replica ratios measured). Checked against processes of known error
 (tests/test_blocking.py) and replicas (tests/test_error_replicas.py).
@@ -74,8 +74,10 @@ MIN_BLOCKS = 8
 
 
 F64 = NDArray[np.float64]
-#: longest correlation time (τ_int, in units of the run's samples n) a run resolves
+#: longest correlation time (τ_int, as a fraction of the run's n samples) whose errors count
+#: as converged, and the longest the extrapolation may assume (beyond, the fit is unconstrained)
 _TAU_LIMIT = 1.0 / 20
+_TAU_CAP = 1.0 / 5
 #: χ² by which the power law must beat the exponential (the physically expected form)
 _MARGIN = 2.0
 Result = F64 | dict[str, F64]
@@ -262,7 +264,8 @@ def _inefficiency(lengths: list[int], counts: list[int], ratios: list[float], el
     variance 2/(m − 1), a median over the elements π/2 of a mean's. The exponential is taken
     unless the power law fits clearly better (χ² lower by more than 2). Returns the variance
     factor g(n)/g_measured(b₀) the finest errors need, the model, its parameter, and whether
-    the errors converged: the correlation time (τ_int = g(∞)/2) is at most n/20 samples."""
+    the errors converged: the exponential fits with τ_int = g(∞)/2 at most n/20 samples (else
+    the factor is capped at τ_int = n/5 and the reason given)."""
     from scipy.optimize import minimize_scalar
 
     n = int(n_samples)
@@ -293,15 +296,15 @@ def _inefficiency(lengths: list[int], counts: list[int], ratios: list[float], el
     if model == "power":
         converged, reason = False, f"blocking curve still rising as b^{alpha:.2f}"
     else:
-        converged = tau_int <= n / 20
+        converged = tau_int <= _TAU_LIMIT * n
         reason = "" if converged else (
-            f"correlation time {tau_int:.0f} samples > run/20 = {n / 20:.0f}")
+            f"correlation time {tau_int:.0f} samples > run/20 = {_TAU_LIMIT * n:.0f}")
     factor = _factor(fits[model][1], b[0], n)
     if not converged:
-        # beyond what the run resolves the extrapolation is a guess that diverges as the
+        # far beyond what the run resolves the extrapolation is a guess that diverges as the
         # slow part cancels from the run's own curve: quote at most the error a correlation
-        # time of n/20 would give (a lower bound, flagged), the longest a run can check
-        factor = min(factor, _factor(lambda x: _g_exponential(x, _TAU_LIMIT * n), b[0], n))
+        # time of n/5 would give (flagged; a lower bound when the correlation is longer)
+        factor = min(factor, _factor(lambda x: _g_exponential(x, _TAU_CAP * n), b[0], n))
     return {"factor": max(1.0, factor), "model": model, "alpha": alpha, "tau": tau_int,
             "converged": converged, "reason": reason}
 
