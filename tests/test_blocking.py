@@ -161,3 +161,47 @@ def test_correlations_as_long_as_the_run_are_flagged():
     (figures,) = report.values()
     assert not figures["converged"]
     assert np.median(err) < ar1_error_of_mean(0.999, 2048)
+
+
+def _profile_like(acc: BlockAccumulator):
+    """jackknife_report with the 200 chains as 20 outputs of 10 elements (like 20 fields of
+    a 10-bin profile): (mean quoted variance, reports)."""
+    from demstudy.analysis.blocking import jackknife_report
+
+    _, err, report = jackknife_report(acc, lambda m: {f"f{i}": m[10 * i: 10 * i + 10]
+                                                      for i in range(20)})
+    return float(np.mean(np.concatenate(list(err.values())) ** 2)), list(report.values())
+
+
+@pytest.mark.parametrize("rho", [0.9, 0.95, 0.97])
+def test_fitted_curve_gives_exponential_errors_of_a_short_run(rho):
+    """1200 samples, stored blocks of 32 (the Couette cell's runs): the curve has only three
+    levels (32, 64, 128), still rising for τ_int = 10–33 samples. The fit of the curve the
+    run measures gives the exact error of the mean (exact²/quoted² 1.07–1.09 here) and
+    τ_int; the old rule (plateau or power law) gave 1.12–1.14."""
+    n = 1200
+    x = ar1(rho, n, 200, seed=12)
+    acc = feed(BlockAccumulator(200, max_blocks=64), x)
+    assert acc.block_length == 32
+    variance, reports = _profile_like(acc)
+    assert ar1_error_of_mean(rho, n) ** 2 / variance == pytest.approx(1.0, abs=0.12)
+    tau_int = (1 + rho) / (2 * (1 - rho))
+    assert np.median([r["correlation_time"] for r in reports]) == pytest.approx(tau_int, rel=0.2)
+    assert all(r["converged"] and r["model"] == "exponential" for r in reports)
+
+
+def test_correlation_beyond_a_twentieth_of_the_run_is_flagged_with_reason():
+    """τ_int = 100 samples in a 1200-sample run (> n/20 = 60): flagged, the reason names the
+    correlation time, and the quoted error is still the fit's (exact²/quoted² = 1.05; not
+    capped below n/5). The old rule's power law overshot the plateau: 0.42."""
+    n, rho = 1200, 0.99
+    acc = feed(BlockAccumulator(200, max_blocks=64), ar1(rho, n, 200, seed=13))
+    variance, reports = _profile_like(acc)
+    assert sum(not r["converged"] for r in reports) >= 18
+    assert all("correlation time" in r["reason"] for r in reports if not r["converged"])
+    assert ar1_error_of_mean(rho, n) ** 2 / variance == pytest.approx(1.0, abs=0.3)
+    from demstudy.analysis.blocking import error_figures
+
+    figures = error_figures({k: r for k, r in zip("abc", reports[:3], strict=True)})
+    assert not figures["errors_converged"] and "a: correlation time" in figures[
+        "errors_unconverged_fields"]

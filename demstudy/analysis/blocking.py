@@ -37,16 +37,26 @@ the bins keeps the curve's noise at a few per cent). err_l² = σ² g(b_l)/n wit
 statistical inefficiency of blocks b_l long, and the error of the run's mean is σ² g(n)/n:
 the curve must be followed to one block of the whole run. Each element's error is its
 finest-level error (the finest level, with the most blocks, is the least noisy) times
-√(g(n)/g(b₀)): the curve's highest point where it levelled off (its last rise within twice
-the median's noise; "converged"), else its power law r ∝ b^α over the last levels
-extrapolated to b = n ("not converged": correlations as long as an eighth of the run, or
-slowly growing ones, as in sheared gases, where bands drift slowly; replicas or longer runs
-check it). Checked against processes of known error (tests/test_blocking.py); what it does
-for sheared granular gases, measured against independent replicas: docs/results-format.md,
-"Statistical errors".
-:func:`jackknife_report` returns these figures: the plateau's block length, the
-factor r, convergence, and the effective number of independent samples n / (g₀ r), g₀ the
-statistical inefficiency of the stored blocks themselves (from the samples' own variance).
+√(g(n)/ĝ(b₀)), from a fit of the curve (:func:`_inefficiency`). Two one-parameter models
+of g: exponential correlations (time τ; g(b) = 1 + 2 Σ_{k<b} (1 − k/b) ρ^k, ρ = e^{−1/τ})
+and a power law g ∝ b^α (slowly growing correlations, as in sheared gases where bands
+drift). Each is fitted as the run *measures* it: block means scatter about the run's own
+mean, so the expected curve is ĝ(b) = (n g(b) − b g(n))/(n − b), which bends over before
+the true plateau when the correlation is not short against the run (the old plateau rule
+read that bend as convergence, the old power-law extrapolation overshot the plateau).
+Weights: a variance of m blocks has relative variance 2/(m − 1). The exponential is kept
+unless the power law fits better by Δχ² > 2. An output is *converged* when the exponential
+fits and τ_int ≤ n/20; otherwise (a power law, a longer τ, or a trend such as a transient
+that outlasts the equilibration) it is flagged, with the reason, and its factor is at most
+what τ_int = n/5 would give (beyond that the fit is unconstrained and diverges: the slow part
+cancels from the run's own curve). Correlations much longer than the run are invisible
+to it altogether: only replicas measure them (docs/results-format.md, "Statistical
+errors", with the replica ratios measured). Checked against processes of known error
+(tests/test_blocking.py) and replicas (tests/test_error_replicas.py).
+:func:`jackknife_report` returns these figures: the longest useful block length, the
+factor r, convergence (with the model, τ_int and the reason), and the effective number of
+independent samples n / (g₀ r), g₀ the statistical inefficiency of the stored blocks
+themselves (from the samples' own variance).
 """
 
 from __future__ import annotations
@@ -64,6 +74,12 @@ MIN_BLOCKS = 8
 
 
 F64 = NDArray[np.float64]
+#: longest correlation time (τ_int, as a fraction of the run's n samples) whose errors count
+#: as converged, and the longest the extrapolation may assume (beyond, the fit is unconstrained)
+_TAU_LIMIT = 1.0 / 20
+_TAU_CAP = 1.0 / 5
+#: χ² by which the power law must beat the exponential (the physically expected form)
+_MARGIN = 2.0
 Result = F64 | dict[str, F64]
 Estimator = Callable[[F64], "F64 | Mapping[str, F64]"]
 
@@ -211,22 +227,86 @@ def _levels(acc: BlockAccumulator, estimator: Estimator,
     return lengths, counts, errors
 
 
+def _g_exponential(b: F64, tau: float) -> F64:
+    """Statistical inefficiency of blocks b samples long for exponential correlations
+    ρ^k, ρ = exp(−1/τ): 1 + 2 Σ_{k<b} (1 − k/b) ρ^k in closed form (1 at b = 1, 2τ_int + ...
+    → (1 + ρ)/(1 − ρ) for b ≫ τ)."""
+    rho = np.exp(-1.0 / tau)
+    return (1 + rho) / (1 - rho) - 2 * rho * (1 - rho**b) / (b * (1 - rho) ** 2)
+
+
+def _g_power(b: F64, alpha: float) -> F64:
+    """Inefficiency rising as a power of the block length, g ∝ b^α (no plateau)."""
+    return b**alpha
+
+
+def _measured(g: Callable[[F64], F64], b: F64, n: int) -> F64:
+    """Expected blocking-curve value at block length b in a run of n samples: block means
+    scatter about the run's own mean, so E[b s_b²/σ²] = (n g(b) − b g(n)) / (n − b). A curve
+    still rising at b ~ n therefore bends over early; fitting this, not g, undoes it."""
+    b = np.minimum(b, 0.5 * n)
+    return (n * g(b) - b * g(np.float64(n))) / (n - b)
+
+
+def _factor(g: Callable[[F64], F64], b0: float, n: int) -> float:
+    """Variance factor g(n) / g_measured(b₀) that turns the finest level's error into the
+    error of the run's mean under the inefficiency model g."""
+    return float(g(np.float64(n)) / _measured(g, np.asarray([b0]), n)[0])
+
+
 def _inefficiency(lengths: list[int], counts: list[int], ratios: list[float], elements: int,
-                  n_samples: int) -> tuple[float, bool]:
-    """(factor, converged): the variance factor g(n)/g(b₀) the finest errors need, from the
-    blocking curve ``ratios`` (r_l at block lengths ``lengths``, with ``counts`` blocks, the
-    median over ``elements`` values). Levelled off (its last rise within twice the median's
-    noise): the curve's highest point. Still rising: extrapolated to one block of the whole
-    run (the variance of the run's mean) along the power law of its last levels, r ∝ b^α
-    with 0 <= α <= 1: conservative for exponentially decaying correlations, as a run too
-    short for them has to be."""
-    if len(ratios) < 2:
-        return 1.0, False
-    noise = 1.25 * np.sqrt(2.0 / max(counts[-1] - 1, 1)) / np.sqrt(max(elements, 1))
-    converged = ratios[-1] <= ratios[-2] * (1.0 + 2.0 * noise)
-    x, y = np.log(np.asarray(lengths, float)), np.log(np.maximum(ratios, 1e-300))
-    alpha = float(np.clip(np.polyfit(x, y, 1)[0], 0.0, 1.0)) if not converged else 0.0
-    return max(1.0, max(ratios), ratios[-1] * (n_samples / lengths[-1]) ** alpha), converged
+                  n_samples: int) -> dict:
+    """Fit the blocking curve ``ratios`` (r_l at block lengths ``lengths`` with ``counts``
+    blocks, the median over ``elements`` values, r_0 = 1) and extrapolate it to one block of
+    the whole run. Two one-parameter models of the run's statistical inefficiency g(b),
+    each seen through the run's finite length (:func:`_measured`): exponential correlations
+    (time τ) and a power law g ∝ b^α. Weights: a block variance of m blocks has relative
+    variance 2/(m − 1), a median over the elements π/2 of a mean's. The exponential is taken
+    unless the power law fits clearly better (χ² lower by more than 2). Returns the variance
+    factor g(n)/g_measured(b₀) the finest errors need, the model, its parameter, and whether
+    the errors converged: the exponential fits with τ_int = g(∞)/2 at most n/20 samples (else
+    the factor is capped at τ_int = n/5 and the reason given)."""
+    from scipy.optimize import minimize_scalar
+
+    n = int(n_samples)
+    b = np.asarray(lengths, float)
+    r = np.maximum(np.asarray(ratios, float), 1e-3)
+    if len(r) < 2:
+        return {"factor": 1.0, "model": "none", "tau": float("nan"), "converged": False,
+                "reason": "fewer than two levels of blocks"}
+    weights = (np.asarray(counts[1:], float) - 1) / 2 * max(elements, 1) / (np.pi / 2)
+
+    def chi2(g: Callable[[F64], F64]) -> float:
+        model = _measured(g, b, n)
+        if not np.all(model > 0):
+            return np.inf
+        return float(np.sum(weights * (np.log(r[1:]) - np.log(model[1:] / model[0])) ** 2))
+
+    fits = {}
+    exp_fit = minimize_scalar(lambda lt: chi2(lambda x: _g_exponential(x, np.exp(lt))),
+                              bounds=(np.log(0.05), np.log(100.0 * n)), method="bounded")
+    tau = float(np.exp(exp_fit.x))
+    fits["exponential"] = (exp_fit.fun, lambda x: _g_exponential(x, tau))
+    pow_fit = minimize_scalar(lambda a: chi2(lambda x: _g_power(x, a)), bounds=(0.0, 0.9),
+                              method="bounded")
+    alpha = float(pow_fit.x)
+    fits["power"] = (pow_fit.fun, lambda x: _g_power(x, alpha))
+    model = "power" if pow_fit.fun < exp_fit.fun - _MARGIN else "exponential"
+    tau_int = 0.5 * float(_g_exponential(np.float64(1e12), tau))
+    if model == "power":
+        converged, reason = False, f"blocking curve still rising as b^{alpha:.2f}"
+    else:
+        converged = tau_int <= _TAU_LIMIT * n
+        reason = "" if converged else (
+            f"correlation time {tau_int:.0f} samples > run/20 = {_TAU_LIMIT * n:.0f}")
+    factor = _factor(fits[model][1], b[0], n)
+    if not converged:
+        # far beyond what the run resolves the extrapolation is a guess that diverges as the
+        # slow part cancels from the run's own curve: quote at most the error a correlation
+        # time of n/5 would give (flagged; a lower bound when the correlation is longer)
+        factor = min(factor, _factor(lambda x: _g_exponential(x, _TAU_CAP * n), b[0], n))
+    return {"factor": max(1.0, factor), "model": model, "alpha": alpha, "tau": tau_int,
+            "converged": converged, "reason": reason}
 
 
 def jackknife_report(acc: BlockAccumulator, estimator: Estimator,
@@ -259,12 +339,13 @@ def jackknife_report(acc: BlockAccumulator, estimator: Estimator,
                 r = (level[part][ok] / base[ok]) ** 2
             r = r[np.isfinite(r)]
             ratios.append(float(np.median(r)) if r.size else 1.0)
-        factor, converged = _inefficiency(lengths, counts, ratios, int(ok.sum()),
-                                          acc.n_samples)
+        fit = _inefficiency(lengths, counts, ratios, int(ok.sum()), acc.n_samples)
+        factor = fit["factor"]
         err[part] = base * np.sqrt(factor)
         report[key] = {"block_length": lengths[int(np.argmax(ratios))],
                        "blocks": counts[int(np.argmax(ratios))], "inefficiency": factor,
-                       "converged": converged,
+                       "converged": fit["converged"], "model": fit["model"],
+                       "correlation_time": fit["tau"], "reason": fit["reason"],
                        "effective_samples": acc.n_samples / (g0 * factor)}
     return unflatten(flat), unflatten(err), report
 
@@ -272,14 +353,18 @@ def jackknife_report(acc: BlockAccumulator, estimator: Estimator,
 def error_figures(report: Mapping[str, Mapping]) -> dict:
     """A report's figures over all outputs, as attributes of a results group: the longest
     block the errors needed, the largest variance factor, the fewest effective independent
-    samples, and whether every output's blocking curve levelled off."""
+    samples, whether every output's errors converged, and the outputs whose did not, with the
+    reason ("name: reason; ...", empty when all did)."""
     if not report:
         return {}
     figures = list(report.values())
     return {"error_block_length": max(f["block_length"] for f in figures),
             "error_inefficiency": max(f["inefficiency"] for f in figures),
             "effective_samples": min(f["effective_samples"] for f in figures),
-            "errors_converged": all(f["converged"] for f in figures)}
+            "errors_converged": all(f["converged"] for f in figures),
+            # which outputs are lower bounds, and why (HDF5 attributes hold one string)
+            "errors_unconverged_fields": "; ".join(
+                f"{key}: {f['reason']}" for key, f in report.items() if not f["converged"])}
 
 
 def jackknife(acc: BlockAccumulator, estimator: Estimator,
