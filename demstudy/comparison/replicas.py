@@ -31,7 +31,7 @@ __all__ = ["combine_replicas", "is_combined"]
 
 #: single-run error estimates that do not describe the replicas' errors: left out
 SINGLE_RUN_ERROR_ATTRS = ("block_length", "error_block_length", "error_inefficiency",
-                          "errors_converged", "effective_samples")
+                          "errors_converged", "effective_samples", "errors_unconverged_fields")
 
 
 def is_combined(res: Results) -> bool:
