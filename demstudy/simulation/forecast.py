@@ -14,9 +14,10 @@ The wall time is a sum of measured costs (seconds per unit) times counts of the 
   + wall bumps, steps = duration / dt;
 * event-driven engines: ``event`` × events + ``atom_sample`` × N × samples + ``sample`` ×
   samples. The events come from the pilot's measured events per particle per τ (× N ×
-  duration), or, with no pilot, from the Enskog collision frequency at T = (reference
-  speed)² with ``EVENTS_PER_COLLISION`` events (collisions and cell crossings) per pair
-  collision; a run counted in collisions (``run.unit = 'collisions'``) knows its count.
+  duration), or, with no pilot, from the Enskog collision frequency at the flow's typical
+  temperature (:func:`typical_temperature`) with ``EVENTS_PER_COLLISION`` events
+  (collisions and cell crossings) per pair collision; a run counted in collisions
+  (``run.unit = 'collisions'``) knows its count.
 
 The costs of each engine, contact model and dimension are measured once by a few short
 benchmark runs through the same simulation loop (a least-squares fit with non-negative
@@ -294,15 +295,31 @@ def expected_events(scene: Scene, pilot: PilotResult | None = None) -> tuple[flo
         per = pilot.events / (pilot.n_particles * pilot.simulated_time)
         return per * n * duration, (f"the pilot's {per:.3g} events per particle per τ × {n} "
                                     f"× {duration:g} τ")
-    from ..contact.stiffness import reference_speed
     from ..theory import collision_frequency
 
-    temperature = reference_speed(scene) ** 2
+    temperature = typical_temperature(scene)
     omega = float(collision_frequency(min(scene.solid_fraction, 0.6), temperature,
                                       scene.dimension))
     return omega * n * duration / 2 * per_collision, (
         f"Enskog ω = {omega:.3g} at T = {temperature:.3g} × {n} × {duration:g} τ / 2 × "
         f"{per_collision:g} events per collision")
+
+
+def typical_temperature(scene: Scene) -> float:
+    """The granular temperature a flow keeps, for the Enskog collision rate (an estimate
+    within a factor of a few, i.e. within ~2 on the rate ∝ √T): the largest of the initial
+    temperature, (γ̇ d)² under shear, (ΔU d / gap)² between moving walls, and g d under
+    gravity; never below 1e-6."""
+    temps = [scene.initial.velocity.temperature]
+    if scene.shear is not None:
+        temps.append(scene.shear.rate**2)
+    if len(scene.walls) == 2:
+        gap = scene.box.size[1]
+        speeds = [w.velocity for w in scene.walls]
+        temps.append(((max(speeds) - min(speeds)) / gap) ** 2)
+    if scene.gravity is not None:
+        temps.append(scene.gravity.magnitude)
+    return max(max(temps), 1e-6)
 
 
 def forecast_run(scene: Scene, backend: Any, timestep: float | None = None,

@@ -14,13 +14,17 @@ import warnings
 from dataclasses import dataclass
 from typing import Any
 
-from ..contact.pilot import PilotResult, run_pilot
+from ..contact.pilot import PILOT_SECONDS, PilotResult, run_pilot
 from ..contact.stiffness import ContactSetup, contact_setup
 from ..scene import Scene
 from .forecast import Forecast, RatesNotMeasured, forecast_run
 from .options import RunOptions
 
 __all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
+
+#: an event-driven run forecast (from Enskog) to last longer than this many seconds gets a
+#: pilot to measure its collision rate (at most a tenth of the forecast)
+PILOT_WORTH = 20.0
 
 #: engines with a benchmark (``forecast.measure_rate``): the others get no forecast
 FORECAST_ENGINES = ("lammps", "edmd")
@@ -76,9 +80,10 @@ class RunPlan:
 
 
 def needs_pilot(scene: Scene, backend: Any, dry_run: bool = False) -> bool:
-    """A soft-contact engine choosing k_n itself; the event-driven engine's forecast only on
-    ``--dry-run`` (a run forecasts its events from the Enskog rate instead: a pilot of up to
-    seconds would multiply the fixed cost of short event-driven runs)."""
+    """A soft-contact engine choosing k_n itself; the event-driven engine's forecast on
+    ``--dry-run`` (a run forecasts its events from the Enskog rate, and runs a pilot only
+    when that forecast exceeds ``PILOT_WORTH``: a pilot of up to seconds would multiply the
+    fixed cost of short event-driven runs)."""
     if backend.capabilities.time_step:
         return scene.soft.stiffness is None and scene.soft.hardness is None
     return dry_run and backend.name == "edmd" and scene.run.unit == "time"
@@ -103,6 +108,15 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
                                     pilot, costs)
         except RatesNotMeasured:
             pass  # said by describe(): no forecast
+        except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
+            warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
+    if (forecast is not None and pilot is None and not backend.capabilities.time_step
+            and backend.name == "edmd" and scene.run.unit == "time"
+            and forecast.seconds > PILOT_WORTH):
+        # a long event-driven run: a pilot of ≤ 10 % of it measures the real collision rate
+        pilot = run_pilot(scene, seconds=min(PILOT_SECONDS, 0.1 * forecast.seconds))
+        try:
+            forecast = forecast_run(scene, backend, None, pilot, costs)
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     n = scene.n_particles
