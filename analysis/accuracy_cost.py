@@ -23,13 +23,15 @@ import demstudy as ds
 ROOT = Path(__file__).resolve().parent.parent
 INPUTS = ROOT / "inputs" / "accuracy-cost"
 
-#: study name → scene, ladder (k* values, steps per contact, contact models), overrides
+#: study name → scene, ladder (k* values, steps per contact, contact models), overrides;
+#: the cheap event-driven reference is replicated (other seeds) to shrink its noise
 STUDIES: dict[str, dict] = {
     "couette": dict(scene=INPUTS / "couette-rough-nu0.55.toml",
                     kstars=[1e2, 1e3, 1e4, 1e5], steps=[10, 50], models=["hooke"],
-                    overrides=["run.production=2400"]),
+                    overrides=["run.production=2400"], reference_replicas=4),
     "le3d-0.3": dict(scene=INPUTS / "lees-edwards-3d-phi0.3.toml",
-                     kstars=[1e3, 1e4, 1e5, 1e6], steps=[10, 50], models=["hooke"]),
+                     kstars=[1e3, 1e4, 1e5, 1e6], steps=[10, 50], models=["hooke"],
+                     reference_replicas=4),
     "le3d-0.55": dict(scene=INPUTS / "lees-edwards-3d-phi0.55.toml",
                       kstars=[1e3, 1e4, 1e5, 1e6], steps=[10], models=["hooke"]),
     # starts from the event-driven steady state (steady_state below): 300 √(d/g) of
@@ -37,7 +39,7 @@ STUDIES: dict[str, dict] = {
     "poiseuille": dict(scene=INPUTS / "poiseuille-phi0.1-small.toml",
                        kstars=[1e4, 1e5, 1e6, 1e7], steps=[10], models=["hooke"],
                        overrides=["run.equilibration=10", "run.production=60"],
-                       steady=True),
+                       steady=True, reference_replicas=4),
 }
 
 

@@ -27,8 +27,8 @@ import sys
 from pathlib import Path
 
 import demstudy as ds
-from demstudy.cost.plan import scene_for, soft_ladder
-from demstudy.cost.report import table
+from demstudy.accuracy.plan import scene_for, soft_ladder
+from demstudy.accuracy.report import table
 from demstudy.engines import get_backend
 from demstudy.simulation import RunOptions, plan_run
 

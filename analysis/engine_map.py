@@ -17,8 +17,8 @@ import json
 import sys
 from pathlib import Path
 
-from demstudy.cost.engine_map import MapSettings, engine_map
-from demstudy.cost.map_figure import map_figure
+from demstudy.accuracy.engine_map import MapSettings, engine_map
+from demstudy.accuracy.map_figure import map_figure
 from demstudy.io.results import write_atomically
 
 ROOT = Path(__file__).resolve().parent.parent

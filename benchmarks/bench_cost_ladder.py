@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from demstudy.cost.study import cost
+from demstudy.accuracy.study import cost
 
 
 def ladder(out: Path, args: argparse.Namespace, workers: int) -> tuple[float, float, int]:

@@ -43,7 +43,7 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "Scene": "demstudy.scene",
     "run": "demstudy.api",
     "load": "demstudy.api",
-    "cost": "demstudy.cost",  # the package, callable as ds.cost(...) (its __init__)
+    "cost": "demstudy.accuracy",
     "Results": "demstudy.io.results",
     "open_lammps": "demstudy.engines.lammps.library",
     "testing": "demstudy.testing",

@@ -232,8 +232,8 @@ def _whole(option: str, text: str | None) -> int | None:
 
 
 def _cmd_cost(args: argparse.Namespace) -> int:
-    from .cost.report import text_report
-    from .cost.study import DEFAULT_KSTARS, DEFAULT_MODELS, DEFAULT_STEPS, cost
+    from .accuracy.report import text_report
+    from .accuracy.study import DEFAULT_KSTARS, DEFAULT_MODELS, DEFAULT_STEPS, cost
 
     study = cost(args.scene, overrides=args.set, quick=args.quick, tolerance=args.tolerance,
                  kstars=_numbers("--kstar", args.kstar) if args.kstar else DEFAULT_KSTARS,
@@ -248,7 +248,7 @@ def _cmd_cost(args: argparse.Namespace) -> int:
 
 
 def _cmd_engine_map(args: argparse.Namespace) -> int:
-    from .cost.engine_map import QUICK, RESTITUTIONS, MapSettings, engine_map
+    from .accuracy.engine_map import QUICK, RESTITUTIONS, MapSettings, engine_map
 
     settings = MapSettings(ratio=args.ratio, timeout=args.timeout)
     dims = _numbers("--dim", args.dim)

@@ -1,4 +1,4 @@
-"""The cost ladder (demstudy.cost): convergence fit, the choice at a tolerance, resuming,
+"""The cost ladder (demstudy.accuracy): convergence fit, the choice at a tolerance, resuming,
 the Dask path, and the command line's refusals. Tiny 2D Lees–Edwards runs (≈ 75 discs, a
 few strain units): dimensionless particle units, d = 1, m = 1, γ̇ = 1."""
 
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import demstudy as ds
+from demstudy.accuracy.analyze import fit_convergence, pick_cheapest
+from demstudy.accuracy.figure import pareto_front
 from demstudy.cli import main
-from demstudy.cost.analyze import fit_convergence, pick_cheapest
-from demstudy.cost.figure import pareto_front
 from demstudy.io.results import read_results
 
 TINY = ["box.size=[10.0, 10.0]", "run.equilibration=1.0", "run.production=2.0",
@@ -55,7 +55,7 @@ def test_tolerance_picks_the_cheapest_qualifying_run():
 
 
 def test_recommendation_names_the_cheaper_engine_and_the_cost_ratio():
-    from demstudy.cost.analyze import recommend
+    from demstudy.accuracy.analyze import recommend
 
     soft = {"name": "soft-hooke-k1e+4-s10", "wall_seconds": 2.0, "error": 0.01, "floor": 0.005}
     assert recommend(soft, 8.0, 0.02, 0.005).startswith("soft contacts")
@@ -204,7 +204,7 @@ def test_reference_tc_ladder_keeps_the_largest_tc_when_the_tc_model_never_acts(t
 
 
 def test_health_figures_when_present_give_the_contact_time_law():
-    from demstudy.cost.study import _fits
+    from demstudy.accuracy.study import _fits
 
     ratio = np.array([0.3, 0.1, 0.03, 0.01])  # t_c/τ_flight of four soft runs
     rows = [{"model": "hooke", "steps_per_contact": 50.0, "kstar": 1e2 / r**2,

@@ -8,9 +8,9 @@ import math
 
 import pytest
 
+from demstudy.accuracy import engine_map as em
+from demstudy.accuracy.map_output import map_hint, nearest_point
 from demstudy.contact import mapping
-from demstudy.cost import engine_map as em
-from demstudy.cost.map_output import map_hint, nearest_point
 
 
 @pytest.mark.parametrize("e", [0.5, 0.7, 0.9, 0.99, 1.0])
@@ -103,8 +103,8 @@ def test_tiny_map_end_to_end(tmp_path):
 
 
 def test_the_cost_report_ends_with_the_map_line(tmp_path):
-    from demstudy.cost.report import text_report
-    from demstudy.cost.study import CostStudy
+    from demstudy.accuracy.report import text_report
+    from demstudy.accuracy.study import CostStudy
 
     study = CostStudy(tmp_path, "k*", [], {}, 0.02, None, "event-driven (edmd): ...",
                       map_hint="engine map: nearest point 2D fraction 0.5, e = 0.9: ...")

@@ -10,9 +10,6 @@ rate or the wall speed sets the time unit).
     study.recommendation, study.rows, study.fits
 """
 
-import sys
-import types
-
 from .._lazy import lazy_exports
 
 __all__ = ["CostStudy", "cost", "fit_convergence", "pick_cheapest"]
@@ -24,16 +21,3 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "pick_cheapest": ".analyze",
 })
 
-
-class _CallablePackage(types.ModuleType):
-    """``ds.cost(...)`` calls :func:`demstudy.cost.study.cost`: ``demstudy.cost`` is this
-    package (Python binds the subpackage to that name once it is imported), so the package
-    itself is callable."""
-
-    def __call__(self, *args, **kwargs):
-        from .study import cost
-
-        return cost(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallablePackage
