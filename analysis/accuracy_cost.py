@@ -14,6 +14,7 @@ Writes results/accuracy-cost/<study>/ (ladder.csv, ladder.json, pareto.png, the 
 from __future__ import annotations
 
 import argparse
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -58,12 +59,29 @@ def steady_state(scene_path: Path, folder: Path) -> list[str]:
     return ["initial.placement=file", f"initial.path={state}"]
 
 
+def figures(name: str, study, into: Path) -> None:
+    """docs/figures/accuracy-<study>-pareto.png and -profiles.png: the ladder's accuracy
+    against cost, and the stiffest soft run at the most steps per contact overlaid on the
+    reference (its replicas combined) with their difference per bin."""
+    into.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(study.folder / "pareto.png", into / f"accuracy-{name}-pareto.png")
+    reference = study.reference["path"].split(",")  # replicas: their files, comma-joined
+    softs = [r for r in study.rows if r["engine"] == "lammps"]
+    best = max(softs, key=lambda r: (r["steps_per_contact"], r["kstar"]))
+    (comparison,) = ds.compare(reference, best["path"].split(","))
+    ds.plot_comparison(comparison, into / f"accuracy-{name}-profiles.png",
+                       fields=["solid_fraction", "velocity[x]", "temperature",
+                               "rotational_temperature"])
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("studies", nargs="*", metavar="STUDY",
                         help=f"of {', '.join(STUDIES)} (default: all)")
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--out", type=Path, default=ROOT / "results" / "accuracy-cost")
+    parser.add_argument("--figures", type=Path, default=ROOT / "docs" / "figures",
+                        help="where the studies' figures go (default docs/figures)")
     args = parser.parse_args(argv)
     unknown = [s for s in args.studies if s not in STUDIES]
     if unknown:
@@ -77,6 +95,7 @@ def main(argv: list[str] | None = None) -> int:
         study = ds.cost(spec.pop("scene"), out=folder, overrides=overrides,
                         workers=args.workers, **spec)
         print(f"{name}: {study.recommendation}")
+        figures(name, study, args.figures)
     return 0
 
 

@@ -99,6 +99,9 @@ def execute(tasks: list[Task], workers: int = 1, dask: Any = None,
     run raises after the others finished (their files are kept for the rerun)."""
     if not tasks:
         return []
+    # longest first (LPT scheduling): the last run to start is a short one, so the workers
+    # finish together instead of one waiting for the stiffest run started last
+    tasks = sorted(tasks, key=lambda t: t.spec.relative_cost, reverse=True)
     if dask is not None:
         return _on_dask(tasks, dask, on_done)
     records, failures = [], []

@@ -72,6 +72,15 @@ class RunSpec:
         return self.engine != "edmd"
 
     @property
+    def relative_cost(self) -> float:
+        """A proxy of the run's wall time for ordering (not a forecast): soft runs take
+        steps ∝ steps per contact × √k (Hooke t_c ∝ k^−1/2); the event-driven ones' cost
+        does not depend on a stiffness and their t_c ladder costs more as t_c shrinks."""
+        if self.soft:
+            return float(self.steps or 1.0) * float(self.kstar or 1.0) ** 0.5
+        return 1.0 / float(self.tc or 1.0) ** 0.25
+
+    @property
     def name(self) -> str:
         """File stem encoding the settings, e.g. ``soft-hooke-k1e+04-s50``, ``ref-edmd-tc1e-05``,
         ``soft-hooke-k100-s10-r1`` (replica 1)."""
