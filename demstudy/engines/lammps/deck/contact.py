@@ -43,6 +43,9 @@ def pair_block(scene: Scene, setup: ContactSetup) -> Block:
         f"{p.model} contacts, k_n = {p.kn:.6g}, e = {p.restitution:g}, "
         f"t_c = {p.contact_time:.6g} (m_eff = m/2)"
         + ("" if p.tangential == "none" else f", k_t = {p.kt:.6g}, {p.tangential} tangential")
+        + ("" if p.steps_per_contact is None else
+           f" (k_t compensated for {p.steps_per_contact:.4g} steps per contact: LAMMPS's "
+           "discrete update restitutes the target beta, docs/contact.md)")
         + f"\n{setup.note()}"
     )
     return Block("contact", comment, cmds)
