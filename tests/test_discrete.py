@@ -28,8 +28,7 @@ DIMS_KINDS = [(2, "pair"), (2, "wall"), (3, "pair"), (3, "wall")]
 
 
 def _model(p, K: float, wall: bool) -> DiscreteContact:
-    return DiscreteContact(p.kn, p.restitution, p.m_eff, K, p.kt, p.xt, p.mu, p.model,
-                           p.mindlin, wall)
+    return DiscreteContact.of(p, K, wall)
 
 
 @pytest.mark.parametrize(("dim", "kind"), [(3, "pair"), (2, "wall")])
@@ -70,15 +69,25 @@ def test_history_preload_is_a_half_step_phase_lead(beta):
         b = collide(_model(p, 0.4, True), p.timestep(steps), 45.0, phases=phases(256))[1].mean()
         lead = -math.cos(omega_t * p.contact_time * (1 + 0.5 / steps))
         assert abs(b - lead) < 1.0 / steps**2
-        assert abs(b - beta) > 0.5 / steps  # the first-order drift being compensated
+        assert abs(b - beta) > 0.3 / steps  # the first-order drift being compensated
 
 
-def test_phase_averaged_e_needs_no_compensation():
-    """e drifts only at second order (< 0.001 at 10 steps): its damping stays continuous."""
+@pytest.mark.parametrize("e", [0.5, 0.7, 0.95])
+def test_damping_compensated_for_e(e):
+    """The half-step normal velocity in the damping force costs e up to 0.01 at 10 steps
+    (phase-averaged, e = 0.5); the compensated damping restitutes e again."""
     for wall in (False, True):
-        p = make_contact(kn=1e5, e=0.7, m_eff=1.0 if wall else 0.5, K=0.5, beta=0.5)
-        e = collide(_model(p, 0.5, wall), p.timestep(10), 45.0, phases=phases(256))[0].mean()
-        assert abs(e - 0.7) < 1e-3
+        m_eff = 1.0 if wall else 0.5
+        plain = make_contact(kn=1e5, e=e, m_eff=m_eff, K=0.5, beta=0.5)
+        p = make_contact(kn=1e5, e=e, m_eff=m_eff, K=0.5, beta=0.5, steps_per_contact=10,
+                         wall=wall)
+        assert plain.lammps_e == e and p.restitution == e
+        drift = collide(_model(plain, 0.5, wall), plain.timestep(10), 45.0,
+                        phases=phases(256))[0].mean() - e
+        assert e > 0.9 or drift < -1e-3
+        assert e > 0.9 or p.lammps_e > e  # more restitution asked of LAMMPS's damping
+        got = collide(_model(p, 0.5, wall), p.timestep(10), 45.0, phases=phases(256))[0].mean()
+        assert abs(got - e) < 1e-3 and (e > 0.9 or abs(got - e) < abs(drift) / 3)
 
 
 @pytest.mark.parametrize("wall", [False, True])
@@ -93,6 +102,7 @@ def test_compensated_kt_restitutes_the_target(wall):
         assert mean_restitution(_model(p, K, wall), tc, steps)[1] == pytest.approx(0.5, abs=1e-6)
         kt0 = tangential_stiffness_for_beta(0.5, K, m_eff, tc)
         assert previous < p.kt < kt0 * 1.005  # softer, converging on the continuous k_t
+        assert p.lammps_e == pytest.approx(0.9, abs=1e-3)
         previous = p.kt
     none = make_contact(kn=1e5, e=0.9, m_eff=m_eff, K=K, beta=0.5, wall=wall)
     assert none.kt == tangential_stiffness_for_beta(0.5, K, m_eff, tc)
@@ -100,18 +110,19 @@ def test_compensated_kt_restitutes_the_target(wall):
 
 
 def test_compensation_leaves_smooth_and_coulomb_contacts():
-    """Only uncapped springs are compensated: the Walton copy's beta drifts by < 0.006 at 10
+    """Only uncapped springs get a new k_t: the Walton copy's beta drifts by < 0.006 at 10
     steps (its normal and tangential oscillators step alike), smooth contacts have no k_t."""
     for mu in (0.3, 1.0):
         p = make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, mu=mu, steps_per_contact=10)
         assert p.kt == make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, mu=mu).kt
-        assert p.steps_per_contact is None
         b = collide(_model(p, 0.4, False), p.timestep(10), 10.0, phases=phases(128))[1].mean()
         assert abs(b - walton_beta(mu, 0.9, 0.9, 0.4, math.tan(math.radians(10.0)))) < 0.006
     assert make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, steps_per_contact=10).kt == 0.0
 
 
 def test_bad_steps_refused():
+    with pytest.raises(ValueError, match="steps_per_contact"):
+        make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, mu=0.3, steps_per_contact=-1.0)
     with pytest.raises(ValueError, match="steps_per_contact"):
         make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, beta=0.5, steps_per_contact=0.0)
     with pytest.raises(UnsupportedByEngine, match="phases"):
@@ -145,11 +156,11 @@ def test_lammps_measures_the_target_beta_after_compensation(dim, kind):
                            angles=(45.0,), phases=32)
         assert row.beta_target == pytest.approx(0.5, abs=1e-3)
         assert abs(row.beta - 0.5) < 0.005, (steps, row)
-        assert abs(row.e - 0.9) < 0.002, (steps, row)
+        assert abs(row.e - 0.9) < 0.001, (steps, row)
 
 
 def test_many_steps_keep_the_continuous_kt():
-    tc = hooke_contact(1e5, 0.9, 0.5).contact_time
     steps = 2 * discrete.MAX_COMPENSATED_STEPS
-    p = make_contact(kn=1e5, e=0.9, m_eff=0.5, K=0.4, beta=0.5, steps_per_contact=steps)
-    assert p.kt == tangential_stiffness_for_beta(0.5, 0.4, 0.5, tc)
+    p = make_contact(kn=1e5, e=0.5, m_eff=0.5, K=0.4, beta=0.5, steps_per_contact=steps)
+    assert p.kt == tangential_stiffness_for_beta(0.5, 0.4, 0.5, p.contact_time)
+    assert p.lammps_e == 0.5

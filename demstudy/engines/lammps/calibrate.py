@@ -172,9 +172,7 @@ def _beta_target(params: ContactParameters, K: float, tc: float, ratio: float,
     if params.tangential == "none":
         return -1.0
     if params.tangential == "spring" and params.steps_per_contact is not None:
-        c = DiscreteContact(params.kn, params.restitution, params.m_eff, K, params.kt,
-                            model=params.model, wall=wall,
-                            radius=r_eff if wall else 2.0 * r_eff)
+        c = DiscreteContact.of(params, K, wall, r_eff if wall else 2.0 * r_eff)
         return mean_restitution(c, params.contact_time, params.steps_per_contact, speed)[1]
     b0 = spring_beta(params.kt, K, params.m_eff, tc)
     if params.tangential == "spring":
