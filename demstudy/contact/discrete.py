@@ -247,19 +247,22 @@ def spring_stiffness(beta: float, kn: float, e: float, m_eff: float, K: float,
 @lru_cache(maxsize=512)
 def damping_restitution(e: float, kn: float, m_eff: float, contact_time: float,
                         steps_per_contact: float, model: str = "hooke", wall: bool = False,
-                        radius: float = 0.5, speed: float = 1.0) -> float:
+                        radius: float = 0.5, speed: float = 1.0, K: float = 0.4,
+                        kt: float = 0.0, xt: float = 0.0, mu: float | None = None,
+                        mindlin: bool = False) -> float:
     """The e to give LAMMPS's ``damping coeff_restitution`` so that the phase-averaged
     discrete normal restitution is ``e`` at ``steps_per_contact`` (scipy brentq): the half-step
     velocity in the damping force loses ≈ 0.010 of e = 0.5 at 10 steps (0.003 at e = 0.7,
-    < 0.001 from e = 0.8). e = 1 (no damping) and more than MAX_COMPENSATED_STEPS keep e."""
+    < 0.001 from e = 0.8). e = 1 (no damping) and more than MAX_COMPENSATED_STEPS keep e.
+    The tangential force (K, kt, xt, mu, mindlin) moves a pair's e by ~2e-4 at 20 steps
+    (the line of centres turns), so the contact's own tangential law is passed."""
     from scipy.optimize import brentq  # noqa: PLC0415 - only when compensating
 
     if e >= 1.0 or steps_per_contact > MAX_COMPENSATED_STEPS:
         return e
 
     def discrete(e_lammps: float) -> float:
-        c = DiscreteContact(kn, e_lammps, m_eff, 1.0, 0.0, model=model, wall=wall,
-                            radius=radius)
+        c = DiscreteContact(kn, e_lammps, m_eff, K, kt, xt, mu, model, mindlin, wall, radius)
         return mean_restitution(c, contact_time, steps_per_contact, speed)[0] - e
 
     lo, hi = 0.5 * e, min(1.0, e + 0.2)

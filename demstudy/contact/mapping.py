@@ -344,7 +344,7 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
             raise ValueError("hertz contacts need r_eff and the impact speed")
         tc = hertz_contact(kn, e, m_eff, r_eff, speed).contact_time
     xt, mindlin, e_damp = 0.0, False, None
-    if steps_per_contact is not None:
+    if steps_per_contact is not None:  # first without the tangential force, refined below
         e_damp = _compensated_e(e, kn, m_eff, tc, steps_per_contact, model, wall, r_eff, speed)
     if mu is not None:
         b0 = default_beta0(e) if beta0 is None else beta0
@@ -363,6 +363,12 @@ def make_contact(*, kn: float, e: float, m_eff: float, K: float, beta: float | N
         if steps_per_contact is not None:
             kt = _compensated_kt(beta, kn, e_damp, m_eff, K, tc, steps_per_contact, model,
                                  wall, r_eff, speed)
+    if steps_per_contact is not None and tangential != "none":
+        e_damp = _compensated_e(e, kn, m_eff, tc, steps_per_contact, model, wall, r_eff, speed,
+                                (K, kt, xt, mu, mindlin))
+        if tangential == "spring":
+            kt = _compensated_kt(beta, kn, e_damp, m_eff, K, tc, steps_per_contact, model,
+                                 wall, r_eff, speed)
     return ContactParameters(model, kn, e, kt, mu, tangential, m_eff, tc,  # type: ignore[arg-type]
                              xt, mindlin, steps_per_contact, e_damp)
 
@@ -373,13 +379,17 @@ def _radius(wall: bool, r_eff: float | None) -> float:
 
 
 def _compensated_e(e: float, kn: float, m_eff: float, tc: float, steps: float, model: Model,
-                   wall: bool, r_eff: float | None, speed: float | None) -> float:
-    """``discrete.damping_restitution`` for this contact's geometry."""
+                   wall: bool, r_eff: float | None, speed: float | None,
+                   tangential: tuple = (0.4, 0.0, 0.0, None, False)) -> float:
+    """``discrete.damping_restitution`` for this contact's geometry and tangential law
+    ``(K, k_t, x_t, mu, mindlin)`` (default: none)."""
     if not steps > 0:
         raise ValueError(f"steps_per_contact must be positive, not {steps}")
+    K, kt, xt, mu, mindlin = tangential
     return discrete.damping_restitution(float(e), float(kn), float(m_eff), tc, float(steps),
                                         model, wall, _radius(wall, r_eff),
-                                        1.0 if speed is None else float(speed))
+                                        1.0 if speed is None else float(speed), float(K),
+                                        float(kt), float(xt), mu, bool(mindlin))
 
 
 def _compensated_kt(beta: float, kn: float, e: float, m_eff: float, K: float, tc: float,
