@@ -210,7 +210,8 @@ def _calibrate_rows(engine: str, args: argparse.Namespace, sizes: list[float]) -
         beta=args.beta if args.beta is not None or args.mu is not None else 0.5,
         mu=args.mu, beta0=args.beta0, K=args.K, kn=args.kn, model=args.model,
         steps_per_contact=args.steps, speeds=args.speeds, angles=args.angles,
-        sizes=(sizes[0], sizes[-1]), spin=args.spin, alpha=args.alpha, v0=args.speeds[0])
+        sizes=(sizes[0], sizes[-1]), spin=args.spin, alpha=args.alpha, v0=args.speeds[0],
+        phases=args.phases)
 
 
 def _numbers(option: str, text: str) -> list[float]:
@@ -419,7 +420,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="Walton's sticking restitution (default: e, as in scenes)")
     p.add_argument("--K", type=float, default=None, help="reduced inertia (default disc/sphere)")
     p.add_argument("--kn", type=float, default=1e5)
-    p.add_argument("--steps", type=float, default=200.0, help="steps per contact")
+    p.add_argument("--steps", type=float, default=200.0,
+                   help="steps per contact (an uncapped spring's k_t is compensated for it)")
+    p.add_argument("--phases", type=int, default=None,
+                   help="impact: average each collision over this many impact phases "
+                        "(default 1: first overlap half a step in)")
     p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0, 2.0],
                    help="impact speeds |g| (sliding: the launch speed)")
     p.add_argument("--angles", type=float, nargs="+", default=[0.0, 30.0, 60.0],

@@ -200,18 +200,32 @@ def contact_setup(scene: Scene, engine: str = "soft contacts",
         kn = choose_stiffness(scene, e, 0.5, engine)
     if soft.hardness is not None and soft.hardness.impact_speed is not None:
         speed = max(speed, soft.hardness.impact_speed)  # Hertz t_c shrinks with speed
+    dt = mapping.timestep(shortest_contact_time(scene, kn, speed), scene.soft.steps_per_contact)
     extra = {"r_eff": 0.25, "speed": speed} if model == "hertz" else {}
+    # each contact's k_t is compensated for its own steps per contact (t_c / dt: a wall's
+    # contact, m_eff = m, lasts √2 × longer than a pair's)
     pair = mapping.make_contact(kn=kn, e=e, m_eff=0.5, K=K, model=model,
                                 **_rule(scene.contact.tangential, engine, e, model, "contact"),
+                                steps_per_contact=_steps(model, kn, e, 0.5, 0.25, speed, dt),
                                 **extra)
-    walls = {w.side: _wall_contact(w, kn, K, model, speed, engine) for w in scene.walls}
-    dt = mapping.timestep(shortest_contact_time(scene, kn, speed), scene.soft.steps_per_contact)
+    walls = {w.side: _wall_contact(w, kn, K, model, speed, engine, dt) for w in scene.walls}
     shown = speed if basis in ("pilot", "estimate") else math.nan
     return ContactSetup(pair, walls, dt, kn, basis, shown, pilot)
 
 
-def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float, engine: str):
+def _steps(model: str, kn: float, e: float, m_eff: float, r_eff: float, speed: float,
+           dt: float) -> float:
+    """Steps per contact t_c / dt of one contact (Hertz: at the design speed)."""
+    if model == "hertz":
+        return mapping.hertz_contact(kn, e, m_eff, r_eff, speed).contact_time / dt
+    return mapping.hooke_contact(kn, e, m_eff).contact_time / dt
+
+
+def _wall_contact(wall: Wall, kn: float, K: float, model: str, speed: float, engine: str,
+                  dt: float):
     extra = {"r_eff": 0.5, "speed": speed} if model == "hertz" else {}
     return mapping.make_contact(kn=kn, e=wall.restitution, m_eff=1.0, K=K, model=model,
                                 **_rule(wall.tangential, engine, wall.restitution, model, "walls"),
-                                **extra)
+                                steps_per_contact=_steps(model, kn, wall.restitution, 1.0, 0.5,
+                                                         speed, dt),
+                                wall=True, **extra)

@@ -24,6 +24,7 @@ from typing import Literal
 import numpy as np
 
 from ...contact.calibration import CollisionRow, MotionRow
+from ...contact.discrete import DiscreteContact, mean_restitution
 from ...contact.mapping import (
     ContactParameters,
     Model,
@@ -161,12 +162,18 @@ def _normal_targets(params: ContactParameters, r_eff: float, vn: float) -> tuple
     return h.contact_time, h.peak_force
 
 
-def _beta_target(params: ContactParameters, K: float, tc: float, ratio: float) -> float:
-    """The hard rule the contact stands for, at |g_t|/|g_n| = ratio (NaN head-on)."""
+def _beta_target(params: ContactParameters, K: float, tc: float, ratio: float,
+                 speed: float, wall: bool, r_eff: float) -> float:
+    """The hard rule the contact stands for, at |g_t|/|g_n| = ratio (NaN head-on): a spring
+    compensated for its steps per contact restitutes, averaged over impact phases, what the
+    discrete model says (the requested beta at the matched speed)."""
     if ratio == 0.0:
         return math.nan
     if params.tangential == "none":
         return -1.0
+    if params.tangential == "spring" and params.steps_per_contact is not None:
+        c = DiscreteContact.of(params, K, wall, r_eff if wall else 2.0 * r_eff)
+        return mean_restitution(c, params.contact_time, params.steps_per_contact, speed)[1]
     b0 = spring_beta(params.kt, K, params.m_eff, tc)
     if params.tangential == "spring":
         return b0
@@ -180,7 +187,7 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
               kn: float = 1e5, steps_per_contact: float = 200,
               speeds: Sequence[float] = (1.0,), angles: Sequence[float] = (0.0, 30.0, 60.0),
               model: Model = "hooke", sizes: Sequence[float] = (1.0, 1.0),
-              spin: float = 0.0) -> list[CollisionRow]:
+              spin: float = 0.0, phases: int = 1) -> list[CollisionRow]:
     """Map (e, beta | mu, beta0) to LAMMPS parameters, then measure them in binary collisions.
 
     ``K`` defaults to the LAMMPS body (disc 1/2 in 2D, sphere 2/5 in 3D); another value is
@@ -190,6 +197,10 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
     the contact point's |g_t| / |g_n| (spin included). Targets: e the input; t_c and the peak
     normal force of the damped Hooke oscillator / Hertz ODE at the normal speed.
     ``sizes``: the two diameters (a wall collision uses the first); masses ∝ d^dim.
+    An uncapped spring's k_t is compensated for ``steps_per_contact`` (LAMMPS's discrete
+    update, ``contact.discrete``), as in scenes. ``phases``: 1 measures each collision with
+    its first overlap half a step after a step; n > 1 averages e, beta, t_c, spin and peak
+    force over n impact phases (bin midpoints), as the collisions of a flow do.
     """
     k_body = inertia_factor(dim)
     if K is not None and abs(K - k_body) > 1e-12:
@@ -197,6 +208,8 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
                                   f" have K = {k_body}")
     if kind not in ("pair", "wall"):
         raise UnsupportedByEngine("lammps", "kind", kind, "use 'pair' or 'wall'")
+    if not (isinstance(phases, int) and 1 <= phases <= 256):
+        raise UnsupportedByEngine("lammps", "phases", phases, "a whole number from 1 to 256")
     if len(sizes) != 2 or min(sizes) <= 0.0:
         raise UnsupportedByEngine("lammps", "sizes", tuple(sizes), "two positive diameters")
     r0, r1 = 0.5 * sizes[0], 0.5 * sizes[1]
@@ -205,19 +218,25 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
     r_eff = r0 if kind == "wall" else pair_radius(r0, r1)
     v_ref = max(speeds)
     params = make_contact(kn=kn, e=e, m_eff=m_eff, K=k_body, beta=beta, mu=mu, beta0=beta0,
-                          model=model, r_eff=r_eff, speed=v_ref)
+                          model=model, r_eff=r_eff, speed=v_ref,
+                          steps_per_contact=steps_per_contact, wall=kind == "wall")
     dt = params.timestep(steps_per_contact)
+    offsets = [0.5] if phases == 1 else [(i + 0.5) / phases for i in range(phases)]
     rows = []
     for speed in speeds:
         for angle in angles:
-            hit = impact(dim, kind, params, speed, angle, dt, sizes=sizes, spin=spin)
+            hits = [impact(dim, kind, params, speed, angle, dt, sizes=sizes, spin=spin,
+                           phase=ph) for ph in offsets]
+            e_m, b_m, tc_m, spin_m, peak_m = (float(np.mean([getattr(h, k) for h in hits]))
+                                              for k in ("e", "beta", "contact_time",
+                                                        "spin_after", "peak_force"))
             th = math.radians(angle)
             vn = speed * math.cos(th)
             tc, f_max = _normal_targets(params, r_eff, vn)
             ratio = abs(speed * math.sin(th) + r0 * spin) / vn  # contact point: g + R W x
-            rows.append(CollisionRow(dim, kind, model, angle, speed, hit.e, hit.beta,
-                                     hit.contact_time, e, _beta_target(params, k_body, tc, ratio),
-                                     tc, hit.spin_after, hit.peak_force, f_max, spin))
+            target = _beta_target(params, k_body, tc, ratio, speed, kind == "wall", r_eff)
+            rows.append(CollisionRow(dim, kind, model, angle, speed, e_m, b_m, tc_m, e, target,
+                                     tc, spin_m, peak_m, f_max, spin))
     return rows
 
 
@@ -233,6 +252,9 @@ def calibrate_case(case: Case = "impact", **settings) -> list[CollisionRow] | li
         return calibrate(**settings)
     if case not in ("rolling", "sliding"):
         raise UnsupportedByEngine("lammps", "case", case, "use impact, rolling or sliding")
+    if settings.get("phases") is not None:
+        raise UnsupportedByEngine("lammps", "phases", settings["phases"],
+                                  "impact phases are averaged only in --case impact")
     inert = {"kind": "wall", "model": "hooke", "sizes": (1.0, 1.0), "spin": 0.0}
     for key, ok in inert.items():
         if key in settings and settings[key] is not None and _differs(settings[key], ok):

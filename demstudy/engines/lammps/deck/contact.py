@@ -18,7 +18,7 @@ UNCAPPED_MU = 1e20
 
 def granular_args(p: ContactParameters) -> str:
     """Model string after ``pair_coeff * *`` or after ``fix ID group wall/gran granular``."""
-    normal = f"{p.model} {p.kn:.12g} {p.restitution:.12g} damping coeff_restitution"
+    normal = f"{p.model} {p.kn:.12g} {p.lammps_e:.12g} damping coeff_restitution"
     if p.tangential == "none":
         return f"{normal} tangential linear_nohistory 0.0 0.0"
     mu = UNCAPPED_MU if p.mu is None else p.mu
@@ -43,6 +43,10 @@ def pair_block(scene: Scene, setup: ContactSetup) -> Block:
         f"{p.model} contacts, k_n = {p.kn:.6g}, e = {p.restitution:g}, "
         f"t_c = {p.contact_time:.6g} (m_eff = m/2)"
         + ("" if p.tangential == "none" else f", k_t = {p.kt:.6g}, {p.tangential} tangential")
+        + ("" if p.steps_per_contact is None else
+           f"\ncompensated for {p.steps_per_contact:.4g} steps per contact (LAMMPS's discrete "
+           f"update restitutes the targets, docs/contact.md): damping e = {p.lammps_e:.6g}"
+           + (", k_t" if p.tangential == "spring" else ""))
         + f"\n{setup.note()}"
     )
     return Block("contact", comment, cmds)
