@@ -27,6 +27,8 @@ from demstudy.io.results import read_results
 from demstudy.scene import validate_scene
 from demstudy.simulation import RunOptions, run_scene
 
+ROOT = Path(__file__).resolve().parent.parent
+
 
 @pytest.fixture(autouse=True)
 def cache_home(tmp_path, monkeypatch):
@@ -181,16 +183,89 @@ def test_the_particles_file_is_part_of_the_cache_key(tmp_path):
 
 
 def test_initial_floor_sees_particles_fired_at_each_other():
-    """Approaching neighbours count with their normal approach speed; receding ones do not;
-    a wall's speed is a floor."""
+    """Approaching neighbours count with their normal approach speed, receding ones do not; a
+    wall's own velocity slides along x and is no impact speed (it was: the floor of a
+    Couette cell was the wall speed); a particle moving towards a wall is."""
     scene = validate_scene({"dimension": 2, "box": {"size": [10.0, 10.0]},
                             "particles": {"count": 2}, "contact": {"restitution": 0.9},
                             "walls": [{"side": "lower", "restitution": 0.9},
-                                      {"side": "upper", "restitution": 0.9, "velocity": 0.5}],
+                                      {"side": "upper", "restitution": 0.9, "velocity": 5.0}],
                             "initial": {"placement": "random"},
                             "run": {"equilibration": 0.0, "production": 1.0,
                                     "sample_interval": 0.5}})
     pos = np.array([[2.0, 5.0], [4.0, 5.0]])
     approach = np.array([[1.5, 0.0], [-1.5, 0.0]])
     assert pilot_mod.initial_floor(scene, pos, approach) == pytest.approx(3.0)
-    assert pilot_mod.initial_floor(scene, pos, -approach) == pytest.approx(0.5)
+    assert pilot_mod.initial_floor(scene, pos, -approach) == 0.0
+    falling = np.array([[0.0, -2.0], [0.0, 0.0]])
+    assert pilot_mod.initial_floor(scene, pos, falling) == pytest.approx(2.0)
+
+
+def test_initial_floor_is_a_quantile_not_the_largest_pair():
+    """2000 isolated pairs closing at 1 and one at 100: the floor is the pairs'
+    DESIGN_QUANTILE (1), not the one outlier, whose weight shrinks with N."""
+    scene = validate_scene({"dimension": 2, "box": {"size": [20000.0, 10.0]},
+                            "particles": {"count": 2}, "contact": {"restitution": 0.9},
+                            "initial": {"placement": "random"},
+                            "run": {"equilibration": 0.0, "production": 1.0,
+                                    "sample_interval": 0.5}})
+    n = 2001
+    pos = np.zeros((2 * n, 2))
+    pos[0::2, 0] = 10.0 * np.arange(n)
+    pos[1::2, 0] = 10.0 * np.arange(n) + 2.0
+    vel = np.zeros((2 * n, 2))
+    vel[0::2, 0], vel[1::2, 0] = 0.5, -0.5
+    vel[0, 0], vel[1, 0] = 50.0, -50.0
+    speeds = np.r_[100.0, np.ones(n - 1)]
+    assert pilot_mod.initial_floor(scene, pos, vel) == pytest.approx(
+        np.quantile(speeds, DESIGN_QUANTILE))
+    assert pilot_mod.initial_floor(scene, pos, vel) < 2.0
+
+
+def test_couette_floor_leaves_out_the_wall_speed():
+    """Campbell's rough Couette cell with automatic stiffness: the impacts are slow against
+    the wall speed U = 1 (relative speeds ~ γ̇ d), so the design speed, hence k_n, comes from
+    the measured impacts and the initial approach speeds, not from U (before: floor 1,
+    k_n ~ 50 × stiffer than needed)."""
+    import tomllib
+
+    data = tomllib.loads((ROOT / "inputs/campbell1982/couette-rough.toml").read_text())
+    del data["soft"]["hardness"]
+    data["run"].update(equilibration=0.0, production=200.0)
+    scene = validate_scene(data)
+    wall_speed = max(abs(w.velocity) for w in scene.walls)
+    pilot = run_pilot(scene)
+    assert pilot.usable and pilot.floor < 0.5 * wall_speed
+    setup = contact_setup(scene, "lammps", pilot)
+    measured = max(pilot.pair[f"q{DESIGN_QUANTILE:g}"], pilot.wall[f"q{DESIGN_QUANTILE:g}"],
+                   pilot.floor)
+    assert setup.basis == "pilot" and setup.speed == pytest.approx(measured)
+    assert setup.speed < 0.5 * wall_speed
+
+
+def test_capped_pilots_are_cached_apart(tmp_path, monkeypatch):
+    """A pilot cut by a smaller wall-time cap or collision window (plan.py runs one with
+    seconds = min(5, 0.1 × forecast)) is not returned for an uncapped call: seconds and
+    collisions are part of the cache key."""
+    scene = head_on(tmp_path)
+    calls = []
+    measure = pilot_mod._measure
+
+    def counting(*args, **kwargs):
+        calls.append(args[1:])
+        return measure(*args, **kwargs)
+
+    monkeypatch.setattr(pilot_mod, "_measure", counting)
+    paths = {pilot_mod.pilot_cache_path(scene), pilot_mod.pilot_cache_path(scene, seconds=0.5),
+             pilot_mod.pilot_cache_path(scene, collisions=5.0)}
+    assert len(paths) == 3
+    run_pilot(scene, seconds=0.5)
+    run_pilot(scene)
+    run_pilot(scene, collisions=5.0)
+    assert calls == [(0.5, pilot_mod.PILOT_COLLISIONS),
+                     (pilot_mod.PILOT_SECONDS, pilot_mod.PILOT_COLLISIONS),
+                     (pilot_mod.PILOT_SECONDS, 5.0)]
+    run_pilot(scene, seconds=0.5)  # each from its own cache now
+    run_pilot(scene)
+    assert len(calls) == 3
+    assert all(p.is_file() for p in paths)

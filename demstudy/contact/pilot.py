@@ -11,12 +11,14 @@ with every collision logged, in windows of ``PILOT_COLLISIONS`` pair collisions 
 particle, until two successive windows agree after ``MIN_TIME`` (the start-up transient is
 over: ``SETTLED``), the scene's own duration (equilibration + production), ``MAX_WINDOWS``
 windows or ``PILOT_SECONDS`` of wall time; the last window is the measurement. It adds the
-initial state's own impacts as a floor (the largest approach speed of neighbouring particles
-and the walls' speeds), so particles fired at each other are seen even when the pilot stops
-first. Results are cached by the scene's TOML (and its particles file) in
-``pilot_cache_dir()``. Where the event-driven engine refuses the scene (soft-only features)
-the result is unusable (``usable`` False, ``reason`` says why) and the stiffness falls back
-to :func:`demstudy.contact.stiffness.reference_speed` with a warning.
+initial state's own impacts as a floor (the DESIGN_QUANTILE of the normal approach speeds of
+approaching neighbours and of particles towards a wall; a wall's own speed is tangential and
+does not count), so particles fired at each other are seen even when the pilot stops first.
+Results are cached by the scene's TOML (and its particles file), the pilot's caps
+(``seconds``, ``collisions``) and version in ``demstudy.cache.cache_dir()``/pilot. Where
+the event-driven engine refuses the scene (soft-only features) the result is unusable
+(``usable`` False, ``reason`` says why) and the stiffness falls back to
+:func:`demstudy.contact.stiffness.reference_speed` with a warning.
 """
 
 from __future__ import annotations
@@ -25,7 +27,6 @@ import dataclasses
 import hashlib
 import json
 import math
-import os
 import tempfile
 import time
 import warnings
@@ -34,10 +35,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..cache import cache_dir
+from ..io.results import write_atomically
 from ..scene import Scene, scene_to_toml
 
 __all__ = ["PILOT_COLLISIONS", "PILOT_SECONDS", "PilotResult", "PilotWarning",
-           "cache_dir", "initial_floor", "pilot_cache_path", "run_pilot"]
+           "initial_floor", "pilot_cache_path", "run_pilot", "store_pilot"]
 
 #: collisions per particle in one measuring window ...
 PILOT_COLLISIONS = 20.0
@@ -57,7 +60,7 @@ SETTLED = 0.25
 MIN_TIME = 1.0
 #: at most this many windows (the wall-time cap usually comes first in large scenes)
 MAX_WINDOWS = 200
-PILOT_VERSION = 2  # part of the cache key: a changed pilot measures again
+PILOT_VERSION = 3  # part of the cache key: a changed pilot measures again
 
 
 class PilotWarning(UserWarning):
@@ -69,9 +72,10 @@ class PilotResult:
     """What the pilot measured (speeds in d/τ, rate in impacts per particle per τ).
 
     ``pair`` / ``wall``: normal impact speed quantiles {"q0.5", "q0.99", "q0.999", "max"}
-    (empty when none was seen); ``floor``: the initial state's largest approach speed (and
-    wall speeds); ``rate``: non-resting impacts per particle per τ (pair impacts count for
-    both partners), 0 when none; ``usable`` False with ``reason`` when the pilot could not run.
+    (empty when none was seen); ``floor``: the initial state's approach speeds' design
+    quantile (:func:`initial_floor`); ``rate``: non-resting impacts per particle per τ (pair
+    impacts count for both partners), 0 when none; ``usable`` False with ``reason`` when
+    the pilot could not run.
     """
 
     usable: bool
@@ -119,45 +123,53 @@ class PilotResult:
 
 
 # -- cache ----------------------------------------------------------------------------------
-def cache_dir() -> Path:
-    """demstudy's cache folder: $XDG_CACHE_HOME/demstudy (default ~/.cache/demstudy)."""
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "demstudy"
-
-
-def pilot_cache_path(scene: Scene) -> Path:
+def pilot_cache_path(scene: Scene, seconds: float = PILOT_SECONDS,
+                     collisions: float = PILOT_COLLISIONS) -> Path:
     """The cache file of ``scene``'s pilot: keyed by its TOML, its particles file's content
-    (placement = 'file') and the pilot's caps and version."""
+    (placement = 'file'), the pilot's caps (``seconds``, ``collisions``: a pilot cut short by
+    a smaller wall-time cap is not the answer to an uncapped call) and its version."""
     key = hashlib.sha256(scene_to_toml(scene).encode())
-    key.update(f"{PILOT_VERSION} {PILOT_COLLISIONS} {PILOT_SECONDS} {RESTING_FRACTION}".encode())
+    key.update(f"{PILOT_VERSION} {collisions!r} {seconds!r} {RESTING_FRACTION}".encode())
     if scene.initial.placement == "file":
         key.update(Path(scene.initial.path).read_bytes())
     return cache_dir() / "pilot" / f"{key.hexdigest()[:24]}.json"
 
 
-def _store(path: Path, result: PilotResult) -> None:
+def store_pilot(path: Path, result: PilotResult) -> None:
+    """``result`` to the cache file ``path``, atomically (a concurrent reader sees the old
+    file or the new one)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as f:
-        f.write(result.to_json())
-    os.replace(f.name, path)  # atomic: a concurrent reader sees the old file or the new
+    write_atomically(path, result.to_json().encode())
 
 
 # -- the initial state's own impacts --------------------------------------------------------
 def initial_floor(scene: Scene, position: np.ndarray, velocity: np.ndarray) -> float:
-    """The largest normal approach speed of neighbouring particles (centres within 3 d) in the
-    initial state, the largest speed of a particle towards a wall, and the walls' speeds."""
+    """The initial state's own impact speed: the larger of the DESIGN_QUANTILE of the normal
+    approach speeds over approaching neighbour pairs (centres within 3 d; with two particles,
+    their one pair) and of the speeds of particles moving towards a wall. A quantile, not the
+    maximum: the maximum over N particles grows with N. A wall's own ``velocity`` slides
+    along x and brings nothing closer; a servo wall's normal motion is slow and not known up
+    front (left out)."""
     from scipy.spatial import cKDTree
 
-    speeds = [abs(w.velocity) for w in scene.walls] + [0.0]
+    from .stiffness import DESIGN_QUANTILE  # one place for the targets
+
+    floors = [0.0]
     if scene.walls:
-        speeds.append(float(np.abs(velocity[:, 1]).max(initial=0.0)))
+        sides = {w.side for w in scene.walls}
+        towards = np.zeros(len(velocity))
+        if "lower" in sides:
+            towards = np.maximum(towards, -velocity[:, 1])
+        if "upper" in sides:
+            towards = np.maximum(towards, velocity[:, 1])
+        floors.append(_quantile(towards[towards > 0], DESIGN_QUANTILE))
     pairs = cKDTree(position).query_pairs(3.0, output_type="ndarray")
     if len(pairs):
         branch = position[pairs[:, 1]] - position[pairs[:, 0]]
         relative = velocity[pairs[:, 0]] - velocity[pairs[:, 1]]
         approach = np.einsum("ij,ij->i", relative, branch) / np.linalg.norm(branch, axis=1)
-        speeds.append(float(approach.max()))
-    return max(speeds)
+        floors.append(_quantile(approach[approach > 0], DESIGN_QUANTILE))
+    return max(floors)
 
 
 # -- the run --------------------------------------------------------------------------------
@@ -166,7 +178,7 @@ def run_pilot(scene: Scene, *, cache: bool = True, seconds: float = PILOT_SECOND
     """The pilot of ``scene`` (from the cache when it ran before, unless ``cache`` is False).
     Warns (``PilotWarning``) and returns an unusable result when the event-driven engine
     cannot run the scene."""
-    path = pilot_cache_path(scene)
+    path = pilot_cache_path(scene, seconds, collisions)
     if cache and path.is_file():
         try:
             return PilotResult.from_json(path.read_text())
@@ -179,7 +191,7 @@ def run_pilot(scene: Scene, *, cache: bool = True, seconds: float = PILOT_SECOND
                       "'estimate'); give soft.stiffness or soft.hardness to choose it",
                       PilotWarning, stacklevel=2)
     if cache:
-        _store(path, result)
+        store_pilot(path, result)
     return result
 
 

@@ -137,9 +137,7 @@ def choose_stiffness(scene: Scene, e: float, m_eff: float,
                                           "k* = k/(ρ d³ γ̇²) needs a shear rate ([shear])")
             return mapping.kn_from_kstar(h.k_star, scene.shear.rate, 1.0, scene.dimension)
         return mapping.kn_from_kappa(h.kappa, h.pressure, scene.dimension)
-    if soft.model == "hertz":
-        return mapping.hertz_kn_for_overlap(overlap, speed, m_eff, 0.25, e)
-    return mapping.hooke_kn_for_overlap(overlap, speed, m_eff, e)
+    return _kn_for_overlap(soft.model, overlap, speed, m_eff, 0.25, e)
 
 
 def shortest_contact_time(scene: Scene, kn: float, speed: float) -> float:
@@ -156,6 +154,8 @@ def shortest_contact_time(scene: Scene, kn: float, speed: float) -> float:
 
 def _kn_for_overlap(model: str, overlap: float, speed: float, m_eff: float, r_eff: float,
                     e: float) -> float:
+    """k_n whose largest overlap at the impact ``speed`` is ``overlap`` (Hertz: for contact
+    radius ``r_eff``; Hooke needs none)."""
     if model == "hertz":
         return mapping.hertz_kn_for_overlap(overlap, speed, m_eff, r_eff, e)
     return mapping.hooke_kn_for_overlap(overlap, speed, m_eff, e)
