@@ -129,6 +129,29 @@ def test_head_on_collision_overlap_and_impact_speed(tmp_path, model):
     assert not any(p.startswith("persistent") for p in attrs["problems"])
 
 
+def test_health_uses_the_runs_own_contacts_when_the_pilot_chose_them(tmp_path, monkeypatch):
+    """Automatic stiffness (no soft.stiffness, no soft.hardness): the pilot sees the impact at
+    v = 1 and sets k_n; the health group's contact time and steps per contact are those of the
+    run (its attrs, the scene's steps_per_contact), not of the guessed reference speed
+    (1e-3 for file velocities: a contact ~10³ × longer)."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # the pilot's cache
+    start = tmp_path / "pair.txt"
+    start.write_text("3.0 5.0 5.0 0.5 0 0\n4.2 5.0 5.0 -0.5 0 0\n")
+    scene = validate_scene({
+        "dimension": 3, "box": {"size": [10.0, 10.0, 10.0]}, "particles": {"count": 2},
+        "contact": {"restitution": 0.9}, "initial": {"placement": "file", "path": str(start)},
+        "run": {"equilibration": 0.0, "production": 0.4, "sample_interval": 0.01},
+        "soft": {"steps_per_contact": 40}})
+    res = run(scene, tmp_path)
+    attrs = res.group_attrs["health"]
+    assert res.attrs["stiffness_basis"] == "pilot"
+    assert attrs["contact_time"] == pytest.approx(res.attrs["contact_time"], rel=1e-12)
+    assert attrs["steps_per_contact"] == pytest.approx(scene.soft.steps_per_contact)
+    assert attrs["timestep"] == res.attrs["timestep"]
+    guessed = contact_setup(scene).pair.contact_time
+    assert attrs["contact_time"] < guessed / 100
+
+
 def gas(n: int, phi: float, stiffness: float, production: float = 6.0):
     """Elastic smooth discs at T = 1 (no cooling: e = 1), sampled every 0.05."""
     length = math.sqrt(n * math.pi / 4 / phi)

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..scene import Scene
 from . import mapping
-from .stiffness import contact_setup
+from .stiffness import ContactSetup
 
 __all__ = ["LIMITS", "SAMPLE_KEYS", "assess", "contact_sample", "health_results",
            "impact_speeds", "shear_rate_of", "warning_text"]
@@ -150,11 +150,11 @@ def _enskog_flight_time(scene: Scene, profiles: Mapping[str, Any] | None) -> flo
     return 1.0 / mean if mean > 0 else None
 
 
-def _contact_times(scene: Scene, speeds: np.ndarray) -> tuple[float, float, float, float]:
-    """(pair t_c, wall t_c, shortest pair t_c, longest pair t_c) of the scene's contact model:
-    Hooke's are speed-independent; Hertz's at the median, largest and smallest measured
-    impact speeds."""
-    setup = contact_setup(scene)
+def _contact_times(scene: Scene, setup: ContactSetup,
+                   speeds: np.ndarray) -> tuple[float, float, float, float]:
+    """(pair t_c, wall t_c, shortest pair t_c, longest pair t_c) of the run's own contacts
+    (``setup``: its k_n, which a pilot may have chosen): Hooke's are speed-independent;
+    Hertz's at the median, largest and smallest measured impact speeds."""
     e = scene.contact.restitution
     wall_e = [w.restitution for w in scene.walls] or [e]
     if scene.soft.model != "hertz":
@@ -204,18 +204,21 @@ def assess(values: Mapping[str, Any], limits: Mapping[str, float] = LIMITS) -> l
     return problems
 
 
-def health_results(scene: Scene, timestep: float, samples: Mapping[str, list],
+def health_results(scene: Scene, setup: ContactSetup, samples: Mapping[str, list],
                    profiles: Mapping[str, Any] | None = None) -> tuple[dict, dict]:
     """The ``health`` group of a soft-contact run: per-sample arrays (``samples``: lists per
     :data:`SAMPLE_KEYS` plus ``time``, production samples only) and the scalar attributes
-    (names in docs/results-format.md), with the verdict ``healthy``/``problems``."""
+    (names in docs/results-format.md), with the verdict ``healthy``/``problems``.
+    ``setup``: the contacts the run used (the backend's ``contact``: k_n and dt as the pilot
+    chose them, not as a fresh ``contact_setup(scene)`` would guess)."""
+    timestep = setup.timestep
     data = {k: np.asarray(v, dtype=float) for k, v in samples.items()}
     count = data["contacts"]
     with np.errstate(invalid="ignore"):
         mean_overlap = (float(np.nansum(data["mean_overlap"] * count) / count.sum())
                         if count.sum() else 0.0)
     tc, tc_wall, tc_fast, tc_slow = _contact_times(
-        scene, np.concatenate([data["min_impact_speed"], data["median_impact_speed"],
+        scene, setup, np.concatenate([data["min_impact_speed"], data["median_impact_speed"],
                                data["max_impact_speed"]]))
     n_mobile = max(1, scene.n_particles)  # bumps are not particles
     z_pair = float(np.mean(2 * data["pair_contacts"])) / n_mobile

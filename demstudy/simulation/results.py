@@ -61,7 +61,7 @@ def run_results(sim: Any, state: RunState, extra: dict[str, Any]) -> Results:
             sim, state, results, equilibration_end)
     if state.health:  # soft contacts: how far from the hard-particle limit
         results.groups["health"], results.group_attrs["health"] = health_results(
-            scene, backend.time_step, state.health, profiles.results)
+            scene, backend.contact, state.health, profiles.results)
     if state.log:
         results.groups["collisions"] = {k: np.concatenate(v) for k, v in state.log.items()}
         results.group_attrs["collisions"] = {
