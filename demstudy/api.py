@@ -47,7 +47,9 @@ def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
     ``dry_run``: run nothing and write nothing; return the run's plan as a dict: engine, N,
     the soft contacts (``kn``, ``timestep``, ``contact_time``, ``steps_per_contact``,
     ``stiffness_basis``), the pilot's impact speeds and collision rate, and the wall-time
-    forecast (``forecast_seconds``, ``forecast_basis``), as ``demstudy run --dry-run``."""
+    forecast (``forecast_seconds``, ``forecast_basis``, ``forecast_factor``; without this
+    machine's measured speed, which a dry run never measures, ``forecast`` says why there is
+    none), as ``demstudy run --dry-run``."""
     from .engines import DEFAULT_ENGINE, get_backend
     from .simulation import RunOptions, check_run, plan_run, run_scene
 

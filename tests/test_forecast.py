@@ -118,10 +118,83 @@ def test_costs_are_cached_per_cpu_and_remeasured_on_demand(monkeypatch):
     assert len(calls) == 3
 
 
-def test_forecast_line_says_the_uncertainty_and_basis():
+def test_forecast_line_says_the_measured_accuracy_and_basis():
+    """The printed band is the one measured constant (ACCURACY), not a ±30 % goal."""
     f = fc.Forecast(12.0, "N × steps")
-    assert f.line() == "forecast: 12 s (±30 %) from N × steps"
+    assert f.line().startswith("forecast: 12 s (measured accuracy: within ×")
+    assert f"×{fc.ACCURACY['factor']:g} in {fc.ACCURACY['met']})" in f.line()
+    assert "±" not in f.line() and f.line().endswith("from N × steps")
     assert f.attrs()["forecast_seconds"] == 12.0 and f.attrs()["forecast_basis"] == "N × steps"
+    assert f.attrs()["forecast_factor"] == fc.ACCURACY["factor"]
+
+
+def fake_benchmark(monkeypatch, capsys=None) -> list:
+    """Replace the benchmark (no timing): each call records the stderr printed before it."""
+    calls = []
+
+    def bench(engine, dim, model):
+        calls.append(capsys.readouterr().err if capsys else "")
+        return ((SOFT_COSTS if engine == "lammps" else
+                 {"event": 1e-6, "atom_sample": 1e-7, "sample": 1e-4}), "fake")
+
+    monkeypatch.setattr(fc, "_benchmark", bench)
+    monkeypatch.setenv(fc.MEASURE_ENV, "1")  # measuring allowed: only a dry run refrains
+    return calls
+
+
+def test_dry_run_never_measures_the_machine(tmp_path, monkeypatch, capsys):
+    """`demstudy run --dry-run` and ds.run(dry_run=True) with no cached speed: no benchmark,
+    no rates file; the plan says there is no forecast and why."""
+    calls = fake_benchmark(monkeypatch)
+    scene = tmp_path / "gas.toml"
+    scene.write_text(scene_to_toml(gas(stiffness=1e4)))
+    assert main(["run", str(scene), "--engine", "lammps", "--out", str(tmp_path / "r.h5"),
+                 "--dry-run"]) == 0
+    out = capsys.readouterr()
+    assert ("forecast: none (this machine's speed is not measured yet: demstudy forecast)"
+            in out.out)
+    assert "measuring" not in out.err
+    plan = ds.run(gas(stiffness=1e4), engine="lammps", out=tmp_path / "r.h5", dry_run=True)
+    assert "forecast_seconds" not in plan and "not measured yet" in plan["forecast"]
+    assert not calls and not fc.rates_path().exists()
+
+
+def test_a_run_says_it_measures_before_measuring(tmp_path, monkeypatch, capsys):
+    """A real run's plan measures the missing speed once, after one line on stderr naming
+    the cache file; the next plan reads the cache silently."""
+    from demstudy.simulation import RunOptions, plan_run
+
+    calls = fake_benchmark(monkeypatch, capsys)
+    backend = get_backend("lammps")
+    options = RunOptions(out=tmp_path / "r.h5", progress=False)
+    plan = plan_run(gas(stiffness=1e4), backend, options)
+    assert len(calls) == 1 and plan.forecast is not None
+    assert calls[0].strip() == ("measuring this machine's speed once for the forecasts (~10 s; "
+                                f"cached in {fc.rates_path()})")
+    capsys.readouterr()
+    plan_run(gas(stiffness=1e4), backend, options)
+    assert len(calls) == 1 and "measuring" not in capsys.readouterr().err
+
+
+def test_rates_are_updated_under_a_lock(monkeypatch):
+    """_store_rate waits for the lock a parallel worker holds (its read-modify-write would
+    otherwise drop the other's entry), then adds its key next to the existing ones."""
+    import threading
+
+    from demstudy.cache import locked
+
+    fc._store_rate("edmd-2d", {"model": fc.COST_MODEL, "costs": {"event": 1.0}})
+    writer = threading.Thread(target=fc._store_rate,
+                              args=("edmd-3d", {"model": fc.COST_MODEL, "costs": {}}))
+    with locked(fc.rates_path()):
+        writer.start()
+        writer.join(0.3)
+        assert writer.is_alive()  # blocked on the lock
+        assert "edmd-3d" not in fc.load_rates()
+    writer.join()
+    assert set(fc.load_rates()) == {"edmd-2d", "edmd-3d"}
+    assert [p.name for p in fc.rates_path().parent.iterdir()
+            if ".tmp" in p.name] == []  # written atomically, nothing left behind
 
 
 def fake_costs(monkeypatch):

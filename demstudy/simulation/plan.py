@@ -56,7 +56,14 @@ class RunPlan:
                        collision_rate=self.pilot.rate, tau_flight=self.pilot.tau_flight)
         if self.forecast is not None:
             out.update(self.forecast.attrs())
+        else:
+            out["forecast"] = self._no_forecast()
         return out
+
+    def _no_forecast(self) -> str:
+        if self.engine in FORECAST_ENGINES:
+            return "none (this machine's speed is not measured yet: demstudy forecast)"
+        return f"none for the {self.engine} engine"
 
     def describe(self) -> str:
         lines = [f"engine: {self.engine}, {self.n_particles} particles"]
@@ -69,13 +76,8 @@ class RunPlan:
                 lines.append(f"design impact speed: {s.speed:.4g}")
         if self.pilot is not None:
             lines.append(f"pilot: {self.pilot.summary()}")
-        if self.forecast is not None:
-            lines.append(self.forecast.line())
-        elif self.engine in FORECAST_ENGINES:
-            lines.append("forecast: none (this machine's speed is not measured yet: "
-                         "demstudy forecast)")
-        else:
-            lines.append(f"forecast: none for the {self.engine} engine")
+        lines.append(self.forecast.line() if self.forecast is not None
+                     else f"forecast: {self._no_forecast()}")
         return "\n".join(lines)
 
 
@@ -93,8 +95,9 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
              costs: dict[str, float] | None = None, dry_run: bool = False) -> RunPlan:
     """The pilot (cached), the soft contacts and the forecast of ``scene`` in ``backend``
     (a backend class); ``costs`` override the machine's measured ones
-    (:func:`demstudy.simulation.forecast.measure_costs`). A forecast that
-    cannot be made (the benchmark failed) is a warning, never a refused run."""
+    (:func:`demstudy.simulation.forecast.measure_costs`; a run measures them once when not
+    cached, announcing it on stderr; a ``dry_run`` never measures: no forecast then). A
+    forecast that cannot be made (the benchmark failed) is a warning, never a refused run."""
     pilot = options.pilot
     if pilot is None and needs_pilot(scene, backend, dry_run):
         pilot = run_pilot(scene)
@@ -105,7 +108,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
     if backend.name in FORECAST_ENGINES:
         try:
             forecast = forecast_run(scene, backend, setup.timestep if setup else None,
-                                    pilot, costs)
+                                    pilot, costs, measure=not dry_run)
         except RatesNotMeasured:
             pass  # said by describe(): no forecast
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
@@ -116,7 +119,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
         # a long event-driven run: a pilot of ≤ 10 % of it measures the real collision rate
         pilot = run_pilot(scene, seconds=min(PILOT_SECONDS, 0.1 * forecast.seconds))
         try:
-            forecast = forecast_run(scene, backend, None, pilot, costs)
+            forecast = forecast_run(scene, backend, None, pilot, costs, measure=not dry_run)
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     n = scene.n_particles
