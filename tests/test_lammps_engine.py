@@ -394,3 +394,52 @@ def test_atoms_outside_the_box_are_an_engine_error(tmp_path):
             session.create_atoms(atoms, np.zeros((2, 7)))
     finally:
         session.close()
+
+
+def test_resume_keeps_the_checkpoints_automatic_contacts(tmp_path, monkeypatch):
+    """Automatic stiffness (the pilot chooses k_n and dt), interrupted, then resumed where the
+    pilot's cache is gone and a new measurement would differ (another node): the resume
+    continues with the checkpoint's own pilot, k_n and dt unchanged; a run handed another
+    pilot is refused, naming both k_n values and the remedy."""
+    import dataclasses
+    import pickle
+    import shutil
+
+    from demstudy.contact import pilot as pilot_mod
+    from demstudy.contact.stiffness import contact_setup
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    scene = validate_scene({
+        "dimension": 2, "box": {"size": [10.0, 10.0]}, "particles": {"count": 20},
+        "contact": {"restitution": 0.9},
+        "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+        "run": {"equilibration": 0.0, "production": 1.0, "sample_interval": 0.25,
+                "checkpoint_interval": 0.25, "seed": 4},
+        "soft": {"steps_per_contact": 20}})
+    run_interrupted(scene, tmp_path, "r.h5", monkeypatch, 0.3)
+    saved = pickle.loads((tmp_path / "r.lammps" / "checkpoint.pkl").read_bytes())
+    contact = saved["backend"]["contact"]
+    assert contact["stiffness_basis"] == "pilot"
+    expected = contact_setup(scene, "lammps", pilot_mod.run_pilot(scene))
+    assert contact["kn"] == expected.kn and contact["timestep"] == expected.timestep
+
+    shutil.rmtree(tmp_path / "cache")
+    measure = pilot_mod._measure
+    measured = []
+
+    def faster(*args, **kwargs):  # another node's pilot: impacts twice as fast
+        measured.append(1)
+        p = measure(*args, **kwargs)
+        return dataclasses.replace(p, pair={k: 2 * v for k, v in p.pair.items()},
+                                   floor=2 * p.floor)
+
+    monkeypatch.setattr(pilot_mod, "_measure", faster)
+    other = pilot_mod.run_pilot(scene, cache=False)
+    assert contact_setup(scene, "lammps", other).kn > 2 * expected.kn
+    with pytest.raises(EngineError, match=rf"k_n = {expected.kn:.9g}.*soft\.stiffness"):
+        run(scene, tmp_path, "r.h5", resume=True, pilot=other)
+    measured.clear()
+    res = run(scene, tmp_path, "r.h5", resume=True)
+    assert not measured  # the checkpoint's pilot, not a new measurement
+    assert res.attrs["kn"] == expected.kn and res.attrs["timestep"] == expected.timestep
+    assert res.timeseries["time"][-1] == pytest.approx(1.0, abs=expected.timestep)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ..scene import Scene
+from .checkpoint import CHECKPOINT, saved_pilot
 from .loop import Simulation
 from .options import RunOptions, check_run, check_run_options, work_folder
 from .plan import RunPlan, plan_run
@@ -34,6 +35,10 @@ def run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
     from .isolation import in_worker, launch_child
 
     backend = get_backend(engine) if isinstance(engine, str) else engine
+    if options.resume and options.pilot is None and not in_worker():
+        # continue with the checkpoint's own pilot (its k_n and dt), not a new measurement
+        saved = saved_pilot(work_folder(Path(options.out).resolve(), backend.name) / CHECKPOINT)
+        options = dataclasses.replace(options, pilot=saved)
     if options.plan and not in_worker():
         check_run(backend, scene, options)  # refused before the pilot runs
         plan = plan_run(scene, backend, options)

@@ -12,6 +12,7 @@ import pickle
 from pathlib import Path
 from typing import Any
 
+from ..contact.pilot import PilotResult
 from ..errors import EngineError
 from ..io.results import write_atomically
 from ..scene import Scene, scene_to_toml
@@ -52,6 +53,19 @@ def load_checkpoint(path: Path, scene: Scene, keys: set[str], version: str,
         raise EngineError("--resume: the checkpoint belongs to a different scene ("
                           f"{scene_difference(saved['scene'], scene)})")
     return saved
+
+
+def saved_pilot(path: Path) -> PilotResult | None:
+    """The pilot a soft-contact run's checkpoint at ``path`` chose its k_n and dt with
+    (``get_state()["contact"]["pilot"]``), for ``--resume`` to continue with the same
+    contacts even where the pilot's cache is gone; None when there is none (or no readable
+    checkpoint: :func:`load_checkpoint` then says why)."""
+    try:
+        with open(path, "rb") as fh:
+            text = pickle.load(fh)["backend"]["contact"]["pilot"]
+        return PilotResult.from_json(text)
+    except Exception:  # noqa: BLE001 - no checkpoint, no pilot, another format
+        return None
 
 
 def scene_difference(saved_toml: str, scene: Scene, most: int = 3) -> str:

@@ -15,6 +15,7 @@ uninterrupted one to round-off.
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 from pathlib import Path
@@ -85,7 +86,7 @@ class LammpsBackend(BackendBase):
     #: False: the deck's data file is written and read (``read_data``), as ``lmp -in``
     #: would; the tests compare the two set-ups
     state_from_memory = True
-    version = f"demstudy {__version__} (lammps checkpoint 4)"
+    version = f"demstudy {__version__} (lammps checkpoint 5)"  # 5: contact settings
 
     @classmethod
     def check(cls, scene: Scene, options) -> None:
@@ -158,6 +159,7 @@ class LammpsBackend(BackendBase):
         (workdir / "deck.in").write_text(self.deck.render(scene.meta.name))
         restart = None
         if saved is not None:
+            self._same_contacts(saved["contact"])
             dump = str(self.dump) if self.dump else None
             if saved["dump"] != dump:
                 raise EngineError(f"--resume: the run started with --dump {saved['dump']}, "
@@ -187,6 +189,23 @@ class LammpsBackend(BackendBase):
         if self.dump is not None and self.rank == 0 and self.dump.exists():
             os.truncate(self.dump, saved["dump_size"])  # drop frames after the checkpoint
         self._set_up_again(saved["forces"])
+
+    def _same_contacts(self, saved: dict) -> None:
+        """Refuse to continue a checkpoint whose k_n or dt differ from this run's beyond
+        round-off (the pilot measured again, e.g. its cache gone on another node: the run
+        would change its contacts halfway). ``run_scene`` normally passes the checkpoint's
+        own pilot (``checkpoint.saved_pilot``), so this is a safety net."""
+        now = self.contact
+        if all(math.isclose(saved[k], v, rel_tol=1e-9)
+               for k, v in (("kn", now.kn), ("timestep", now.timestep))):
+            return
+        remedy = ("give soft.stiffness (a new run), or restore the pilot's cache "
+                  "($XDG_CACHE_HOME/demstudy/pilot) and resume without passing a pilot")
+        raise EngineError(
+            f"--resume: the checkpoint ran with k_n = {saved['kn']:.9g}, dt = "
+            f"{saved['timestep']:.9g} (stiffness_basis = {saved['stiffness_basis']}), this "
+            f"run has k_n = {now.kn:.9g}, dt = {now.timestep:.9g} ({now.basis}): continuing "
+            f"would change the contacts mid-run; {remedy}")
 
     def _issue_deck(self, restart: Path | None,
                     rows: tuple[np.ndarray, np.ndarray] | None = None) -> None:
@@ -419,7 +438,9 @@ class LammpsBackend(BackendBase):
             self._set_up_again(forces)
         return {"restart": restart.name, "forces": forces, "step": self.step,
                 "impulse": self.wall_impulse(), "edges": self.edges,
-                "dump": str(self.dump) if self.dump else None, "dump_size": dump_size}
+                "dump": str(self.dump) if self.dump else None, "dump_size": dump_size,
+                # k_n, dt, basis and the pilot: a resume continues with the same contacts
+                "contact": self.contact.attrs()}
 
     def cleanup(self, keep: dict | None) -> None:
         if self.rank != 0:
