@@ -52,11 +52,13 @@ from pathlib import Path
 from typing import Any
 
 from ..contact import mapping
+from ..contact.stiffness import TARGET_CONTACT_RATIO
 from ..errors import BadOption
 
-#: t_c / τ_flight that keeps profile errors within the target (2 %); a placeholder until the
-#: accuracy ladders measure it: a parameter of the map (``ratio``)
-R_DEFAULT = 0.05
+#: t_c / τ_flight that keeps profile errors within the target (2 %), from the accuracy
+#: ladders (docs/accuracy-cost.md: 2.4 % at 0.018, 8.6 % at 0.05 in Malik's Poiseuille);
+#: the same as the automatic settings' target (``contact.stiffness.TARGET_CONTACT_RATIO``)
+R_DEFAULT = TARGET_CONTACT_RATIO
 #: soft time steps per contact time
 STEPS_PER_CONTACT = 50.0
 #: the grid of the map (issue 12, item 7)
