@@ -4,8 +4,9 @@ flow, with what each step closer costs.
 The flow: Campbell's (1982) Couette cell of rough inelastic discs at ν ≈ 0.55 (10 × 10 discs,
 his rough walls, fixed gap: inputs/accuracy-cost/couette-rough-nu0.55.toml). The job
 
-1. prints the forecast of every run it is about to make (this machine's measured speed;
-   measured first if it never was, ~20 s),
+1. prints the forecast of every run it is about to make and of the whole ladder on its
+   workers (`ds.cost` does, first: demstudy.accuracy.forecast; this machine's measured
+   speed, measured first if it never was, ~20 s),
 2. runs the event-driven reference and a ladder of soft LAMMPS runs over stiffness
    k* = k_n/(m U_T²/d) and steps per contact (`demstudy cost`, resumable, both cores),
 3. overlays the reference and the stiffest soft run with their difference per bin
@@ -27,29 +28,11 @@ import sys
 from pathlib import Path
 
 import demstudy as ds
-from demstudy.accuracy.plan import scene_for, soft_ladder
 from demstudy.accuracy.report import table
-from demstudy.engines import get_backend
-from demstudy.simulation import RunOptions, plan_run
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENE = ROOT / "inputs" / "accuracy-cost" / "couette-rough-nu0.55.toml"
 KSTARS, STEPS = (1e2, 1e3, 1e4), (10, 50)
-
-
-def forecast(scene) -> float:
-    """Print and sum the forecast wall time of the reference and of every soft run."""
-    total = 0.0
-    runs = [("reference (edmd)", scene, "edmd")]
-    runs += [(spec.name, scene_for(scene, spec), "lammps")
-             for spec in soft_ladder(KSTARS, STEPS, ["hooke"])]
-    for label, sc, engine in runs:
-        plan = plan_run(sc, get_backend(engine), RunOptions(out=Path("unused.h5")),
-                        dry_run=True)
-        seconds = plan.forecast.seconds if plan.forecast else float("nan")
-        total += seconds
-        print(f"  {label:24s} {plan.forecast.line() if plan.forecast else 'no forecast'}")
-    return total
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -62,12 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     scene = ds.load_scene(SCENE, args.set)
     print(f"scene: {SCENE.relative_to(ROOT)} ({scene.n_particles} discs, "
           f"{scene.run.equilibration:g} + {scene.run.production:g} d/U_T)")
-    print("forecast (this machine's measured speed, ±30 %):")
-    total = forecast(scene)
     workers = args.workers or 2
-    print(f"  in all: {total:.0f} s of runs, about {total / workers:.0f} s on {workers} "
-          "workers\n")
-
     folder = args.out / "cross-check"
     study = ds.cost(scene, kstars=KSTARS, steps=STEPS, models=["hooke"], workers=workers,
                     out=folder)

@@ -36,9 +36,11 @@ def ladder(out: Path, args: argparse.Namespace, workers: int) -> tuple[float, fl
                  steps=[float(s) for s in args.steps.split(",")], models=["hooke"])
     total = time.perf_counter() - t0
     t = study.timings
-    print(f"{workers} worker(s): total {total:.2f} s = running {t.get('ladder', 0):.2f} s "
-          f"(tasks as the workers saw them: {t.get('runs', 0):.2f} s) + analysis and "
-          f"outputs {t.get('analysis', 0):.2f} s + setup")
+    print(f"{workers} worker(s): total {total:.2f} s = forecast {t.get('forecast', 0):.2f} s "
+          f"(the pilot and the machine's speed: cached after the first ladder) + running "
+          f"{t.get('ladder', 0):.2f} s (tasks as the workers saw them: "
+          f"{t.get('runs', 0):.2f} s) + analysis and outputs {t.get('analysis', 0):.2f} s + "
+          "setup")
     return total, sum(r["wall_seconds"] for r in study.rows), len(study.rows)
 
 

@@ -137,6 +137,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from .comparison import compare, plot_comparison
     from .errors import NotComparable
 
+    if args.out != "none":
+        _check_figure_file("-o/--out", args.out)
     fields = [f.strip() for f in args.fields.split(",") if f.strip()] if args.fields else None
     # A,B,C: replicas of one run (other seeds), combined before the comparison
     groups = [[p for p in arg.split(",") if p.strip()] for arg in args.results]
@@ -154,6 +156,18 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     if args.out != "none":
         print(f"figure: {plot_comparison(comparisons, args.out, fields)}")
     return 0
+
+
+def _check_figure_file(option: str, path: str) -> None:
+    """A figure file matplotlib can write (by its extension), checked before computing."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    from .errors import BadOption
+
+    kinds = FigureCanvasBase.get_supported_filetypes()
+    if Path(path).suffix.lower().lstrip(".") not in kinds:
+        raise BadOption(option, path, "a figure file ending in ."
+                        + ", .".join(sorted(kinds)) + " (or none: no figure) is allowed")
 
 
 def _cmd_forecast(args: argparse.Namespace) -> int:
@@ -177,6 +191,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     from .errors import UnsupportedByEngine
 
     engine = args.engine
+    _check_calibrate(args)
     if args.beta0 is not None and args.mu is None:
         raise UnsupportedByEngine(engine, "--beta0", args.beta0, "beta0 is Walton's sticking "
                                   "restitution: it needs Coulomb friction, --mu")
@@ -200,6 +215,30 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     if why and args.case == "impact":
         print(f"note: scenes refuse this rule for soft engines: {why}")
     return 0
+
+
+def _check_calibrate(args: argparse.Namespace) -> None:
+    """Values no calibration case can use: exit 2 naming the option, before anything runs."""
+    from .errors import BadOption
+
+    if not 0.0 < args.e <= 1.0:
+        raise BadOption("--e", args.e, "a normal restitution in (0, 1] is allowed")
+    if args.mu is not None and not args.mu >= 0.0:
+        raise BadOption("--mu", args.mu, "a friction coefficient >= 0 is allowed")
+    if not args.steps >= 1.0:
+        raise BadOption("--steps", args.steps, "steps per contact >= 1 are allowed")
+    if not args.kn > 0.0:
+        raise BadOption("--kn", args.kn, "a normal stiffness > 0 is allowed")
+    bad = [v for v in args.speeds if not v > 0.0]
+    if bad:
+        raise BadOption("--speeds", bad, "impact speeds > 0 are allowed")
+    if args.sizes is not None and len(args.sizes) != 2 and (args.kind != "wall"
+                                                            or len(args.sizes) != 1):
+        raise BadOption("--sizes", args.sizes, "two diameters (a wall collision: one) are "
+                        "allowed")
+    if args.case == "rolling" and not 0.0 < args.alpha < 90.0:
+        raise BadOption("--alpha", args.alpha, "an incline angle in (0, 90) degrees is "
+                        "allowed")
 
 
 def _calibrate_rows(engine: str, args: argparse.Namespace, sizes: list[float]) -> list:
@@ -234,17 +273,19 @@ def _whole(option: str, text: str | None) -> int | None:
 
 def _cmd_cost(args: argparse.Namespace) -> int:
     from .accuracy.report import text_report
-    from .accuracy.study import DEFAULT_KSTARS, DEFAULT_MODELS, DEFAULT_STEPS, cost
+    from .accuracy.study import cost
 
     study = cost(args.scene, overrides=args.set, quick=args.quick, tolerance=args.tolerance,
-                 kstars=_numbers("--kstar", args.kstar) if args.kstar else DEFAULT_KSTARS,
-                 steps=_numbers("--steps", args.steps) if args.steps else DEFAULT_STEPS,
+                 kstars=_numbers("--kstar", args.kstar) if args.kstar else None,
+                 steps=_numbers("--steps", args.steps) if args.steps else None,
                  models=([m.strip() for m in args.models.split(",") if m.strip()]
-                         if args.models else DEFAULT_MODELS),
+                         if args.models else None),
                  workers=args.workers, dask=args.dask, out=args.out,
                  replicas=_whole("--replicas", args.replicas),
-                 reference_replicas=_whole("--reference-replicas", args.reference_replicas))
-    print(text_report(study))
+                 reference_replicas=_whole("--reference-replicas", args.reference_replicas),
+                 dry_run=args.dry_run)
+    if not args.dry_run:
+        print(text_report(study))
     return 0
 
 
@@ -450,7 +491,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tolerance", type=float, default=0.02,
                    help="relative profile error to meet (default 0.02)")
     p.add_argument("--workers", type=int, help="local processes (default: the cores)")
-    p.add_argument("--dask", metavar="ADDRESS", help="run on this Dask scheduler instead")
+    p.add_argument("--dask", metavar="ADDRESS",
+                   help="run on this Dask scheduler instead (tcp://host:port or host:port)")
     p.add_argument("--out", help="ladder folder (default results/cost/<scene>/)")
     p.add_argument("--replicas", default="1", metavar="R",
                    help="make every run R times (seeds seed, seed+1, ...; files -r0, -r1, "
@@ -460,7 +502,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="replicas of the event-driven reference (default: --replicas)")
     p.add_argument("--quick", action="store_true",
                    help="a tiny ladder of short runs (k* 1e2,1e3,1e4, 10 steps/contact, "
-                        "hooke)")
+                        "hooke; not with --kstar, --steps or --models)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print every planned run with its forecast and the total on the "
+                        "workers; run nothing, write nothing")
     p.set_defaults(func=_cmd_cost)
 
     p = sub.add_parser("engine-map",

@@ -16,10 +16,10 @@ standard error √(σ_a² + σ_b²). The
 comparison as a whole fails with the probability of a two-sided ``sigma``-σ event (0.27 % at
 3σ) when the two runs sample the same state: with n compared values each one is held to the
 Šidák-corrected level, so a profile of 40 bins does not fail by chance one time in ten. The
-errors are estimates (jackknife over the profiles' ``n_blocks`` time blocks), so each
-difference is judged against Student's t with the Welch–Satterthwaite degrees of freedom
-(n_blocks − 1 per run), not the normal distribution: with 20 blocks a 3σ-normal test would
-fail several times too often. Bins with nothing to compare are left out and counted: values
+errors are estimates, so each difference is judged against Student's t with the
+Welch–Satterthwaite degrees of freedom (max(1, min(n_blocks, effective_samples) − 1) per
+run), not the normal distribution: with 20 blocks a 3σ-normal test would fail several times
+too often. Bins with nothing to compare are left out and counted: values
 or errors not finite, or both errors zero with equal values (an empty bin: ν = 0 ± 0 in both).
 On failure the ``AssertionError`` carries a table of every disagreeing bin. The errors are
 the profiles' own; they are only as good as the blocking behind them (docs/results-format.md).
@@ -129,7 +129,7 @@ def compare_profiles(a: Results | str | os.PathLike, b: Results | str | os.PathL
         dense = (pa["solid_fraction"] >= min_solid_fraction) & \
                 (pb["solid_fraction"] >= min_solid_fraction)
     y = pa.get("y", 0.5 * (pa["edges"][1:] + pa["edges"][:-1]))
-    # degrees of freedom of each run's errors: jackknife over n_blocks blocks
+    # degrees of freedom of each run's errors (comparison.stats.block_dof)
     dof_a, dof_b = (block_dof(r.profile_attrs) for r in (ra, rb))
     rows, skipped = [], 0
     for name in fields:

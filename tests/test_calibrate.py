@@ -318,6 +318,18 @@ def test_scene_refuses_a_coulomb_rule_the_soft_spring_cannot_follow():
     (["--mu", "0.3", "--beta", "0.5"], 2, "--beta"),
     (["--kind", "wall", "--sizes", "1", "2"], 2, "--sizes"),
     (["--sizes", "1", "-2"], 2, "--sizes"),
+    (["--sizes", "1", "1", "1"], 2, "--sizes"),
+    (["--sizes", "1"], 2, "--sizes"),  # a pair needs two diameters
+    (["--e", "0"], 2, "--e"),
+    (["--e", "1.2"], 2, "--e"),
+    (["--mu", "-0.1"], 2, "--mu"),
+    (["--steps", "0.5"], 2, "--steps"),
+    (["--speeds", "1", "0"], 2, "--speeds"),
+    (["--speeds", "-1"], 2, "--speeds"),
+    (["--kn", "0"], 2, "--kn"),
+    (["--kn=-1e5"], 2, "--kn"),
+    (["--case", "rolling", "--alpha", "0"], 2, "--alpha"),
+    (["--case", "rolling", "--alpha", "90"], 2, "--alpha"),
 ])
 def test_cli_refusals_name_the_option(capsys, argv, code, option):
     assert main(["calibrate", *argv]) == code

@@ -255,3 +255,64 @@ def test_the_command_line(tmp_path, capsys, monkeypatch):
                        (["a.h5"], "at least one other run")):
         assert main(["compare", *argv, "-o", "none"]) == 2, argv
         assert says in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("effective, dof", [(5.0, 4.0), (100.0, 39.0), (None, 39.0)])
+def test_degrees_of_freedom_come_from_the_effective_samples(effective, dof):
+    """A single run's errors rest on min(n_blocks, effective_samples) independent samples:
+    40 blocks but 5 effective samples give 4 degrees of freedom, not 39; each bin's p-value
+    is Student's t on the Welch–Satterthwaite dof of the pair (equal errors: 2 × dof), and
+    the notes say which dof each run got."""
+    from scipy.stats import t as student_t
+
+    rng = np.random.default_rng(3)
+    runs = [synthetic(rng=rng), synthetic(rng=rng, plant={"temperature": 3.0})]
+    for run in runs:
+        if effective is not None:
+            run.profile_attrs["effective_samples"] = effective
+    (cmp,) = ds.compare(*runs)
+    t = cmp.fields["temperature"]
+    assert t.p == pytest.approx(2 * student_t.sf(t.max_z, 2 * dof), rel=1e-9)
+    note = next(n for n in cmp.notes if n.startswith("degrees of freedom"))
+    assert f"reference {dof:g} (40 blocks" in note and f"other {dof:g}" in note
+
+
+def test_replica_means_keep_r_minus_one_degrees_of_freedom():
+    from demstudy.comparison.stats import block_dof
+
+    assert block_dof({"n_blocks": 3, "error_method": "replicas"}) == 2.0
+    assert block_dof({"n_blocks": 40, "effective_samples": 1.5}) == 1.0  # at least 1
+    assert block_dof({}) == math.inf
+
+
+def test_fields_known_to_round_off_are_left_out_and_named():
+    """mean_mass of equal particles: errors ~1e-16 in both runs and equal values is no
+    comparison (rows of noise): left out, one note; a real difference of such a field is
+    kept (and resolved)."""
+    rng = np.random.default_rng(4)
+    runs = [synthetic(rng=rng), synthetic(rng=rng)]
+    for run in runs:
+        run.profiles["mean_mass_err"] = np.full(20, 1.1e-16)
+    (cmp,) = ds.compare(*runs)
+    assert "mean_mass" not in cmp.fields and "exact in both runs: mean_mass" in cmp.notes
+    assert "solid_fraction" in cmp.fields
+    runs[1].profiles["mean_mass"] = runs[1].profiles["mean_mass"] * (1 + 1e-9)
+    (cmp,) = ds.compare(*runs)
+    assert cmp.fields["mean_mass"].resolved
+    assert not any(n.startswith("exact in both") for n in cmp.notes)
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["-o", "figure.xyz"], "-o/--out"),
+    (["-o", "figure"], "-o/--out"),
+    (["--sigma", "0"], "sigma"),
+])
+def test_cli_refuses_bad_values_before_computing(argv, named, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rng = np.random.default_rng(2)
+    for name in ("a", "b"):
+        synthetic(rng=rng, path=tmp_path / f"{name}.h5")
+    assert main(["compare", "a.h5", "b.h5", *argv]) == 2
+    captured = capsys.readouterr()
+    assert named in captured.err and "reference:" not in captured.out  # nothing computed
+    assert not list(tmp_path.glob("figure*"))

@@ -42,13 +42,18 @@ def test_fit_without_floor_is_exact_on_an_exact_law():
 
 
 def test_tolerance_picks_the_cheapest_qualifying_run():
-    rows = [{"name": "a", "error": 0.05, "wall_seconds": 1.0},   # too inaccurate
-            {"name": "b", "error": 0.015, "wall_seconds": 9.0},
-            {"name": "c", "error": 0.019, "wall_seconds": 4.0},  # cheapest meeting 0.02
-            {"name": "d", "error": 0.0, "wall_seconds": 30.0},
-            {"name": "e", "error": math.nan, "wall_seconds": 0.1}]  # no error: never chosen
+    """A run meets the tolerance when its error AND its noise floor are within it: a run
+    whose floor exceeds the tolerance cannot tell, however small its debiased error."""
+    rows = [{"name": "a", "error": 0.05, "floor": 0.01, "wall_seconds": 1.0},  # inaccurate
+            {"name": "b", "error": 0.015, "floor": 0.01, "wall_seconds": 9.0},
+            {"name": "c", "error": 0.019, "floor": 0.01, "wall_seconds": 4.0},  # cheapest
+            {"name": "d", "error": 0.0, "floor": 0.005, "wall_seconds": 30.0},
+            {"name": "f", "error": 0.0, "floor": 0.03, "wall_seconds": 2.0},  # too noisy
+            {"name": "e", "error": math.nan, "floor": 0.0, "wall_seconds": 0.1}]  # no error
     assert pick_cheapest(rows, 0.02)["name"] == "c"
     assert pick_cheapest(rows, 0.01)["name"] == "d"
+    assert pick_cheapest(rows, 0.03)["name"] == "f"
+    assert pick_cheapest([{**rows[2], "floor": math.nan}], 0.02) is None  # floor unknown
     assert pick_cheapest(rows[:1], 0.02) is None
     with pytest.raises(ValueError, match="tolerance"):
         pick_cheapest(rows, 0.0)
@@ -88,6 +93,12 @@ def test_ladder_resumes_and_skips_what_was_done(tmp_path):
     assert second.skipped == ["ref-edmd-tc1e-05"]
     third = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=2, **LADDER)
     assert third.executed == [] and set(third.skipped) == names
+    # the forecast lists done runs as reused, not forecast
+    lines: list[str] = []
+    dry = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=2, dry_run=True,
+                  **{**LADDER, "progress": lines.append})
+    assert {n for n, phase, _, _ in dry.forecast.runs if phase == "reused"} == names
+    assert "0 run(s) to make, 3 reused" in lines[-1] and dry.executed == []
     # other settings of the scene (a longer run) are not mistaken for done ones
     longer = ds.cost("shear/lees-edwards-2d", overrides=[*TINY, "run.production=2.5"],
                      out=out, workers=1, **{**LADDER, "kstars": [1e2]})
@@ -171,6 +182,15 @@ def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
 
 @pytest.mark.parametrize("argv, named", [
     (["--set", "soft.stiffnes=3"], "stiffnes"),
+    (["--dask", "notanaddress"], "--dask"),
+    (["--dask", "tcp://host:port"], "--dask"),
+    (["--dask", "tcp://127.0.0.1:1"], "--dask"),  # no scheduler there: refused, named
+    (["--workers", "0"], "--workers"),
+    (["--workers", "-3"], "--workers"),
+    (["--quick", "--kstar", "1e3"], "--kstar"),
+    (["--quick", "--models", "hooke"], "--quick"),
+    (["--out", "FILE"], "--out"),
+    (["--out", "FILE/ladder"], "--out"),
     (["--kstar", "1e3,-1e4"], "--kstar"),
     (["--kstar", "1e3,abc"], "--kstar"),
     (["--steps", "5"], "--steps"),
@@ -182,10 +202,103 @@ def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
     (["--replicas", "2", "--reference-replicas", "0"], "--reference-replicas"),
 ])
 def test_cli_refuses_bad_input_naming_the_option(argv, named, capsys, tmp_path):
-    code = main(["cost", "shear/lees-edwards-2d", "--out", str(tmp_path), *argv])
+    (tmp_path / "FILE").write_text("not a folder")
+    argv = [str(tmp_path / a) if a.startswith("FILE") else a for a in argv]
+    code = main(["cost", "shear/lees-edwards-2d", "--out", str(tmp_path / "ladder"), *argv])
     assert code == 2
     assert named in capsys.readouterr().err
-    assert not list(tmp_path.glob("*.h5"))  # nothing ran
+    assert not list(tmp_path.rglob("*.h5"))  # nothing ran
+    assert (tmp_path / "FILE").read_text() == "not a folder"
+
+
+FAKE_COSTS = {"step": 2e-6, "atom_step": 1e-7, "contact_step": 1e-7, "atom_sample": 1e-7,
+              "sample": 1e-3, "shear_atom_step": 5e-8, "history_atom_step": 5e-8,
+              "wall_step": 1e-6, "event": 1e-6}
+
+
+def test_dry_run_forecasts_the_whole_ladder_measuring_the_machine_once(tmp_path, monkeypatch,
+                                                                       capsys):
+    """--dry-run: every planned run with its forecast (replicas and the t_c ladder share
+    one), the total and the wall time on the workers (longest first onto the least busy),
+    the machine's costs asked for in this process before anything else; nothing runs,
+    nothing is written."""
+    import demstudy.simulation.forecast as fc
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # the pilot's cache
+    asked: list[tuple] = []
+
+    def fake_costs(engine, dim, model=None, **kw):
+        asked.append((engine, dim, model))
+        return dict(FAKE_COSTS)
+
+    monkeypatch.setattr(fc, "measure_costs", fake_costs)
+    out = tmp_path / "ladder"
+    assert main(["cost", "shear/lees-edwards-2d", "--out", str(out), "--kstar", "1e2,1e3",
+                 "--steps", "10", "--models", "hooke", "--workers", "2", "--replicas", "2",
+                 "--dry-run", *[a for kv in TINY for a in ("--set", kv)]]) == 0
+    printed = capsys.readouterr().out
+    assert not out.exists()  # nothing written
+    assert asked[:2] == [("lammps", 2, "hooke"), ("edmd", 2, None)]  # measured first
+    study = ds.cost("shear/lees-edwards-2d", overrides=TINY, out=out, workers=2, replicas=2,
+                    dry_run=True, **LADDER)
+    runs = {name: (phase, s) for name, phase, s, _ in study.forecast.runs}
+    assert len(runs) == (3 + 2) * 2 and all(name in printed for name in runs)
+    assert runs["soft-hooke-k1e+3-s10-r0"][1] > runs["soft-hooke-k100-s10-r0"][1] > 0
+    assert runs["soft-hooke-k100-s10-r1"] == runs["soft-hooke-k100-s10-r0"]
+    assert runs["ref-edmd-tc1e-06-r0"][0] == "tc-ladder?"  # decided by the reference
+    ref = [s for phase, s in runs.values() if phase == "reference"]
+    soft = [s for phase, s in runs.values() if phase == "soft"]
+    assert study.forecast.total == pytest.approx(sum(ref) + sum(soft))
+    # two workers: each phase takes at least half its work and at least its longest run
+    wall = study.forecast.wall
+    assert max(sum(ref) / 2, max(ref)) + max(sum(soft) / 2, max(soft)) <= wall + 1e-12
+    assert wall <= study.forecast.total
+    assert f"{wall:.3g} s on 2 worker(s)" in printed and not out.exists()
+
+
+def test_ladder_task_paths_are_absolute(tmp_path, monkeypatch):
+    """A relative --out becomes absolute, so workers in another directory (Dask) write into
+    the ladder folder."""
+    import demstudy.accuracy.study as study_module
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def fake_execute(tasks, *args, **kwargs):
+        seen.extend(tasks)
+        raise Stop
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(study_module, "execute", fake_execute)
+    with pytest.raises(Stop):
+        ds.cost("shear/lees-edwards-2d", overrides=TINY, out="relative/ladder", workers=1,
+                **LADDER)
+    assert seen and all(t.path.is_absolute() for t in seen)
+    assert all(t.path.parent == tmp_path / "relative" / "ladder" for t in seen)
+
+
+def test_a_tc_dominated_reference_says_it_is_not_the_hard_particle_limit(tmp_path):
+    """A reference whose TC model made more than 10 % of its collisions elastic (synthetic
+    attributes) is no hard-particle reference: a note and the recommendation say so; 5 %
+    does not."""
+    from demstudy.accuracy.plan import RunSpec
+    from demstudy.accuracy.study import CostStudy, _assemble
+    from demstudy.io.results import Results, write_results
+
+    scene = ds.load_scene("shear/lees-edwards-2d", TINY)
+    spec = RunSpec("edmd", tc=1e-5)
+    for elastic, says in ((300, True), (50, False)):
+        write_results(tmp_path / f"{spec.name}.h5", Results(
+            {"engine": "edmd", "wall_seconds": 1.0, "events": 4000,
+             "elastic_tc_collisions": elastic},
+            timeseries={"time": np.array([0.0, 3.0]), "collisions": np.array([0, 1000])}))
+        study = CostStudy(tmp_path, "k*", [], {}, 0.02, None, "")
+        _assemble(study, scene, [[spec]], [])
+        note = f"no hard-particle reference: the TC model made {elastic // 10} % of collisions"
+        assert (note in " ".join(study.notes)) is says
+        assert (note in study.recommendation) is says
 
 
 def test_reference_tc_ladder_keeps_the_largest_tc_when_the_tc_model_never_acts(tmp_path):

@@ -8,8 +8,10 @@ module gives the relative L2 difference rel_l2_f, its noise floor rel_l2_floor_f
 statistical errors alone produce) and the debiased difference
 sqrt(max(rel_l2_f² − rel_l2_floor_f², 0)); the run's error is the worst field's debiased
 difference. The table of every field is ``demstudy compare``'s. A run meets a tolerance X
-when that error ≤ X; when the noise floor of the chosen run (or, with none chosen, of the
-quietest run) exceeds X, the runs are too short to tell, and the recommendation says so.
+when that error ≤ X AND its noise floor (the largest over the counted fields) ≤ X: with a
+floor above X the run cannot tell whether it meets X. When the noise floor of the chosen run
+(or, with none chosen, of the quietest run) exceeds X, the runs are too short to tell, and
+the recommendation says so (lengthen the runs).
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 """
 
@@ -27,7 +29,7 @@ class RunError:
     field: str          # that field
     rel_l2: float       # its rel_l2
     floor: float        # the largest noise floor of all fields
-    resolved: list[str]  # fields whose difference is resolved (max |Δ|/σ > sigma)
+    resolved: list[str]  # fields whose difference is resolved (compare's family test)
 
 
 #: the fields whose error counts (when present in both runs)
@@ -102,13 +104,20 @@ def fit_convergence(x, error, rel_sigma: float = 0.1) -> ConvergenceFit:
                           int(x.size))
 
 
+def meets(row: dict, tolerance: float) -> bool:
+    """Whether a run meets ``tolerance`` (module doc): its ``error`` and its noise ``floor``
+    both ≤ ``tolerance`` (a missing or NaN one: not met)."""
+    error, floor = float(row.get("error", np.nan)), float(row.get("floor", np.nan))
+    return bool(np.isfinite(error) and np.isfinite(floor) and error <= tolerance
+                and floor <= tolerance)
+
+
 def pick_cheapest(rows: list[dict], tolerance: float) -> dict | None:
-    """The cheapest row (``wall_seconds``) whose ``error`` ≤ ``tolerance`` (module doc);
-    None when none does."""
+    """The cheapest row (``wall_seconds``) that :func:`meets` ``tolerance`` (error and noise
+    floor ≤ tolerance, module doc); None when none does."""
     if not tolerance > 0:
         raise ValueError(f"tolerance must be > 0, not {tolerance}")
-    meeting = [r for r in rows if np.isfinite(r.get("error", np.nan))
-               and r["error"] <= tolerance]
+    meeting = [r for r in rows if meets(r, tolerance)]
     return min(meeting, key=lambda r: r["wall_seconds"], default=None)
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .. import UNITS_NOTE
 from ..io.results import write_atomically
-from .analyze import ConvergenceFit
+from .analyze import ConvergenceFit, meets
 
 COLUMNS = ("name", "engine", "model", "kstar", "kn", "steps_per_contact", "tc", "dt", "steps",
            "replicas", "wall_seconds", "error", "field", "rel_l2", "floor", "resolved",
@@ -49,7 +49,7 @@ def table(study) -> str:
 
 
 def _meets(study, row: dict) -> bool | str:
-    return "" if row["engine"] == "edmd" else bool(row["error"] <= study.tolerance)
+    return "" if row["engine"] == "edmd" else meets(row, study.tolerance)
 
 
 def summary(study) -> dict:
@@ -62,6 +62,8 @@ def summary(study) -> dict:
              for row in study.rows]
     return {"units": UNITS_NOTE + "; wall times in seconds", "stiffness": study.scale,
             "error_rule": "worst field's rel_l2 minus its noise floor rel_l2_floor (>= 0)",
+            "tolerance_rule": "meets the tolerance when error <= tolerance and floor <= "
+                              "tolerance",
             "replicas_rule": "a run of R > 1 replicas (seeds seed, seed+1, ...): error of their "
                              "mean with the standard error across them; wall_seconds and "
                              "steps: the SUM over the replicas",

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..io.results import Results, read_results
 from . import analyze
+from .engine_map import TC_IMPRACTICAL
 from .plan import RunSpec
 
 NAN = math.nan
@@ -112,4 +113,26 @@ def choose_reference(folder: Path, refs: list[list[RunSpec]], notes: list[str]
                         "(the smallest t_c: the larger ones differ resolvably)"))
     for i, row in enumerate(rows):
         row["reference"] = i == chosen
+    share = tc_share([_read(folder / f"{spec.name}.h5") for spec in refs[chosen]])
+    rows[chosen]["tc_share"] = share
+    if share > TC_IMPRACTICAL:
+        notes.append(tc_note(share))
     return {**rows[chosen], "results": runs[chosen][1]}, rows
+
+
+def tc_share(runs: list[Results]) -> float:
+    """The share of the pair collisions that the TC model made elastic, over ``runs`` (a
+    reference, or its replicas): attribute ``elastic_tc_collisions`` over the timeseries'
+    ``collisions`` count (both since t = 0); 0 when either is missing."""
+    elastic = sum(int(r.attrs.get("elastic_tc_collisions", 0)) for r in runs)
+    total = 0.0
+    for r in runs:
+        counts = r.timeseries.get("collisions")
+        total += float(counts[-1]) if counts is not None and len(counts) else 0.0
+    return elastic / total if total > 0 else 0.0
+
+
+def tc_note(share: float) -> str:
+    """The note (and recommendation caveat) of a TC-dominated reference."""
+    return (f"no hard-particle reference: the TC model made {100 * share:.0f} % of "
+            "collisions elastic")

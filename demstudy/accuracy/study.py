@@ -23,6 +23,7 @@ from ..errors import BadOption
 from ..scene import Scene, load_scene, scene_to_toml
 from . import analyze
 from .execute import Task, execute, pending
+from .forecast import LadderForecast, ladder_forecast, measure_machine
 from .plan import (
     RunSpec,
     reference_ladder,
@@ -63,17 +64,60 @@ class CostStudy:
     scale_label: str = "$k^*$"
     #: the engine map's line for this scene (nearest grid point), None without a map
     map_hint: str | None = None
-    #: seconds spent: "runs" (executing, as the workers saw it: task_seconds summed),
+    #: seconds spent: "forecast" (measuring the machine if needed, the event-driven pilot,
+    #: the forecasts), "runs" (executing, as the workers saw it: task_seconds summed),
     #: "ladder" (running everything), "analysis" (comparisons, fits, outputs)
     timings: dict[str, float] = field(default_factory=dict)
+    #: the whole ladder's forecast, made before any run (printed first)
+    forecast: LadderForecast | None = None
 
 
-def _check(name: str, values: Sequence[float], low: float = 0.0) -> list[float]:
+def _check(name: str, values: Sequence[float], low: float = 0.0,
+           strict: bool = True) -> list[float]:
+    """Finite numbers > ``low`` (``strict``) or ≥ ``low``."""
     values = [float(v) for v in values]
-    bad = [v for v in values if not (math.isfinite(v) and v > low)]
+    bad = [v for v in values if not (math.isfinite(v) and (v > low if strict else v >= low))]
     if not values or bad:
-        raise BadOption(name, bad or values, f"positive numbers (> {low:g}) are allowed")
+        allowed = (f"positive numbers (> {low:g})" if strict else f"numbers ≥ {low:g}")
+        raise BadOption(name, bad or values, f"{allowed} are allowed")
     return values
+
+
+def check_folder(path: Path) -> Path:
+    """The ladder folder, absolute (pool and Dask workers in another working directory write
+    into it): refused when it, or a folder above it, is an existing file."""
+    path = path.expanduser().resolve()
+    for part in (path, *path.parents):
+        if part.exists() and not part.is_dir():
+            raise BadOption("--out", str(path), f"a folder is allowed; {part} is a file")
+    return path
+
+
+#: seconds to wait for a Dask scheduler before giving up
+DASK_TIMEOUT = 5.0
+
+
+def check_dask_address(address: str) -> str:
+    """A scheduler address ``tcp://host:port`` or ``host:port`` (port 1–65535)."""
+    rest = address[len("tcp://"):] if address.startswith("tcp://") else address
+    host, _, port = rest.rpartition(":")
+    if not (host and "/" not in host and port.isdigit() and 0 < int(port) < 65536):
+        raise BadOption("--dask", address, "a Dask scheduler address tcp://host:port or "
+                        "host:port is allowed")
+    return address
+
+
+def connect(address: str):
+    """A ``distributed.Client`` of the scheduler at ``address``; a scheduler that does not
+    answer within ``DASK_TIMEOUT`` seconds is a BadOption (nothing ran)."""
+    from distributed import Client
+
+    try:
+        return Client(address, timeout=f"{DASK_TIMEOUT:g}s")
+    except (OSError, TimeoutError) as exc:
+        raise BadOption("--dask", address, f"no Dask scheduler answered within "
+                        f"{DASK_TIMEOUT:g} s ({type(exc).__name__}); start one (dask "
+                        "scheduler) or check the address") from None
 
 
 def _count(name: str, value: Any) -> int:
@@ -82,61 +126,62 @@ def _count(name: str, value: Any) -> int:
     return value
 
 
-def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_KSTARS,
-         steps: Sequence[float] = DEFAULT_STEPS, models: Sequence[str] = DEFAULT_MODELS,
+def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = None,
+         steps: Sequence[float] | None = None, models: Sequence[str] | None = None,
          tolerance: float = 0.02, workers: int | None = None, dask: Any = None,
          out: str | os.PathLike | None = None, overrides: Sequence[str] = (),
          quick: bool = False, tc_ladder: bool | None = None, figure: bool = True,
-         replicas: int = 1, reference_replicas: int | None = None,
+         replicas: int = 1, reference_replicas: int | None = None, dry_run: bool = False,
          progress=print) -> CostStudy:
     """Run (or resume) the cost ladder of ``scene`` and write its table, summary and figure
-    into ``out`` (default ``results/cost/<scene name>/``). ``kstars``: dimensionless
-    stiffnesses (``plan.stiffness_scale``), ``steps``: steps per contact (≥ 10), ``models``:
-    hooke and/or hertz; ``workers`` local processes (default: the machine's cores) or
-    ``dask`` (a scheduler address or a ``distributed.Client``). ``quick``: a tiny ladder of
-    short runs. ``tc_ladder``: force (True) or forbid (False) the reference's t_c ladder
-    (default: when its TC model acted). ``replicas``: make every soft run that many times
-    (seeds seed, seed + 1, …; files ``…-r0.h5``, ``…-r1.h5``): errors from the replicas'
-    scatter, cost the sum of their wall times; ``reference_replicas``: the same for the
-    reference (default ``replicas``; the event-driven reference is cheap). ``progress``:
-    called with one line per event."""
+    into ``out`` (default ``results/cost/<scene name>/``, made absolute). ``kstars``:
+    dimensionless stiffnesses (``plan.stiffness_scale``; default 1e3…1e6), ``steps``: steps
+    per contact (≥ 10; default 10, 50, 200), ``models``: hooke and/or hertz (default both);
+    ``workers`` local processes (default: the machine's cores) or ``dask`` (a scheduler
+    address ``tcp://host:port`` or ``host:port``, or a ``distributed.Client``). ``quick``: a
+    tiny ladder of short runs (not with ``kstars``, ``steps`` or ``models``). ``tc_ladder``:
+    force (True) or forbid (False) the reference's t_c ladder (default: when its TC model
+    acted). ``replicas``: make every soft run that many times (seeds seed, seed + 1, …; files
+    ``…-r0.h5``, ``…-r1.h5``): errors from the replicas' scatter, cost the sum of their wall
+    times; ``reference_replicas``: the same for the reference (default ``replicas``; the
+    event-driven reference is cheap). The forecast of the whole ladder (``study.forecast``)
+    is printed first; ``dry_run``: print it and stop (nothing runs, nothing is written).
+    ``progress``: called with one line per event. Bad values raise ``BadOption`` before
+    anything runs."""
     replicas = _count("--replicas", replicas)
     reference_replicas = _count("--reference-replicas", replicas if reference_replicas is None
                                 else reference_replicas)
     if quick:
+        given = [n for n, v in (("--kstar", kstars), ("--steps", steps), ("--models", models))
+                 if v is not None]
+        if given:
+            raise BadOption("--quick", True, f"not together with {', '.join(given)} (--quick "
+                            "sets its own ladder: drop one of them)")
         kstars, steps, models = QUICK["kstars"], QUICK["steps"], QUICK["models"]
-    kstars, steps = _check("--kstar", kstars), _check("--steps", steps, 9.999)
+    kstars = _check("--kstar", DEFAULT_KSTARS if kstars is None else kstars)
+    steps = _check("--steps", DEFAULT_STEPS if steps is None else steps, 10.0, strict=False)
+    models = list(DEFAULT_MODELS if models is None else models)
     if not tolerance > 0:
         raise BadOption("--tolerance", tolerance, "a relative error > 0 is allowed")
     bad = [m for m in models if m not in ("hooke", "hertz")]
     if bad or not models:
         raise BadOption("--models", bad or list(models), "hooke and/or hertz are allowed")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise BadOption("--workers", workers, "a whole number of processes >= 1 is allowed")
+    if isinstance(dask, str | os.PathLike):
+        dask = check_dask_address(str(dask))
     if not isinstance(scene, Scene):
         sections = {"run": QUICK["run"]} if quick else {}
         scene = load_scene(scene, overrides, **sections)
     elif quick:
         scene = scene.model_copy(update={"run": scene.run.model_copy(update=QUICK["run"])})
-    folder = Path(out or Path("results") / "cost" / scene.meta.name)
-    folder.mkdir(parents=True, exist_ok=True)
-    base = scene_to_toml(scene)
+    # absolute: Dask workers (and pool workers) in another directory write into this folder
+    folder = check_folder(Path(out or Path("results") / "cost" / scene.meta.name))
     workers = workers or os.cpu_count() or 1
     scale = stiffness_scale(scene)
     study = CostStudy(folder, scale.definition, [], {}, tolerance, None, "",
                       scale_label=scale.label)
-
-    def run_all(specs: list[RunSpec]) -> None:
-        todo, done = pending(Task(s, base, folder / f"{s.name}.h5") for s in specs)
-        study.skipped += [t.spec.name for t in done]
-        if todo:
-            progress(f"cost: {len(todo)} run(s) to make, {len(done)} reused, "
-                     f"{'dask' if dask is not None else f'{min(workers, len(todo))} worker(s)'}")
-        started = time.perf_counter()
-        records = execute(todo, min(workers, len(todo)) if dask is None else workers, dask,
-                          lambda r: (study.executed.append(r["name"]),
-                                     progress(f"  done {r['name']} ({r['wall_seconds']:.3g} s)")))
-        study.timings["ladder"] = study.timings.get("ladder", 0.0) + time.perf_counter() - started
-        study.timings["runs"] = study.timings.get("runs", 0.0) + sum(
-            r["task_seconds"] for r in records)
 
     from ..engines.edmd.core import DEFAULT_TC
 
@@ -149,15 +194,57 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_
                            f"run (seeds {scene.run.seed}, {scene.run.seed + 1}, …); errors "
                            "from their scatter, cost = the SUM of their wall times")
     refs = [replicate([r], reference_replicas) for r in reference_ladder(DEFAULT_TC)]
-    run_all(refs[0])
-    if tc_ladder or (tc_ladder is None and _tc_active(folder / f"{refs[0][0].name}.h5")):
-        study.notes.append("reference t_c laddered (" + (
-            "asked for)" if tc_ladder else "its TC model acted)"))
-        run_all([s for group in refs[1:] for s in group])
-    else:
-        refs = refs[:1]
-    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, list(models))]
-    run_all([s for group in softs for s in group])
+    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, models)]
+    # an unreachable scheduler is refused before anything runs (a dry run runs nothing)
+    client = connect(dask) if isinstance(dask, str) and not dry_run else dask
+    try:
+        return _study(study, scene, client, dask, refs, softs, tc_ladder, workers, dry_run,
+                      figure, progress)
+    finally:
+        if client is not dask:
+            client.close()
+
+
+def _study(study: CostStudy, scene: Scene, client: Any, dask: Any,
+           refs: list[list[RunSpec]], softs: list[list[RunSpec]], tc_ladder: bool | None,
+           workers: int, dry_run: bool, figure: bool, progress) -> CostStudy:
+    """The forecast, then (unless ``dry_run``) the runs and the outputs of ``cost``."""
+    folder, base = study.folder, scene_to_toml(scene)
+    # the whole ladder's forecast first; the machine measured here, once, before any worker
+    # starts (workers then read it from the cache instead of benchmarking a loaded machine)
+    started = time.perf_counter()
+    phases = {name: pending(Task(s, base, folder / f"{s.name}.h5") for s in specs)
+              for name, specs in (("reference", refs[0]),
+                                  (_tc_phase(folder, refs, tc_ladder),
+                                   [s for g in refs[1:] for s in g]),
+                                  ("soft", [s for g in softs for s in g]))}
+    phases.pop("none", None)
+    study.forecast = ladder_forecast(phases, None if dask is not None else workers,
+                                     measure_machine(scene.dimension, sorted(
+                                         {g[0].model for g in softs})))
+    study.timings["forecast"] = time.perf_counter() - started
+    for line in study.forecast.lines():
+        progress(line)
+    if dry_run:
+        study.recommendation = "dry run: nothing ran"
+        return study
+    folder.mkdir(parents=True, exist_ok=True)
+
+    def run_all(specs: list[RunSpec]) -> None:
+        todo, done = pending(Task(s, base, folder / f"{s.name}.h5") for s in specs)
+        study.skipped += [t.spec.name for t in done]
+        if todo:
+            progress(f"cost: {len(todo)} run(s) to make, {len(done)} reused, "
+                     f"{'dask' if client is not None else f'{min(workers, len(todo))} worker(s)'}")
+        started = time.perf_counter()
+        records = execute(todo, min(workers, len(todo)) if client is None else workers, client,
+                          lambda r: (study.executed.append(r["name"]),
+                                     progress(f"  done {r['name']} ({r['wall_seconds']:.3g} s)")))
+        study.timings["ladder"] = study.timings.get("ladder", 0.0) + time.perf_counter() - started
+        study.timings["runs"] = study.timings.get("runs", 0.0) + sum(
+            r["task_seconds"] for r in records)
+
+    _run_ladder(study, run_all, refs, softs, tc_ladder)
     started = time.perf_counter()
     _assemble(study, scene, refs, softs)
     from .report import write_outputs
@@ -165,6 +252,36 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] = DEFAULT_
     write_outputs(study, figure=figure)
     study.timings["analysis"] = time.perf_counter() - started
     return study
+
+
+def _run_ladder(study: CostStudy, run_all, refs: list[list[RunSpec]],
+                softs: list[list[RunSpec]], tc_ladder: bool | None) -> None:
+    """The reference, its t_c ladder when asked for or when its TC model acted, the soft
+    runs (``refs`` is cut to the references made)."""
+    run_all(refs[0])
+    if tc_ladder or (tc_ladder is None and _tc_active(study.folder / f"{refs[0][0].name}.h5")):
+        study.notes.append("reference t_c laddered (" + (
+            "asked for)" if tc_ladder else "its TC model acted)"))
+        run_all([s for group in refs[1:] for s in group])
+    else:
+        del refs[1:]
+    run_all([s for group in softs for s in group])
+
+
+def _tc_phase(folder: Path, refs: list[list[RunSpec]], tc_ladder: bool | None) -> str:
+    """The forecast's phase of the reference's t_c ladder: "tc-ladder" (it will run),
+    "none" (it will not) or "tc-ladder?" (the reference, not made yet, decides)."""
+    from .forecast import MAYBE
+
+    if tc_ladder is not None:
+        return "tc-ladder" if tc_ladder else "none"
+    done = [folder / f"{s.name}.h5" for s in refs[0]]
+    if not all(p.is_file() for p in done):
+        return MAYBE
+    try:
+        return "tc-ladder" if _tc_active(done[0]) else "none"
+    except Exception:  # noqa: BLE001 - an unreadable file is redone: undecided
+        return MAYBE
 
 
 def _tc_active(path: Path) -> bool:
@@ -183,7 +300,8 @@ def _tc_active(path: Path) -> bool:
 def _assemble(study: CostStudy, scene: Scene, refs: list[list[RunSpec]],
               softs: list[list[RunSpec]]) -> None:
     """The rows: one per run (its replicas combined), reference first."""
-    from .rows import choose_reference, soft_row
+    from .engine_map import TC_IMPRACTICAL
+    from .rows import choose_reference, soft_row, tc_note
 
     reference, ref_rows = choose_reference(study.folder, refs, study.notes)
     study.reference = reference
@@ -196,6 +314,9 @@ def _assemble(study: CostStudy, scene: Scene, refs: list[list[RunSpec]],
              min((r["floor"] for r in rows if math.isfinite(r["floor"])), default=math.nan))
     study.recommendation = analyze.recommend(study.choice, reference["wall_seconds"],
                                              study.tolerance, floor)
+    share = reference.get("tc_share", 0.0)
+    if share > TC_IMPRACTICAL:  # the reference is not the hard-particle limit: say so
+        study.recommendation += f" ({tc_note(share)}; the errors are against it)"
     study.fits = _fits(rows)
     from .map_output import map_hint
 

@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import NotComparable
 from ..io.results import Results, read_results
 from .rebin import common_grid, rebin_profiles, rebin_stress, splits_bins
-from .stats import block_dof, sidak_level, z_test
+from .stats import block_dof, dof_note, sidak_level, z_test
 
 __all__ = ["Comparison", "FieldComparison", "compare", "field_names"]
 
@@ -40,6 +40,9 @@ __all__ = ["Comparison", "FieldComparison", "compare", "field_names"]
 FIRST = ("solid_fraction", "velocity", "temperature", "temperature_components",
          "rotational_temperature", "stress")
 AXES = "xyz"
+#: relative error (and difference) below which a field is known exactly in both runs: its
+#: errors are round-off (the mean mass of equal particles), its rows would be noise
+EXACT = 1e-12
 
 
 @dataclass(frozen=True)
@@ -272,6 +275,21 @@ def _select(requested: Sequence[str] | None, ref: dict, other: dict, labels: tup
 
 
 # -- the comparison ------------------------------------------------------------------------
+def _exact(r: np.ndarray, er: np.ndarray, o: np.ndarray, eo: np.ndarray) -> bool:
+    """Both runs know the field to round-off and agree to it (module constant ``EXACT``):
+    every bin with a finite value has errors ≤ EXACT × |value| in both runs and
+    |Δ| ≤ EXACT × max |value|."""
+    with np.errstate(invalid="ignore"):
+        have = np.isfinite(r) & np.isfinite(o)
+        if not have.any():
+            return False
+        r, er, o, eo = r[have], er[have], o[have], eo[have]
+        scale = np.maximum(np.abs(r), np.abs(o))
+        return bool(np.all(np.abs(er) <= EXACT * np.abs(r))
+                    and np.all(np.abs(eo) <= EXACT * np.abs(o))
+                    and np.all(np.abs(o - r) <= EXACT * scale))
+
+
 def _field(name: str, y: np.ndarray, r: np.ndarray, er: np.ndarray, o: np.ndarray,
            eo: np.ndarray, dense: np.ndarray, dofs: tuple[float, float], sigma: float,
            rebinned: bool, units: str) -> FieldComparison:
@@ -377,12 +395,18 @@ def compare_pair(ref: Results, other: Results, fields: Sequence[str] | None = No
     dense = (phi[0] >= min_solid_fraction) & (phi[1] >= min_solid_fraction) \
         if min_solid_fraction > 0 else np.ones(len(y), bool)
     dofs = (block_dof(ref.profile_attrs), block_dof(other.profile_attrs))
+    notes.append(f"degrees of freedom: reference {dof_note(ref.profile_attrs, dofs[0])}, "
+                 f"other {dof_note(other.profile_attrs, dofs[1])}")
     out: dict[str, FieldComparison] = {}
     skipped: list[str] = []
     empty: list[str] = []
+    exact: list[str] = []
     for name in names:
         r, er, dataset = split[0][name]
         o, eo, _ = split[1][name]
+        if fields is None and _exact(r, er, o, eo):  # round-off errors: rows of noise
+            exact.append(name)
+            continue
         scalar = r.shape == (1,) and len(y) != 1
         fc = _field(name, np.array([np.nan]) if scalar else np.asarray(y, float), r, er, o, eo,
                     np.ones(1, bool) if scalar else dense, dofs, sigma, rebinned,
@@ -395,6 +419,8 @@ def compare_pair(ref: Results, other: Results, fields: Sequence[str] | None = No
             skipped.append(f"{name} {len(fc.y) - fc.n_compared}")
     if empty:
         notes.append(f"no bin with a value and an error in both runs: {', '.join(empty)}")
+    if exact:
+        notes.append(f"exact in both runs: {', '.join(exact)}")
     if skipped:
         why = "empty in both, or without a finite value and error" + \
             (f", or below solid fraction {min_solid_fraction:g}" if min_solid_fraction else "")

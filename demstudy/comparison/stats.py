@@ -2,9 +2,12 @@
 z-scores judged with Student's t and a Šidák-corrected family level.
 
 Each difference is divided by its combined standard error √(σ_a² + σ_b²). The errors are
-estimates (jackknife over ``n_blocks`` time blocks), so the ratio follows Student's t with the
-Welch–Satterthwaite degrees of freedom (n_blocks − 1 per run), not the normal distribution:
-with 20 blocks a 3σ-normal test would fail several times too often. A family of n values
+estimates, so the ratio follows Student's t with the Welch–Satterthwaite degrees of freedom,
+not the normal distribution: with 20 blocks a 3σ-normal test would fail several times too
+often. A single run's errors are its finest blocks' jackknife scaled by a fitted statistical
+inefficiency, so they rest on at most ``effective_samples`` independent samples, not on
+``n_blocks``: dof = max(1, min(n_blocks, effective_samples) − 1) per run. A replica mean
+(``n_blocks`` = R replicas, no ``effective_samples``) has R − 1. A family of n values
 fails with the probability of one two-sided ``sigma``-σ normal event (0.27 % at 3σ) when both
 runs sample the same state: each value is held to 1 − (1 − p)^(1/n) (Šidák).
 Units: whatever the compared quantities carry (dimensionless particle units in demstudy).
@@ -19,7 +22,7 @@ import numpy as np
 from scipy.special import erfc
 from scipy.stats import t as student_t
 
-__all__ = ["block_dof", "sidak_level", "z_test"]
+__all__ = ["block_dof", "dof_note", "sidak_level", "z_test"]
 
 
 def sidak_level(sigma: float, n: int) -> float:
@@ -30,10 +33,27 @@ def sidak_level(sigma: float, n: int) -> float:
 
 
 def block_dof(attrs: dict[str, Any]) -> float:
-    """Degrees of freedom of errors estimated from ``attrs["n_blocks"]`` blocks (jackknife):
-    n_blocks − 1; infinite (errors taken as exact) when the attribute is missing."""
+    """Degrees of freedom of a run's errors (module doc): max(1, min(n_blocks,
+    effective_samples) − 1); n_blocks − 1 without ``effective_samples`` (a replica mean:
+    R − 1); infinite (errors taken as exact) without ``n_blocks``."""
     n = attrs.get("n_blocks")
-    return float(max(1, int(n) - 1)) if n else math.inf
+    if not n:
+        return math.inf
+    samples = float(attrs.get("effective_samples", math.inf))
+    if not math.isfinite(samples) or samples <= 0:
+        samples = math.inf
+    return float(max(1.0, min(float(n), samples) - 1.0))
+
+
+def dof_note(attrs: dict[str, Any], dof: float) -> str:
+    """Where ``dof`` (from :func:`block_dof`) came from, for a comparison's notes."""
+    if not math.isfinite(dof):
+        return "∞ (no n_blocks: errors taken as exact)"
+    samples = attrs.get("effective_samples")
+    basis = f"{int(attrs['n_blocks'])} blocks"
+    if samples is not None and math.isfinite(float(samples)):
+        basis += f", {float(samples):.3g} effective samples"
+    return f"{dof:.3g} ({basis})"
 
 
 def z_test(diff: Any, err_a: Any, err_b: Any, dof_a: float, dof_b: float
