@@ -31,6 +31,16 @@ def test_fit_recovers_a_synthetic_power_law():
     assert abs(fit.p - 0.7) < 3 * fit.p_err  # within its (three-sigma) error
     assert fit.p_err < 0.2  # and the error is informative
     assert abs(fit.floor - 2e-4) < 3 * fit.floor_err + 1e-5
+    assert fit.resolved and "no decay" not in fit.law()
+
+
+def test_a_flat_ladder_resolves_no_decay():
+    """Errors flat within their noise (every run at the noise floor) fit any exponent: the
+    law says that no decay is resolved."""
+    rng = np.random.default_rng(3)
+    k = np.logspace(3, 6, 4)
+    fit = fit_convergence(k, 0.025 * (1 + 0.2 * rng.standard_normal(k.size)))
+    assert not fit.resolved and "no decay resolved" in fit.law()
 
 
 def test_fit_without_floor_is_exact_on_an_exact_law():

@@ -64,10 +64,20 @@ class ConvergenceFit:
     floor_err: float
     n: int
 
+    @property
+    def resolved(self) -> bool:
+        """Whether the data resolve a decay: an exponent at least twice its error (a flat
+        ladder, every run within the noise, fits any exponent: 3e-5 ± 1e8)."""
+        return bool(np.isfinite(self.p) and np.isfinite(self.p_err) and self.p > 0
+                    and self.p_err < 0.5 * self.p)
+
     def law(self, variable: str = "k*") -> str:
         floor = f" + {self.floor:.2g} ± {self.floor_err:.1g}" if self.n >= 4 else ""
-        return (f"error = {self.a:.3g} {variable}^-({self.p:.3g} ± {self.p_err:.2g})"
-                f"{floor} ({self.n} runs)")
+        law = (f"error = {self.a:.3g} {variable}^-({self.p:.3g} ± {self.p_err:.2g})"
+               f"{floor} ({self.n} runs)")
+        if not self.resolved:
+            law += ": no decay resolved (the errors are flat within their noise)"
+        return law
 
 
 def fit_convergence(x, error, rel_sigma: float = 0.1) -> ConvergenceFit:
