@@ -33,9 +33,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--ratio", type=float, default=MapSettings.ratio,
                         help="t_c / tau_flight of the soft runs (default %(default)s)")
+    parser.add_argument("--steps", type=float, default=MapSettings.steps_per_contact,
+                        help="soft steps per contact (default %(default)s)")
     args = parser.parse_args(argv)
     if args.measure:
-        result = engine_map(settings=MapSettings(ratio=args.ratio), workers=args.workers,
+        settings = MapSettings(ratio=args.ratio, steps_per_contact=args.steps)
+        result = engine_map(settings=settings, workers=args.workers,
                             out=ROOT / "results" / "engine-map")
         DATA.mkdir(parents=True, exist_ok=True)
         for path in result.written[:2]:  # csv and json

@@ -81,7 +81,7 @@ def test_tiny_map_end_to_end(tmp_path):
     for row in data["points"]:
         assert row["impractical"] == ""
         assert row["tc"] == pytest.approx(0.05 * row["tau_flight"], rel=1e-9)
-        assert row["dt"] == pytest.approx(row["tc"] / 50, rel=1e-9)
+        assert row["dt"] == pytest.approx(row["tc"] / settings.steps_per_contact, rel=1e-9)
         assert row["soft_steps"] == pytest.approx(row["soft_strain"] / row["dt"], abs=1)
         assert row["repeats"] == 2 and row["log10_ratio_err"] >= 0
         assert row["cost_ratio"] == pytest.approx(10 ** row["log10_ratio"])
