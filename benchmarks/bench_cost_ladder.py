@@ -1,7 +1,7 @@
 """A whole ``demstudy cost`` ladder: orchestration overhead and parallel efficiency.
 
-Run: .venv/bin/python benchmarks/bench_cost_ladder.py [--box 24] [--production 6]
-     [--kstar 1e2,1e3,1e4] [--steps 10,50] [--workers 2]
+Run: .venv/bin/python benchmarks/bench_cost_ladder.py [--box 40] [--production 40]
+     [--kstar 1e3,1e4] [--steps 10,50] [--workers 2]
 
 The ladder (2D Lees–Edwards preset in a smaller box, dimensionless particle units d = 1,
 m = 1, γ̇ = 1: the reference plus soft Hooke runs over k* and steps per contact) runs twice
@@ -46,9 +46,9 @@ def ladder(out: Path, args: argparse.Namespace, workers: int) -> tuple[float, fl
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--box", type=float, default=24.0, help="box side (d)")
-    parser.add_argument("--production", type=float, default=30.0, help="strain units")
-    parser.add_argument("--kstar", default="1e2,1e3,1e4")
+    parser.add_argument("--box", type=float, default=40.0, help="box side (d)")
+    parser.add_argument("--production", type=float, default=40.0, help="strain units")
+    parser.add_argument("--kstar", default="1e3,1e4")
     parser.add_argument("--steps", default="10,50")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
