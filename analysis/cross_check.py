@@ -15,7 +15,7 @@ his rough walls, fixed gap: inputs/accuracy-cost/couette-rough-nu0.55.toml). The
 and writes into results/: cross-check/ (the ladder's runs, ladder.csv, ladder.json),
 cross-check-pareto.png (accuracy against cost), cross-check-profiles.png (overlay and
 difference), cross-check.txt (the tables). Dimensionless particle units: d = 1, m = 1, the
-wall speed U_T = 1 sets the time scale (no gravity). About 3–6 minutes on 2 cores.
+wall speed U_T = 1 sets the time scale (no gravity). About a minute on 2 cores.
 
     python analysis/cross_check.py [--set run.production=600 ...] [--workers 2]
 """

@@ -82,7 +82,7 @@ class LadderForecast:
         return math.fsum(makespan(self.seconds(p), w) for p in PHASES if p != MAYBE)
 
     def lines(self) -> list[str]:
-        out = ["forecast of the ladder (this machine's measured speed, ±30 %):"]
+        out = ["forecast of the ladder (this machine's measured speed):"]
         for name, phase, _, line in self.runs:
             tag = " (only if the reference's TC model acts)" if phase == MAYBE else ""
             out.append(f"  {name:28s} {line}{tag}")
