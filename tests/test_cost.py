@@ -179,7 +179,7 @@ def test_a_ladder_killed_after_its_first_runs_resumes_with_the_rest(tmp_path):
 
 
 def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
-    distributed = pytest.importorskip("distributed")
+    import distributed  # a declared dependency: the Dask path is always tested
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:

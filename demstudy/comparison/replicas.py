@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import NotComparable
 from ..io.results import Results
+from ..scene import flat_fields
 from .core import _load, _stress
 
 __all__ = ["combine_replicas", "is_combined"]
@@ -43,22 +44,11 @@ def _name(res: Results, i: int) -> str:
     return res.path.name if res.path is not None else f"replica {i + 1}"
 
 
-def _flatten(table: dict, prefix: str = "") -> dict:
-    """{"run.production": 2.0, ...}: scene fields by their dotted names."""
-    out = {}
-    for key, value in table.items():
-        if isinstance(value, dict):
-            out.update(_flatten(value, f"{prefix}{key}."))
-        else:
-            out[f"{prefix}{key}"] = value
-    return out
-
-
 def _scene_without_seed(res: Results) -> dict | None:
     text = res.attrs.get("scene_toml")
     if not isinstance(text, str):
         return None
-    scene = _flatten(tomllib.loads(text))
+    scene = flat_fields(tomllib.loads(text))
     scene.pop("run.seed", None)
     return scene
 

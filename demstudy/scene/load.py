@@ -264,6 +264,18 @@ def load_scene(source: str | os.PathLike, overrides: Iterable[str] = (),
     return validate_scene(data, name)
 
 
+def flat_fields(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Scene data by dotted field names: {"run.production": 2.0, "walls": [...], ...} (arrays
+    of tables stay whole). Used to say which fields two scenes differ in."""
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        if isinstance(value, Mapping):
+            out.update(flat_fields(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
 def scene_to_toml(scene: Scene) -> str:
     """A canonical TOML rendering of a validated scene (stored in every results file)."""
     return dump_toml(scene.model_dump(mode="json", exclude_none=True))

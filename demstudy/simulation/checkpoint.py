@@ -15,7 +15,7 @@ from typing import Any
 from ..contact.pilot import PilotResult
 from ..errors import EngineError
 from ..io.results import write_atomically
-from ..scene import Scene, scene_to_toml
+from ..scene import Scene, flat_fields, scene_to_toml
 
 CHECKPOINT = "checkpoint.pkl"
 
@@ -73,16 +73,8 @@ def scene_difference(saved_toml: str, scene: Scene, most: int = 3) -> str:
     whose values differ, e.g. "run.production: 4.0 in the checkpoint, 1.0 now"."""
     import tomllib  # noqa: PLC0415
 
-    def flat(data: dict, prefix: str = "") -> dict:
-        out = {}
-        for key, value in data.items():
-            if isinstance(value, dict):
-                out.update(flat(value, f"{prefix}{key}."))
-            else:
-                out[f"{prefix}{key}"] = value
-        return out
-
-    old, new = flat(tomllib.loads(saved_toml)), flat(tomllib.loads(scene_to_toml(scene)))
+    old = flat_fields(tomllib.loads(saved_toml))
+    new = flat_fields(tomllib.loads(scene_to_toml(scene)))
     missing = object()
     diffs = [f"{k}: {old.get(k, 'unset')!r} in the checkpoint, {new.get(k, 'unset')!r} now"
              for k in sorted(old.keys() | new.keys())
