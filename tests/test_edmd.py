@@ -647,3 +647,34 @@ def test_cli_runs_the_edmd_engine(tmp_path, capsys):
     assert main(["run", str(path), "--engine", "edmd", "--out", str(out), "--quiet",
                  "--set", "contact.law.model=campbell-exp"]) == 2
     assert "unsupported by edmd: contact.law.model" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("size", [(20.0, 10.0, 8.0), (40.0, 10.0, 8.0), (200.0, 4.0, 4.0)])
+def test_a_few_particles_run_in_an_elongated_periodic_box(tmp_path, size):
+    """The cell budget (≤ 8 cells per particle, at least 64) coarsens the longest axis first:
+    one sphere in an elongated box keeps 3 cells along its short axes instead of being
+    refused (issue 13: a wider uniform cell made them fall below 3). Two elastic smooth
+    spheres (zero total momentum) cross the cells and the periodic images: their energy stays
+    exactly as given."""
+    from demstudy.scene import load_scene
+
+    scene = load_scene("cooling/hcs-3d", box={"size": list(size)},
+                       particles={"count": 2, "solid_fraction": None},
+                       contact={"restitution": 1.0, "tangential": {"model": "beta",
+                                                                   "beta": -1.0}},
+                       run={"equilibration": 0.0, "production": 20.0, "sample_interval": 1.0})
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "two.h5",
+                                                           progress=False)))
+    ke = res.timeseries["kinetic_energy"]
+    assert ke[0] > 0 and np.allclose(ke, ke[0], rtol=1e-12)
+    assert res.attrs["events"] > 10  # cell crossings at least
+
+
+def test_a_periodic_box_shorter_than_three_diameters_is_refused_by_name(tmp_path):
+    from demstudy.scene import load_scene
+
+    scene = load_scene("cooling/hcs-3d", box={"size": [20.0, 10.0, 2.5]},
+                       particles={"count": 2, "solid_fraction": None},
+                       run={"equilibration": 0.0, "production": 1.0, "sample_interval": 1.0})
+    with pytest.raises(UnsupportedByEngine, match=r"box.size = .*at least 3 largest diameters"):
+        run_scene(scene, "edmd", RunOptions(out=tmp_path / "x.h5", progress=False))

@@ -541,35 +541,38 @@ EventDriven::EventDriven(const Params& p, std::int64_t n, const double* pos, con
 }
 
 // Cells: width >= the largest diameter, >= 3 per periodic axis, at most ~8 per particle. A
-// non-periodic y is covered from y_lo to y_hi; its first and last rows are open-ended.
+// non-periodic y is covered from y_lo to y_hi; its first and last rows are open-ended. Over
+// the cell budget, the axis with the most cells is coarsened first (each axis has its own
+// width), so a few particles in an elongated box keep 3 cells along its short periodic axes.
 void EventDriven::setup_grid() {
     // counted in floating point: a huge box must not overflow the cell counts
-    double width = dmax_;
     const double cap = static_cast<double>(std::max<std::int64_t>(8 * n_, 64));
-    double total = 0.0;
-    for (int iter = 0; iter < 1000; ++iter) {
-        total = 1.0;
-        for (int a = 0; a < p_.dim; ++a) {
-            const double L = (a == 1 && !p_.periodic_y) ? p_.y_hi - p_.y_lo : p_.box[a];
-            const double c = std::clamp(std::floor(L / width), 1.0, 1e9);
-            ncell_[a] = static_cast<int>(c);
-            total *= c;
-        }
-        if (total <= cap) break;
-        width *= 1.1;
-    }
-    if (total > cap)
-        throw std::invalid_argument("the box is too large for a cell grid of at most 8 cells per "
-                                    "particle");
+    double cells[3] = {1.0, 1.0, 1.0};
+    double least[3] = {1.0, 1.0, 1.0};
     for (int a = 0; a < p_.dim; ++a) {
         const bool periodic = a != 1 || p_.periodic_y;
-        if (periodic && ncell_[a] < 3)
+        const double L = periodic ? p_.box[a] : p_.y_hi - p_.y_lo;
+        cells[a] = std::clamp(std::floor(L / dmax_), 1.0, 1e9);
+        least[a] = periodic ? 3.0 : 1.0;
+        if (periodic && cells[a] < 3.0)
             throw std::invalid_argument(
-                "every periodic box length must be at least 3 cell widths (axis " +
-                std::to_string(a) + ": " + std::to_string(p_.box[a]) + "; cell width " +
-                std::to_string(width) +
-                (width > dmax_ ? ", widened from the largest diameter to keep at most 8 cells "
-                                 "per particle" : ", the largest diameter") + ")");
+                "every periodic box length must be at least 3 largest particle diameters "
+                "(axis " + std::to_string(a) + ": " + std::to_string(p_.box[a]) +
+                "; largest diameter " + std::to_string(dmax_) + ")");
+    }
+    for (int iter = 0; iter < 100000; ++iter) {
+        double total = 1.0;
+        int most = -1;
+        for (int a = 0; a < p_.dim; ++a) {
+            total *= cells[a];
+            if (cells[a] > least[a] && (most < 0 || cells[a] > cells[most])) most = a;
+        }
+        if (total <= cap || most < 0) break;  // at the floor: 27 cells or fewer, under cap
+        cells[most] = std::max(least[most], std::floor(cells[most] / 1.1));
+    }
+    for (int a = 0; a < p_.dim; ++a) {
+        const bool periodic = a != 1 || p_.periodic_y;
+        ncell_[a] = static_cast<int>(cells[a]);
         const double L = periodic ? p_.box[a] : p_.y_hi - p_.y_lo;
         cw_[a] = L / ncell_[a];
         org_[a] = periodic ? 0.0 : p_.y_lo;
