@@ -452,7 +452,7 @@ def test_simd_pair_times_give_the_scalar_bits(dim, options):
 def test_rejects_bad_input():
     scene = make_scene(3, 0.2, 100)
     st = build_initial_state(scene)
-    with pytest.raises(ValueError, match="at least 3 cell widths.*the largest diameter"):
+    with pytest.raises(ValueError, match="at least 3 largest particle diameters .axis 0: 2.5"):
         from_initial_state(st, [2.5, 2.5, 2.5])
     with pytest.raises(ValueError, match="restitution"):
         from_initial_state(st, scene.box.size, e=1.5)
