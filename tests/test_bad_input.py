@@ -144,3 +144,67 @@ def test_validate_counts_file_rows(tmp_path, capsys):
     scene.write_text(dump_toml(file_scene(tmp_path, [[5.0, 5.0]])))
     assert main(["validate", str(scene)]) == 0
     assert "1 particles" in capsys.readouterr().out
+
+
+# ------------------------------------------------------------ demstudy validate on broken files
+
+ROOT = Path(__file__).resolve().parent.parent
+CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
+
+
+def broken_scenes(tmp_path: Path) -> dict[str, Path]:
+    """One scene file per way of being broken (each was once exit 1, a traceback or a stop)."""
+    files = {
+        "utf8": b"dimension = 2\nmeta = { name = 'caf\xe9' }\n",  # Latin-1, not UTF-8
+        "toml": b"dimension = [2,\n",
+        "value": CHUTE.read_bytes().replace(b"restitution = 0.6", b"restitution = 1.6"),
+        "deep": b"a = " + b"[" * 10_000 + b"]" * 10_000 + b"\n",
+        "deep-ok-for-tomllib": b"[meta]\nname = " + b"[" * 100 + b"]" * 100 + b"\n",
+    }
+    out = {}
+    for name, content in files.items():
+        out[name] = tmp_path / f"{name}.toml"
+        out[name].write_bytes(content)
+    out["missing"] = tmp_path / "missing.toml"
+    return out
+
+
+@pytest.mark.parametrize("kind", ["utf8", "toml", "value", "deep", "deep-ok-for-tomllib",
+                                  "missing"])
+def test_validate_exits_2_on_each_kind_of_broken_file(tmp_path, capsys, kind):
+    path = broken_scenes(tmp_path)[kind]
+    assert main(["validate", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"invalid scene {path}" in err and "Traceback" not in err
+
+
+def test_validate_checks_every_file_and_names_each(tmp_path, capsys):
+    broken = broken_scenes(tmp_path)
+    files = [*broken.values(), CHUTE]
+    assert main(["validate", *map(str, files)]) == 2
+    captured = capsys.readouterr()
+    for path in broken.values():
+        assert f"invalid scene {path}:" in captured.err
+    assert f"ok: {CHUTE}" in captured.out  # the good file after the broken ones is checked
+    assert "byte 0xe9 at line 2" in captured.err and "nested more than" in captured.err
+
+
+def test_deep_values_refused_without_recursion(tmp_path):
+    """load_scene, --set values and keyword sections: nesting is measured, not recursed."""
+    from demstudy.scene import load_scene
+    from demstudy.scene.load import MAX_DEPTH
+
+    deep: object = 1
+    for _ in range(5000):
+        deep = [deep]
+    with pytest.raises(SceneError, match="nested more than"):
+        load_scene(CHUTE, meta={"name": deep})
+    with pytest.raises(SceneError, match=r"meta.name\[0\].*nested more than"):
+        load_scene(CHUTE, ["meta.name=" + "[" * 400 + "]" * 400])
+    shallow: object = "x"
+    for _ in range(MAX_DEPTH - 2):
+        shallow = [shallow]
+    # within the limit: an ordinary validation error (a name is a string), not a depth error
+    with pytest.raises(SceneError, match="meta.name = ") as info:
+        load_scene(CHUTE, meta={"name": shallow})
+    assert "nested" not in str(info.value)
