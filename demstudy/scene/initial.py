@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from .base import SceneError
+from .particle_file import particle_file_problems, read_particle_file
 from .scene import Scene
 
 MARGIN = 1e-3
@@ -47,7 +48,7 @@ def build_initial_state(scene: Scene) -> InitialState:
     rng = np.random.default_rng(scene.run.seed)
     dim, n = scene.dimension, scene.n_particles
     spread = scene.particles.diameter_spread
-    diameter = 1.0 + spread * (rng.random(n) - 0.5) if spread > 0 else np.ones(n)
+    diameter = particle_diameters(scene, rng)
     init = scene.initial
     if init.placement == "lattice":
         position = _campbell_lattice(scene, rng, d_max=1.0 + spread / 2)
@@ -69,6 +70,13 @@ def build_initial_state(scene: Scene) -> InitialState:
         if scene.rotation_matters and scene.inertia_k > 0:
             angular = rng.normal(size=(n, spin_dofs)) * np.sqrt(temperature / inertia)[:, None]
     return InitialState(position, velocity, angular, diameter)
+
+
+def particle_diameters(scene: Scene, rng: np.random.Generator) -> np.ndarray:
+    """Diameters: 1, or uniform in 1 ± diameter_spread/2 (the first draw from ``rng``, so
+    validation can check a particle file against the very diameters a run uses)."""
+    n, spread = scene.n_particles, scene.particles.diameter_spread
+    return 1.0 + spread * (rng.random(n) - 0.5) if spread > 0 else np.ones(n)
 
 
 def _campbell_lattice(scene: Scene, rng: np.random.Generator, d_max: float = 1.0) -> np.ndarray:
@@ -190,19 +198,15 @@ def _close_packed(a: float, lengths: np.ndarray, periodic: np.ndarray) -> np.nda
 
 
 def _from_file(scene: Scene) -> tuple[np.ndarray, np.ndarray | None]:
-    dim, path = scene.dimension, Path(scene.initial.path)
-    data = np.atleast_2d(np.loadtxt(path))
-    if data.shape[1] not in (dim, 2 * dim):
-        raise ValueError(
-            f"initial.path = {str(path)!r}: expected {dim} or {2 * dim} columns, "
-            f"got {data.shape[1]}"
-        )
-    if len(data) != scene.n_particles:
-        raise ValueError(
-            f"initial.path = {str(path)!r}: {len(data)} rows but the scene has "
-            f"{scene.n_particles} particles"
-        )
-    velocity = data[:, dim:] if data.shape[1] == 2 * dim else None
+    """Positions (and velocities, if the file has 2·dim columns) from ``initial.path``; the
+    scene's validation has checked the file (:mod:`demstudy.scene.particle_file`), but it
+    may have changed since, so check again."""
+    dim = scene.dimension
+    problems = particle_file_problems(scene)
+    if problems:
+        raise SceneError(str(scene.initial.path), problems)
+    data = read_particle_file(scene.initial.path).data
+    velocity = data[:, dim:].copy() if data.shape[1] == 2 * dim else None
     return data[:, :dim].copy(), velocity
 
 

@@ -61,6 +61,7 @@ def validate_scene(data: Mapping[str, Any], source: str = "<scene>") -> Scene:
     """Validate a scene mapping (as read from TOML); raise ``SceneError`` on any problem."""
     if not isinstance(data, Mapping):
         raise SceneError(source, [f"(top level): expected a table, got {type(data).__name__}"])
+    check_depth(data, source)
     try:
         return Scene.model_validate(dict(data))
     except ValidationError as exc:
@@ -75,7 +76,7 @@ def parse_value(text: str) -> Any:
     string."""
     try:
         return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+    except (tomllib.TOMLDecodeError, RecursionError):  # the depth check refuses the string
         return text
 
 
@@ -128,20 +129,62 @@ def apply_overrides(data: dict, overrides: Iterable[str], source: str = "--set")
     return data
 
 
-def read_scene_data(path: str | Path) -> dict:
+#: Deepest nesting of tables and arrays a scene may have (a real scene nests ~4 deep); deeper
+#: data is refused before copying or validating it, which would exhaust Python's stack.
+MAX_DEPTH = 32
+
+
+def read_scene_data(path: str | Path, source: str | None = None) -> dict:
+    """The TOML data of a scene file; ``SceneError`` (naming ``source``, default the path)
+    if it cannot be read, is not UTF-8, is not TOML or nests deeper than ``MAX_DEPTH``."""
     path = Path(path)
+    source = str(path) if source is None else source
     try:
-        text = path.read_text()
+        raw = path.read_bytes()
     except OSError as exc:
-        raise SceneError(str(path), [f"cannot read the file: {exc.strerror or exc}"]) from None
-    return parse_scene_text(text, str(path))
+        raise SceneError(source, [f"cannot read the file: {exc.strerror or exc}"]) from None
+    try:
+        text = raw.decode("utf-8")  # TOML is UTF-8 (read_text would use the locale's)
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise SceneError(source, [
+            f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at line {line} (byte offset "
+            f"{exc.start}); TOML files must be UTF-8"]) from None
+    return parse_scene_text(text, source)
 
 
 def parse_scene_text(text: str, source: str = "<scene>") -> dict:
+    """Parse TOML text; ``SceneError`` if it is not TOML or nests deeper than ``MAX_DEPTH``."""
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(source, [f"not valid TOML: {exc}"]) from None
+    except RecursionError:  # tomllib parses nested arrays and inline tables recursively
+        raise SceneError(source, [_too_deep("(top level)")]) from None
+    check_depth(data, source)
+    return data
+
+
+def _too_deep(where: str) -> str:
+    return (f"{where}: values nested more than {MAX_DEPTH} deep (arrays or tables inside "
+            f"each other); a scene nests at most {MAX_DEPTH}")
+
+
+def check_depth(data: Any, source: str = "<scene>") -> None:
+    """``SceneError`` naming the first field nested deeper than ``MAX_DEPTH`` (iterative, so
+    any depth is measured without recursion)."""
+    stack: list[tuple[Any, str, int]] = [(data, "", 0)]
+    while stack:
+        node, where, depth = stack.pop()
+        if not isinstance(node, Mapping | list | tuple):
+            continue
+        if depth > MAX_DEPTH:
+            raise SceneError(source, [_too_deep(where or "(top level)")])
+        items = node.items() if isinstance(node, Mapping) else enumerate(node)
+        for key, value in items:
+            label = f"{where}[{key}]" if not isinstance(node, Mapping) else (
+                f"{where}.{key}" if where else str(key))
+            stack.append((value, label, depth + 1))
 
 
 def resolve_scene(source: str | os.PathLike) -> tuple[Path, str]:
@@ -257,8 +300,9 @@ def load_scene(source: str | os.PathLike, overrides: Iterable[str] = (),
     if isinstance(overrides, str):  # one override given as a string, not a list of them
         overrides = [overrides]
     path, name = resolve_scene(source)
-    data = read_scene_data(path)
+    data = read_scene_data(path, name)
     if sections:
+        check_depth(sections, f"{name} (keyword overrides)")
         data = apply_sections(data, sections, source=f"{name} (keyword overrides)")
     data = apply_overrides(data, overrides, source=name)
     return validate_scene(data, name)

@@ -90,6 +90,10 @@ class Scene(StrictModel):
             return init.rows * init.columns * layers
         if p.count is not None:
             return p.count
+        if init.placement == "file":  # the file's rows (0 if it cannot be read: a problem)
+            from .particle_file import file_count  # noqa: PLC0415 - it imports numpy
+
+            return file_count(self)
         if p.solid_fraction is not None:
             return max(1, round(p.solid_fraction * self.box_volume / self.particle_volume))
         return 0
@@ -275,6 +279,10 @@ class Scene(StrictModel):
                     f"initial: rows × spacing = {init.rows * s:g} exceeds box.size[1] = "
                     f"{self.box.size[1]:g}"
                 )
+        if init.placement == "file" and init.path and len(self.box.size) == dim:
+            from .particle_file import particle_file_problems  # noqa: PLC0415
+
+            problems += particle_file_problems(self)
         v = init.velocity
         if v.profile == "campbell-chute" and (self.gravity is None or self.gravity.angle is None):
             problems.append("initial.velocity.profile = 'campbell-chute' needs gravity.angle")

@@ -284,7 +284,11 @@ class Initial(StrictModel):
     at random by at most the gap (spacing − 1)/2 (``jitter = false`` disables that).
     ``random``: random non-overlapping placement at the particles' count or solid fraction.
     ``file``: positions (and optionally velocities) from a text file with columns
-    x y [z] [vx vy [vz]].
+    x y [z] [vx vy [vz]] (a relative ``path`` is relative to the working directory). The
+    scene's validation checks the file (:mod:`demstudy.scene.particle_file`): it parses,
+    has one row per particle (``particles.count``, if given, must match; otherwise the rows
+    are the count), finite values, centres inside the periodic box and a radius from walls,
+    and no overlaps (tolerance 1e-9 d).
     """
 
     placement: Literal["lattice", "random", "file"] = "random"
