@@ -12,6 +12,7 @@ import pytest
 
 from demstudy.cli import main
 from demstudy.scene import SceneError, load_scene
+from demstudy.scene.schema import MAX_SAMPLES, MAX_SPEED, MIN_INTERVAL
 
 ROOT = Path(__file__).resolve().parent.parent
 CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
@@ -53,3 +54,41 @@ def test_switches_take_only_booleans():
                          ids=lambda p: p.parent.name + "/" + p.name)
 def test_every_preset_still_validates(path):
     load_scene(path)
+
+
+# ---- 2. numbers that overflowed the decks -----------------------------------------------
+HUGE_IMPACT = "soft={hardness={overlap=0.01, impact_speed=1e300}}"
+
+
+@pytest.mark.parametrize("setting, field", [
+    ("run.sample_interval=5e-324", "run.sample_interval = 5e-324"),
+    (HUGE_IMPACT, "soft.hardness.impact_speed = 1e+300"),
+    ("walls.0.velocity=1e300", "walls[0].velocity = 1e+300"),
+])
+@pytest.mark.parametrize("command", [["deck"], ["run", "--engine", "lammps", "-q"]])
+def test_overflowing_values_are_refused_before_any_deck(tmp_path, capsys, setting, field,
+                                                        command):
+    out = ["-o", str(tmp_path / "deck")] if command == ["deck"] else [
+        "--out", str(tmp_path / "r.h5")]
+    err = _refused(capsys, [command[0], str(CHUTE), "--set", setting, *command[1:], *out])
+    assert field in err and "OverflowError" not in err
+    assert not (tmp_path / "deck").exists() and not (tmp_path / "r.h5").exists()
+
+
+def test_sample_count_is_bounded():
+    """An interval above MIN_INTERVAL can still ask for more than MAX_SAMPLES samples."""
+    run_length = 200.0 + 400.0  # chute-30: equilibration + production
+    interval = 0.5 * run_length / MAX_SAMPLES
+    assert interval > MIN_INTERVAL
+    with pytest.raises(SceneError, match=r"run.sample_interval = .*at most 1e\+09 samples"):
+        load_scene(CHUTE, [f"run.sample_interval={interval!r}"])
+    load_scene(CHUTE, [f"run.sample_interval={2 * run_length / MAX_SAMPLES!r}"])
+
+
+def test_speeds_at_the_bound_still_give_finite_contacts():
+    """At the largest allowed speed the hardness mapping is finite (k_n ∝ v²/δ²)."""
+    from demstudy.contact.stiffness import contact_setup
+
+    scene = load_scene(CHUTE, [f"soft={{hardness={{overlap=1e-6, impact_speed={MAX_SPEED!r}}}}}"])
+    setup = contact_setup(scene)
+    assert 0 < setup.timestep and setup.kn < float("inf")

@@ -14,6 +14,7 @@ from .base import StrictModel
 from .schema import (
     INERTIA_K,
     MAX_PACKING,
+    MAX_SAMPLES,
     Box,
     Contact,
     Gravity,
@@ -173,6 +174,14 @@ class Scene(StrictModel):
             problems.append(
                 f"run.sample_interval = {self.run.sample_interval}: longer than "
                 f"run.production = {self.run.production}"
+            )
+        run = self.run
+        samples = (run.equilibration + run.production) / run.sample_interval
+        if samples > MAX_SAMPLES:  # the decks count steps and samples in machine integers
+            problems.append(
+                f"run.sample_interval = {run.sample_interval:g}: {samples:.3g} samples in "
+                f"equilibration + production = {run.equilibration + run.production:g}; "
+                f"allowed: at most {MAX_SAMPLES:g} samples per run"
             )
         if problems:
             raise ValueError("; ".join(problems))

@@ -25,6 +25,16 @@ AXES: tuple[Axis, ...] = ("x", "y", "z")
 MAX_PACKING = {2: math.pi / (2 * math.sqrt(3)), 3: math.pi / (3 * math.sqrt(2))}
 #: Reduced inertia K = 4 I / (m d^2) of the named shapes.
 INERTIA_K = {"disc": 0.5, "sphere": 0.4, "shell": 2.0 / 3.0, "point": 0.0}
+# Bounds that keep the decks finite (a 1e300 speed or a 5e-324 interval validated and then
+# overflowed, or ran as nonsense). In particle units the time unit is √(d/g), d/U or 1/γ̇, so
+# speeds are O(1)–O(100): 1e6 leaves ample room. A sample interval below 1e-9 time units is
+# below any contact time; more than 1e9 samples per run would not fit in memory anyway.
+#: Largest speed (walls, impacts, initial flow) and shear rate, in particle units.
+MAX_SPEED = 1e6
+#: Shortest sample, checkpoint and servo interval, in time units.
+MIN_INTERVAL = 1e-9
+#: Most samples per run ((equilibration + production) / sample_interval).
+MAX_SAMPLES = 1e9
 
 
 class Meta(StrictModel):
@@ -198,7 +208,7 @@ class Servo(StrictModel):
 
     normal_stress: PosFloat
     interval_collisions: PosFloat = 3.0
-    interval_time: PosFloat | None = None
+    interval_time: Float | None = Field(default=None, ge=MIN_INTERVAL, le=1e9)
     gain: PosFloat = 0.25
     scale_width: Bool = True
     hold_shear_rate: Bool = True
@@ -220,7 +230,7 @@ class Wall(StrictModel):
     kind: Literal["flat", "bumpy"] = "flat"
     restitution: Float = Field(gt=0.0, le=1.0)
     tangential: WallTangential = Smooth(model="smooth")
-    velocity: Float = 0.0
+    velocity: Float = Field(default=0.0, ge=-MAX_SPEED, le=MAX_SPEED)
     servo: Servo | None = None
     bumps: Bumps | None = None
 
@@ -240,7 +250,7 @@ class Gravity(StrictModel):
     [1, 0, 0] for Poiseuille flow between vertical walls.
     """
 
-    magnitude: PosFloat = 1.0
+    magnitude: Float = Field(default=1.0, gt=0.0, le=MAX_SPEED)
     angle: Float | None = Field(default=None, ge=-90.0, le=90.0)
     direction: list[Float] | None = Field(default=None, min_length=2, max_length=3)
 
@@ -258,7 +268,7 @@ class Gravity(StrictModel):
 class Shear(StrictModel):
     """Lees–Edwards simple shear: u = rate · y, y periodic with sliding images."""
 
-    rate: Float = Field(gt=0.0)
+    rate: Float = Field(gt=0.0, le=MAX_SPEED)
 
 
 class VelocityInit(StrictModel):
@@ -271,9 +281,9 @@ class VelocityInit(StrictModel):
     """
 
     profile: Literal["none", "uniform", "linear", "campbell-chute"] = "none"
-    scale: Float = 0.0
+    scale: Float = Field(default=0.0, ge=-MAX_SPEED, le=MAX_SPEED)
     perturbation: Float = Field(default=0.0, ge=0.0)
-    temperature: Float = Field(default=0.0, ge=0.0)
+    temperature: Float = Field(default=0.0, ge=0.0, le=MAX_SPEED**2)  # speed²
 
 
 class Initial(StrictModel):
@@ -308,19 +318,20 @@ class Initial(StrictModel):
 class Run(StrictModel):
     """Run control, in time units (or collisions per particle with ``unit = 'collisions'``)."""
 
-    equilibration: Float = Field(ge=0.0)
-    production: Float = Field(gt=0.0)
-    sample_interval: PosFloat = 1.0
+    equilibration: Float = Field(ge=0.0, le=1e12)
+    production: Float = Field(gt=0.0, le=1e12)
+    sample_interval: Float = Field(default=1.0, ge=MIN_INTERVAL)
     seed: Int = Field(default=12345, ge=1, lt=2**31)
     unit: Literal["time", "collisions"] = "time"
-    checkpoint_interval: PosFloat | None = None
+    checkpoint_interval: Float | None = Field(default=None, ge=MIN_INTERVAL)
+
 
 
 class Hardness(StrictModel):
     """Stiffness chosen by a hardness target (one of them)."""
 
-    overlap: Float | None = Field(default=None, gt=0.0, lt=0.5)
-    impact_speed: Float | None = Field(default=None, gt=0.0)
+    overlap: Float | None = Field(default=None, ge=1e-6, lt=0.5)
+    impact_speed: Float | None = Field(default=None, gt=0.0, le=MAX_SPEED)
     k_star: Float | None = Field(default=None, gt=0.0)
     kappa: Float | None = Field(default=None, gt=0.0)
     pressure: Float | None = Field(default=None, gt=0.0)
