@@ -92,3 +92,29 @@ def test_speeds_at_the_bound_still_give_finite_contacts():
     scene = load_scene(CHUTE, [f"soft={{hardness={{overlap=1e-6, impact_speed={MAX_SPEED!r}}}}}"])
     setup = contact_setup(scene)
     assert 0 < setup.timestep and setup.kn < float("inf")
+
+
+# ---- 3. values that validated but gave nonsense -----------------------------------------
+LE_2D = ROOT / "inputs" / "shear" / "lees-edwards-2d.toml"
+
+
+@pytest.mark.parametrize("gravity", ["{angle=30.0}", "{direction=[0.0, -1.0]}",
+                                     "{direction=[1.0, 1.0]}"])
+def test_gravity_across_lees_edwards_images_is_refused(capsys, gravity):
+    err = _refused(capsys, ["validate", str(LE_2D), "--set", f"gravity={gravity}"])
+    assert "gravity." in err and "y component" in err and "sliding images" in err
+    assert "along x" in err  # what is allowed instead
+
+
+@pytest.mark.parametrize("gravity", ["{direction=[1.0, 0.0]}", "{angle=90.0}",
+                                     "{angle=-90.0}"])
+def test_gravity_along_the_flow_is_allowed_with_shear(gravity):
+    scene = load_scene(LE_2D, [f"gravity={gravity}"])
+    assert abs(scene.gravity_vector[1]) < 1e-12 and abs(scene.gravity_vector[0]) == 1.0
+
+
+def test_wall_speed_is_bounded():
+    """A 1e300 wall speed used to validate and run as a silently frictionless wall."""
+    with pytest.raises(SceneError, match=r"walls\[0\].velocity = -1e\+300"):
+        load_scene(CHUTE, ["walls.0.velocity=-1e300"])
+    assert load_scene(CHUTE, [f"walls.0.velocity={MAX_SPEED!r}"]).walls[0].velocity == MAX_SPEED
