@@ -118,3 +118,37 @@ def test_wall_speed_is_bounded():
     with pytest.raises(SceneError, match=r"walls\[0\].velocity = -1e\+300"):
         load_scene(CHUTE, ["walls.0.velocity=-1e300"])
     assert load_scene(CHUTE, [f"walls.0.velocity={MAX_SPEED!r}"]).walls[0].velocity == MAX_SPEED
+
+
+SOFT = ["run.equilibration=0", "run.production=4", "run.sample_interval=0.05"]
+
+
+def test_contacts_too_soft_for_hard_particles_are_warned_and_the_run_agrees(tmp_path, capsys):
+    """A stiffness whose head-on overlap at the scene's impact speed (4 √(gd) in chute-30)
+    exceeds the health limit is warned about at validation (still exit 0); a short LAMMPS
+    run of it then measures an overlap above the limit too, and no more than the estimate
+    (its impacts are no faster than the estimated speed)."""
+    from demstudy.contact.health import LIMITS
+    from demstudy.contact.stiffness import estimated_overlap
+    from demstudy.io.results import read_results
+
+    soft = load_scene(CHUTE, ["soft.stiffness=600", *SOFT])
+    estimate = estimated_overlap(soft)
+    assert estimate > LIMITS["max_overlap"]
+    assert main(["validate", str(CHUTE), "--set", "soft.stiffness=600"]) == 0
+    err = capsys.readouterr().err
+    assert "warning:" in err and "soft.stiffness = 600" in err and "'health'" in err
+    out = tmp_path / "soft.h5"
+    sets = [a for s in ["soft.stiffness=600", *SOFT] for a in ("--set", s)]
+    assert main(["run", str(CHUTE), "--engine", "lammps", "--out", str(out), "-q", *sets]) == 0
+    measured = read_results(out).group_attrs["health"]["max_overlap"]
+    assert LIMITS["max_overlap"] < measured <= estimate
+
+
+def test_hard_enough_contacts_are_not_warned_about():
+    from demstudy.contact.stiffness import overlap_warning
+
+    for path in sorted((ROOT / "inputs").glob("*/*.toml")):
+        assert overlap_warning(load_scene(path)) is None, path
+    # the preset's own k_n = 1e5: δ ≈ 1.8e-3 d at 1 √(gd), i.e. 7e-3 d at 4 √(gd)
+    assert overlap_warning(load_scene(CHUTE, ["soft.stiffness=1e5"])) is None
