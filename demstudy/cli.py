@@ -26,6 +26,11 @@ def _cmd_validate(args: argparse.Namespace) -> int:
             continue
         where = "open top" if scene.has_open_top else f"solid fraction {scene.solid_fraction:.4g}"
         print(f"ok: {path} ({scene.dimension}D, {scene.n_particles} particles, {where})")
+        from .contact.stiffness import overlap_warning  # numpy/scipy: only when needed
+
+        warning = overlap_warning(scene)
+        if warning:
+            print(f"warning: {path}: {warning}", file=sys.stderr)
     return 2 if failed else 0
 
 

@@ -172,7 +172,7 @@ def test_generic_inputs():
         ("particles", "inertia", "cube", ["particles.inertia", "'cube'", "'disc', 'sphere'"]),
         ("particles", "diameter_spread", 0.7, ["particles.diameter_spread", "less than 0.5"]),
         ("run", "seed", 0, ["run.seed", "0", "greater than or equal to 1"]),
-        ("run", "production", "long", ["run.production", "'long'", "valid number"]),
+        ("run", "production", "long", ["run.production", "'long'", "a number", "not a string"]),
         ("run", "equilibration", math.nan, ["run.equilibration", "nan", "finite"]),
         ("initial", "placement", "grid", ["initial.placement", "'grid'", "'lattice'"]),
     ],

@@ -143,6 +143,62 @@ def choose_stiffness(scene: Scene, e: float, m_eff: float,
     return _kn_for_overlap(soft.model, overlap, speed, m_eff, 0.25, e)
 
 
+#: Largest normal impact speed in simple shear, in γ̇ d: the largest overlaps measured in 3D
+#: Lees–Edwards shear at φ = 0.3 (docs/accuracy-cost.md: 0.067, 0.031, 0.0053 d at k* = 1e3,
+#: 1e4, 1e5) are those of impacts at ≈ 4–5 γ̇ d, whatever the box height.
+SHEAR_IMPACT_SPEED = 5.0
+
+
+def impact_speed_estimate(scene: Scene) -> float:
+    """:func:`reference_speed`, except that under shear the mean-flow speed γ̇ Ly/2 (which
+    grows with the box, while neighbours meet at a few γ̇ d) is capped at
+    SHEAR_IMPACT_SPEED γ̇ d."""
+    if scene.shear is None:
+        return reference_speed(scene)
+    rest = reference_speed(scene.model_copy(update={"shear": None}))
+    rate = scene.shear.rate
+    return max(rest, rate * min(scene.box.size[1] / 2, SHEAR_IMPACT_SPEED))
+
+
+def estimated_overlap(scene: Scene) -> float:
+    """Largest overlap (in d) of a head-on impact at the scene's impact speed
+    (:func:`impact_speed_estimate`; a hardness target's ``impact_speed`` if higher), over the pair
+    contact (m_eff = m/2) and every wall's (m_eff = m); NaN when the stiffness is defined only
+    by a pilot or by nothing an engine accepts (hardness k* without shear, κ for Hertz)."""
+    e, model = scene.contact.restitution, scene.soft.model
+    speed = impact_speed_estimate(scene)
+    h = scene.soft.hardness
+    if h is not None and h.impact_speed is not None:
+        speed = max(speed, h.impact_speed)
+    try:
+        kn = choose_stiffness(scene, e, 0.5)
+    except UnsupportedByEngine:
+        return math.nan
+    cases = [(e, 0.5, 0.25)] + [(w.restitution, 1.0, 0.5) for w in scene.walls]
+    if model == "hertz":
+        return max(mapping.hertz_contact(kn, e_, m, r, speed).max_overlap for e_, m, r in cases)
+    return max(mapping.hooke_max_overlap(kn, e_, m, speed) for e_, m, _ in cases)
+
+
+def overlap_warning(scene: Scene) -> str | None:
+    """A warning when the scene's contacts are so soft that the overlap at its reference
+    speed exceeds the health limit LIMITS['max_overlap'] (the run would be valid but far
+    from hard particles, and its health group flags it); None otherwise."""
+    from .health import LIMITS  # health imports this module's neighbours; keep it lazy
+
+    overlap, limit = estimated_overlap(scene), LIMITS["max_overlap"]
+    if not overlap > limit:  # NaN: nothing to estimate
+        return None
+    soft = scene.soft
+    given = (f"soft.stiffness = {soft.stiffness:g}" if soft.stiffness is not None else
+             f"soft.hardness = {soft.hardness.model_dump(exclude_none=True)}"
+             if soft.hardness is not None else "the default stiffness")
+    return (f"{given}: contacts this soft overlap by about {overlap:.3g} d at the estimated "
+            f"impact speed {impact_speed_estimate(scene):.3g}, above the health limit {limit:g} d "
+            "(results group 'health' will flag max_overlap); raise the stiffness or set "
+            "soft.hardness.overlap")
+
+
 def shortest_contact_time(scene: Scene, kn: float, speed: float) -> float:
     """Contact time of the lightest contacts: the two smallest particles of a polydisperse
     scene (d_min = 1 − spread/2, m ∝ d^dim), and the smallest particle on a wall."""

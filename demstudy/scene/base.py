@@ -3,9 +3,18 @@
 from __future__ import annotations
 
 import difflib
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, model_validator
+
+# Strict scalars: TOML has real booleans, integers and floats, so a boolean or a string where
+# a number is expected is a mistake (`inertia = true` would otherwise read as K = 1,
+# `restitution = "0.5"` as 0.5). Strict floats still take integers (TOML `1` for 1.0).
+Float = Annotated[float, Strict()]
+Int = Annotated[int, Strict()]
+Bool = Annotated[bool, Strict()]
+PosFloat = Annotated[float, Strict(), Field(gt=0.0)]
+PosInt = Annotated[int, Strict(), Field(gt=0)]
 
 
 class SceneError(ValueError):

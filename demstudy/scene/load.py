@@ -20,6 +20,13 @@ from .scene import Scene
 _TANGENTIAL_TAGS = ("smooth", "beta", "rough", "coulomb", "campbell-noslip")
 
 
+#: What a strict scalar field takes (the scene's numbers and switches are never coerced).
+_STRICT_TYPES = {"float_type": "a number (integer or decimal, e.g. 1 or 0.5)",
+                 "int_type": "an integer (e.g. 3)", "bool_type": "true or false"}
+_TOML_TYPE = {"bool": "boolean", "str": "string", "float": "decimal number", "list": "array",
+              "int": "integer"}
+
+
 def _location(loc: tuple) -> str:
     parts: list[str] = []
     previous = None
@@ -54,6 +61,9 @@ def _describe(error: dict) -> str:
     shown = repr(value)
     if len(shown) > 60:
         shown = shown[:57] + "..."
+    if kind in _STRICT_TYPES:  # a boolean or a string where a number (or boolean) belongs
+        return (f"{where} = {shown}: {_STRICT_TYPES[kind]} is allowed, not a "
+                f"{_TOML_TYPE.get(type(value).__name__, type(value).__name__)}")
     return f"{where} = {shown}: {message}"
 
 

@@ -14,6 +14,7 @@ from .base import StrictModel
 from .schema import (
     INERTIA_K,
     MAX_PACKING,
+    MAX_SAMPLES,
     Box,
     Contact,
     Gravity,
@@ -169,6 +170,8 @@ class Scene(StrictModel):
         g = self.gravity
         if g is not None and g.direction is not None and len(g.direction) != dim:
             problems.append(f"gravity.direction = {g.direction}: needs {dim} components")
+        elif self.shear is not None and g is not None:
+            problems += self._sheared_gravity_problems()
         problems += self._initial_problems()
         from ..analysis.registry import scene_problems  # the statistics' own registry
 
@@ -178,9 +181,35 @@ class Scene(StrictModel):
                 f"run.sample_interval = {self.run.sample_interval}: longer than "
                 f"run.production = {self.run.production}"
             )
+        run = self.run
+        samples = (run.equilibration + run.production) / run.sample_interval
+        if samples > MAX_SAMPLES:  # the decks count steps and samples in machine integers
+            problems.append(
+                f"run.sample_interval = {run.sample_interval:g}: {samples:.3g} samples in "
+                f"equilibration + production = {run.equilibration + run.production:g}; "
+                f"allowed: at most {MAX_SAMPLES:g} samples per run"
+            )
         if problems:
             raise ValueError("; ".join(problems))
         return self
+
+    def _sheared_gravity_problems(self) -> list[str]:
+        """Gravity with a y component under Lees–Edwards shear has no support: y is periodic
+        with sliding images and there are no walls, so the bed falls through the images for
+        ever; each net crossing shifts its x velocity by γ̇ Ly and the energy grows without
+        bound. Gravity along x (or z) only accelerates the centre of mass, as in any
+        wall-free periodic box, and is left alone."""
+        g_y = self.gravity_vector[1]
+        if abs(g_y) <= 1e-9 * self.gravity.magnitude:  # cos(90°) is 6e-17, not 0
+            return []
+        given = (f"gravity.angle = {self.gravity.angle:g}" if self.gravity.angle is not None
+                 else f"gravity.direction = {list(self.gravity.direction)}")
+        along_x = "[1, 0]" if self.dimension == 2 else "[1, 0, 0]"
+        return [f"{given}: gravity has a y component ({g_y:.3g}) but Lees–Edwards shear makes "
+                "y periodic with sliding images and allows no walls, so nothing supports the "
+                "weight and the energy grows without bound; allowed with [shear]: gravity "
+                f"along x (direction = {along_x}, or angle = ±90), or drop [shear] and bound y "
+                "with walls"]
 
     def _wall_problems(self) -> list[str]:
         problems = []

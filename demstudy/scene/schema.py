@@ -14,9 +14,9 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import Field, PositiveFloat, PositiveInt, model_validator
+from pydantic import Field, model_validator
 
-from .base import StrictModel
+from .base import Bool, Float, Int, PosFloat, PosInt, StrictModel
 
 Axis = Literal["x", "y", "z"]
 AXES: tuple[Axis, ...] = ("x", "y", "z")
@@ -25,6 +25,16 @@ AXES: tuple[Axis, ...] = ("x", "y", "z")
 MAX_PACKING = {2: math.pi / (2 * math.sqrt(3)), 3: math.pi / (3 * math.sqrt(2))}
 #: Reduced inertia K = 4 I / (m d^2) of the named shapes.
 INERTIA_K = {"disc": 0.5, "sphere": 0.4, "shell": 2.0 / 3.0, "point": 0.0}
+# Bounds that keep the decks finite (a 1e300 speed or a 5e-324 interval validated and then
+# overflowed, or ran as nonsense). In particle units the time unit is √(d/g), d/U or 1/γ̇, so
+# speeds are O(1)–O(100): 1e6 leaves ample room. A sample interval below 1e-9 time units is
+# below any contact time; more than 1e9 samples per run would not fit in memory anyway.
+#: Largest speed (walls, impacts, initial flow) and shear rate, in particle units.
+MAX_SPEED = 1e6
+#: Shortest sample, checkpoint and servo interval, in time units.
+MIN_INTERVAL = 1e-9
+#: Most samples per run ((equilibration + production) / sample_interval).
+MAX_SAMPLES = 1e9
 
 
 class Meta(StrictModel):
@@ -41,7 +51,7 @@ class Box(StrictModel):
     leave it upwards, e.g. the free surface of a chute flow; its extent grows as needed).
     """
 
-    size: list[Annotated[float, Field(gt=0.0, lt=1e7)]] = Field(min_length=2, max_length=3)
+    size: list[Annotated[Float, Field(gt=0.0, lt=1e7)]] = Field(min_length=2, max_length=3)
     periodic: list[Axis] | None = None
 
     @model_validator(mode="after")
@@ -72,7 +82,7 @@ class ConstantBeta(StrictModel):
     """Constant tangential restitution β of Lun / Malik (β = 0: Campbell's fully rough rule)."""
 
     model: Literal["beta"]
-    beta: float = Field(ge=-1.0, le=1.0)
+    beta: Float = Field(ge=-1.0, le=1.0)
 
 
 class Rough(StrictModel):
@@ -89,8 +99,8 @@ class Coulomb(StrictModel):
     """Walton's model: Coulomb friction μ with sticking tangential restitution β₀."""
 
     model: Literal["coulomb"]
-    mu: float = Field(ge=0.0, le=1e3)
-    beta0: float | None = Field(
+    mu: Float = Field(ge=0.0, le=1e3)
+    beta0: Float | None = Field(
         default=None, ge=-1.0, le=1.0,
         description="sticking tangential restitution; unset = the contact's normal restitution "
                     "e (per collision for velocity-dependent e): a tangential compliance that "
@@ -119,9 +129,9 @@ class RestitutionLaw(StrictModel):
     """
 
     model: Literal["constant", "campbell-exp", "gutt-piecewise"] = "constant"
-    e1: float | None = Field(default=None, ge=0.0, le=1.0)
-    e2: float | None = Field(default=None, ge=0.0, le=1.0)
-    crossover_speed: float | None = Field(default=None, gt=0.0)
+    e1: Float | None = Field(default=None, ge=0.0, le=1.0)
+    e2: Float | None = Field(default=None, ge=0.0, le=1.0)
+    crossover_speed: Float | None = Field(default=None, gt=0.0)
 
     @model_validator(mode="after")
     def _gutt_needs_parameters(self) -> RestitutionLaw:
@@ -133,7 +143,7 @@ class RestitutionLaw(StrictModel):
 class Contact(StrictModel):
     """Particle–particle collisions: normal restitution e and a tangential rule."""
 
-    restitution: float = Field(gt=0.0, le=1.0)
+    restitution: Float = Field(gt=0.0, le=1.0)
     law: RestitutionLaw = RestitutionLaw()
     tangential: Tangential = Smooth(model="smooth")
 
@@ -147,12 +157,12 @@ class Particles(StrictModel):
     ``diameter_spread`` > 0 makes the diameters uniform in [1 − s/2, 1 + s/2] (mass ∝ volume).
     """
 
-    count: PositiveInt | None = None
-    solid_fraction: float | None = Field(default=None, gt=0.0, lt=1.0)
+    count: PosInt | None = None
+    solid_fraction: Float | None = Field(default=None, gt=0.0, lt=1.0)
     inertia: (
-        Literal["disc", "sphere", "shell", "point"] | Annotated[float, Field(ge=0, le=1)] | None
+        Literal["disc", "sphere", "shell", "point"] | Annotated[Float, Field(ge=0, le=1)] | None
     ) = None
-    diameter_spread: float = Field(default=0.0, ge=0.0, lt=0.5)
+    diameter_spread: Float = Field(default=0.0, ge=0.0, lt=0.5)
 
     @model_validator(mode="after")
     def _one_of_count_or_fraction(self) -> Particles:
@@ -164,8 +174,8 @@ class Particles(StrictModel):
 class Bumps(StrictModel):
     """A bumpy wall: a row (2D) or square grid (3D) of fixed particles on the wall plane."""
 
-    spacing: PositiveFloat = 1.0
-    diameter: PositiveFloat = 1.0
+    spacing: PosFloat = 1.0
+    diameter: PosFloat = 1.0
     pattern: Literal["regular", "random"] = "regular"
 
 
@@ -196,13 +206,13 @@ class Servo(StrictModel):
     Couette input); without it the mean stress itself converges to σ_n.
     """
 
-    normal_stress: PositiveFloat
-    interval_collisions: PositiveFloat = 3.0
-    interval_time: PositiveFloat | None = None
-    gain: PositiveFloat = 0.25
-    scale_width: bool = True
-    hold_shear_rate: bool = True
-    clamp: bool = True
+    normal_stress: PosFloat
+    interval_collisions: PosFloat = 3.0
+    interval_time: Float | None = Field(default=None, ge=MIN_INTERVAL, le=1e9)
+    gain: PosFloat = 0.25
+    scale_width: Bool = True
+    hold_shear_rate: Bool = True
+    clamp: Bool = True
     interval_unit: Literal["collisions", "time"] = "collisions"
 
     @model_validator(mode="after")
@@ -216,11 +226,11 @@ class Wall(StrictModel):
     """A flat (or bumpy) plane normal to y, at the lower or upper side of the box."""
 
     side: Literal["lower", "upper"]
-    position: float | None = None
+    position: Float | None = None
     kind: Literal["flat", "bumpy"] = "flat"
-    restitution: float = Field(gt=0.0, le=1.0)
+    restitution: Float = Field(gt=0.0, le=1.0)
     tangential: WallTangential = Smooth(model="smooth")
-    velocity: float = 0.0
+    velocity: Float = Field(default=0.0, ge=-MAX_SPEED, le=MAX_SPEED)
     servo: Servo | None = None
     bumps: Bumps | None = None
 
@@ -240,9 +250,9 @@ class Gravity(StrictModel):
     [1, 0, 0] for Poiseuille flow between vertical walls.
     """
 
-    magnitude: PositiveFloat = 1.0
-    angle: float | None = Field(default=None, ge=-90.0, le=90.0)
-    direction: list[float] | None = Field(default=None, min_length=2, max_length=3)
+    magnitude: Float = Field(default=1.0, gt=0.0, le=MAX_SPEED)
+    angle: Float | None = Field(default=None, ge=-90.0, le=90.0)
+    direction: list[Float] | None = Field(default=None, min_length=2, max_length=3)
 
     @model_validator(mode="after")
     def _angle_or_direction(self) -> Gravity:
@@ -258,7 +268,7 @@ class Gravity(StrictModel):
 class Shear(StrictModel):
     """Lees–Edwards simple shear: u = rate · y, y periodic with sliding images."""
 
-    rate: float = Field(gt=0.0)
+    rate: Float = Field(gt=0.0, le=MAX_SPEED)
 
 
 class VelocityInit(StrictModel):
@@ -271,9 +281,9 @@ class VelocityInit(StrictModel):
     """
 
     profile: Literal["none", "uniform", "linear", "campbell-chute"] = "none"
-    scale: float = 0.0
-    perturbation: float = Field(default=0.0, ge=0.0)
-    temperature: float = Field(default=0.0, ge=0.0)
+    scale: Float = Field(default=0.0, ge=-MAX_SPEED, le=MAX_SPEED)
+    perturbation: Float = Field(default=0.0, ge=0.0)
+    temperature: Float = Field(default=0.0, ge=0.0, le=MAX_SPEED**2)  # speed²
 
 
 class Initial(StrictModel):
@@ -292,11 +302,11 @@ class Initial(StrictModel):
     """
 
     placement: Literal["lattice", "random", "file"] = "random"
-    rows: PositiveInt | None = None
-    columns: PositiveInt | None = None
-    layers: PositiveInt | None = None
-    spacing: float | None = Field(default=None, gt=1.0)
-    jitter: bool = True
+    rows: PosInt | None = None
+    columns: PosInt | None = None
+    layers: PosInt | None = None
+    spacing: Float | None = Field(default=None, gt=1.0)
+    jitter: Bool = True
     path: str | None = None
     velocity: VelocityInit = VelocityInit()
 
@@ -312,22 +322,23 @@ class Initial(StrictModel):
 class Run(StrictModel):
     """Run control, in time units (or collisions per particle with ``unit = 'collisions'``)."""
 
-    equilibration: float = Field(ge=0.0)
-    production: float = Field(gt=0.0)
-    sample_interval: PositiveFloat = 1.0
-    seed: int = Field(default=12345, ge=1, lt=2**31)
+    equilibration: Float = Field(ge=0.0, le=1e12)
+    production: Float = Field(gt=0.0, le=1e12)
+    sample_interval: Float = Field(default=1.0, ge=MIN_INTERVAL)
+    seed: Int = Field(default=12345, ge=1, lt=2**31)
     unit: Literal["time", "collisions"] = "time"
-    checkpoint_interval: PositiveFloat | None = None
+    checkpoint_interval: Float | None = Field(default=None, ge=MIN_INTERVAL)
+
 
 
 class Hardness(StrictModel):
     """Stiffness chosen by a hardness target (one of them)."""
 
-    overlap: float | None = Field(default=None, gt=0.0, lt=0.5)
-    impact_speed: float | None = Field(default=None, gt=0.0)
-    k_star: float | None = Field(default=None, gt=0.0)
-    kappa: float | None = Field(default=None, gt=0.0)
-    pressure: float | None = Field(default=None, gt=0.0)
+    overlap: Float | None = Field(default=None, ge=1e-6, lt=0.5)
+    impact_speed: Float | None = Field(default=None, gt=0.0, le=MAX_SPEED)
+    k_star: Float | None = Field(default=None, gt=0.0)
+    kappa: Float | None = Field(default=None, gt=0.0)
+    pressure: Float | None = Field(default=None, gt=0.0)
 
     @model_validator(mode="after")
     def _one_target(self) -> Hardness:
@@ -345,9 +356,9 @@ class Soft(StrictModel):
     """Soft-contact numerics (ignored by hard-particle engines)."""
 
     model: Literal["hooke", "hertz"] = "hooke"
-    stiffness: PositiveFloat | None = None
+    stiffness: PosFloat | None = None
     hardness: Hardness | None = None
-    steps_per_contact: float = Field(default=50.0, ge=10.0, le=1e4)
+    steps_per_contact: Float = Field(default=50.0, ge=10.0, le=1e4)
 
     @model_validator(mode="after")
     def _stiffness_or_hardness(self) -> Soft:
@@ -364,6 +375,6 @@ class Measure(StrictModel):
     supply is refused before anything runs. ``keep_frames`` stores every production frame."""
 
     axis: Axis = "y"
-    bin_width: PositiveFloat = 1.0
+    bin_width: PosFloat = 1.0
     statistics: list[str] = ["profiles"]
-    keep_frames: bool = False
+    keep_frames: Bool = False

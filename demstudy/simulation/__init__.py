@@ -46,6 +46,12 @@ def run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
                                       forecast=plan.forecast)
         if plan.setup is not None:
             print(f"{backend.name}: {plan.setup.note()}", file=sys.stderr)
+            if plan.setup.basis in ("stiffness", "hardness"):  # a pilot's k_n is never soft
+                from ..contact.stiffness import overlap_warning
+
+                warning = overlap_warning(scene)
+                if warning:
+                    print(f"warning: {warning}", file=sys.stderr)
         if plan.forecast is not None:
             print(plan.forecast.line(), file=sys.stderr, flush=True)
     if (options.isolate or options.np > 1) and not in_worker():
