@@ -102,6 +102,11 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     source = Path(args.source)
     if source.suffix in (".h5", ".hdf5"):
         results = read_results(source)
+        if not args.scene and "scene_toml" not in results.attrs:
+            from .errors import BadInputFile
+
+            raise BadInputFile(f"results file {source} has no scene_toml attribute: pass the "
+                               "scene it ran with --scene SCENE.toml")
         if args.scene:
             scene = load_scene(args.scene, args.set)
         else:  # the run's own scene, with any --set applied
@@ -124,6 +129,9 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
             raise ValueError("analyzing a dump needs --scene SCENE.toml (the scene it ran)")
         scene = load_scene(args.scene, args.set)
         results, frames = dump_source(source, scene, args.dt, args.reader, args.start)
+        if "angular_velocity" in results.attrs:  # a foreign dump without omega columns
+            print(f"note: {source}: angular velocity {results.attrs['angular_velocity']}",
+                  file=sys.stderr)
         out = Path(args.out or source.with_suffix(".h5"))
 
     ctx = Context(scene, frames=frames, results=results, z_cells=args.z_cells)
@@ -538,6 +546,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     from .errors import (
+        BadInputFile,
         BadOption,
         EngineError,
         NotComparable,
@@ -558,7 +567,7 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(exc, RunStopped):
             return 3  # checkpoint written: run again with --resume
         refused = (SceneError | UnsupportedByEngine | RunRefused | StatisticUnavailable
-                   | BadOption | NotComparable)
+                   | BadOption | NotComparable | BadInputFile)
         return 2 if isinstance(exc, refused) else 1  # 2: nothing ran or was computed
     except KeyboardInterrupt:  # outside a run loop (which checkpoints and stops by itself)
         print("error: interrupted", file=sys.stderr)

@@ -49,10 +49,16 @@ class NotComparable(ValueError):
     message names the files and the field. Nothing was computed (exit 2)."""
 
 
+class BadInputFile(ValueError):
+    """A file given to read (a results file, a LAMMPS dump) is damaged, not of the expected
+    kind or lacks what is needed (a dump without z or with scaled coordinates); the message
+    names the file and what is missing. Nothing was computed (exit 2)."""
+
+
 class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["BadOption", "EngineError", "NotComparable", "RunRefused", "RunStopped",
+__all__ = ["BadInputFile", "BadOption", "EngineError", "NotComparable", "RunRefused", "RunStopped",
            "StatisticUnavailable",
            "UnsupportedByEngine"]

@@ -6,6 +6,7 @@ the triclinic header). Dimensionless particle units: d = 1, m = 1.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -111,3 +112,100 @@ def test_both_readers_agree_on_a_negative_tilt(tmp_path):
     np.testing.assert_allclose(slow.position, fast.position, atol=1e-6)
     assert slow.tilt == fast.tilt == -3.0
     np.testing.assert_array_equal(slow.box_lo, [0.0, 0.0, 0.0])
+
+
+# ---- foreign dumps: other columns than demstudy writes -------------------------------------
+
+GAS_TOML = """dimension = 3
+[box]
+size = [6.0, 6.0, 6.0]
+[contact]
+restitution = 0.9
+[particles]
+count = 3
+[initial.velocity]
+temperature = 1.0
+[run]
+equilibration = 0.0
+production = 1.0
+sample_interval = 0.5
+"""
+FULL = ("id", "type", "radius", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz")
+
+
+def write_dump(path: Path, columns: tuple[str, ...], seed: int = 3) -> Path:
+    """Two frames of three spheres in a 6³ box, random state, only ``columns`` (from FULL,
+    or scaled xs ys zs = x / 6) written; ids shuffled as LAMMPS writes them on MPI ranks."""
+    rng = np.random.default_rng(seed)
+    text = ""
+    for step in (0, 50):
+        data = {"id": np.array([3, 1, 2]), "type": np.ones(3, int), "radius": np.full(3, 0.5)}
+        for axis in "xyz":
+            data[axis] = rng.uniform(0.5, 5.5, 3)
+            data[f"{axis}s"] = data[axis] / 6.0
+            data[f"v{axis}"] = rng.normal(size=3)
+            data[f"omega{axis}"] = rng.normal(size=3)
+        text += (f"ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS pp pp pp\n"
+                 + "0 6\n" * 3 + f"ITEM: ATOMS {' '.join(columns)}\n")
+        text += "".join(" ".join(repr(data[c][i].item()) for c in columns) + "\n"
+                        for i in range(3))
+    path.write_text(text)
+    return path
+
+
+def test_a_dump_without_omega_columns_gives_frames_without_rotation(tmp_path, capsys):
+    """Without omegax omegay omegaz both readers give the same translational frames as the
+    full dump and NaN angular velocities; `analyze` says so, computes the translational
+    profiles of the full dump exactly and leaves the rotational ones NaN."""
+    from demstudy.cli import main
+    from demstudy.io.results import read_results
+
+    full = write_dump(tmp_path / "full.dump", FULL)
+    bare = write_dump(tmp_path / "bare.dump", FULL[:9])
+    for read in (read_dump, read_dump_fast):
+        a, b = list(read(full, 3, dt=0.01)), list(read(bare, 3, dt=0.01))
+        assert len(a) == len(b) == 2
+        for x, y in zip(a, b, strict=True):
+            np.testing.assert_array_equal(x.position, y.position)
+            np.testing.assert_array_equal(x.velocity, y.velocity)
+            assert np.isfinite(x.angular_velocity).all() and np.isnan(y.angular_velocity).all()
+    scene = tmp_path / "gas.toml"
+    scene.write_text(GAS_TOML)
+    for dump in (full, bare):
+        assert main(["analyze", str(dump), "--scene", str(scene), "--what", "profiles",
+                     "--dt", "0.01"]) == 0
+    assert f"note: {bare}: angular velocity absent" in capsys.readouterr().err
+    a, b = (read_results(tmp_path / f"{n}.h5") for n in ("full", "bare"))
+    assert "angular_velocity" in b.attrs and "angular_velocity" not in a.attrs
+    for key in ("solid_fraction", "velocity", "temperature"):
+        np.testing.assert_array_equal(a.profiles[key], b.profiles[key], err_msg=key)
+    occupied = a.profiles["solid_fraction"] > 0
+    assert np.isfinite(a.profiles["rotational_temperature"][occupied]).all()
+    assert np.isnan(b.profiles["rotational_temperature"]).all()
+
+
+@pytest.mark.parametrize("columns, said", [
+    (tuple(c for c in FULL if c != "z"), "lacks the columns z:"),
+    (tuple({"x": "xs", "y": "ys", "z": "zs"}.get(c, c) for c in FULL),
+     "lacks the columns x y z; it has scaled (xs ys zs) coordinates instead"),
+    (FULL[3:], "lacks the columns id type radius:"),
+])
+def test_a_dump_without_z_or_with_scaled_coordinates_is_refused_by_name(tmp_path, capsys,
+                                                                        columns, said):
+    """A dump lacking a column both readers need, or with positions in box fractions, is
+    refused before any frame is read: BadInputFile naming the file and the columns (both
+    readers), `analyze` exit 2 with that message and no results file."""
+    from demstudy.cli import main
+    from demstudy.errors import BadInputFile
+
+    dump = write_dump(tmp_path / "foreign.dump", columns)
+    with pytest.raises(BadInputFile, match=re.escape(f"dump {dump} {said}")):
+        list(read_dump(dump, 3))
+    scene = tmp_path / "gas.toml"
+    scene.write_text(GAS_TOML)
+    for reader in ("auto", "mdanalysis"):
+        assert main(["analyze", str(dump), "--scene", str(scene), "--what", "profiles",
+                     "--dt", "0.01", "--reader", reader]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"error: dump {dump} {said}") and "Traceback" not in err
+    assert not (tmp_path / "foreign.h5").exists()

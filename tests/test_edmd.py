@@ -47,6 +47,7 @@ from demstudy.errors import UnsupportedByEngine
 from demstudy.io.results import read_results
 from demstudy.scene.initial import build_initial_state
 from demstudy.simulation import RunOptions, run_scene
+from demstudy.simulation.checkpoint import pickle_atomically
 from demstudy.theory import kinetic as theory
 
 
@@ -561,14 +562,43 @@ def test_resume_refuses_checkpoints_it_cannot_continue(tmp_path):
                          RunOptions(out=out, progress=False, resume=True))
     with pytest.raises(EngineError, match="checkpoint of the interrupted run writing .*r.v1"):
         run_scene(scene, "edmd", RunOptions(out=tmp_path / "r.v2", progress=False))
-    ckpt.write_bytes(pickle.dumps({**saved, "version": "demstudy-edmd 0.0"}))
+    intact = ckpt.read_bytes()
+    pickle_atomically(ckpt, {**saved, "version": "demstudy-edmd 0.0"})
     with pytest.raises(EngineError, match="written by demstudy-edmd 0.0"):
         resume()
-    ckpt.write_bytes(pickle.dumps(saved)[:1000])
-    with pytest.raises(EngineError, match="is not readable"):
+    ckpt.write_bytes(intact[:1000])
+    with pytest.raises(EngineError, match="is damaged"):
         resume()
-    ckpt.write_bytes(pickle.dumps(saved))
+    pickle_atomically(ckpt, [1, 2])  # whole, but not a checkpoint
+    with pytest.raises(EngineError, match="not a checkpoint of the edmd engine"):
+        resume()
+    ckpt.write_bytes(intact)
     assert read_results(resume()).attrs["engine"] == "edmd"  # the intact one continues
+
+
+@pytest.mark.parametrize("where", [0.1, 0.5, 0.9, 0.99])
+def test_resume_refuses_a_checkpoint_with_flipped_bytes(tmp_path, where):
+    """Bytes flipped anywhere in the state pickle (unpickled, flips resumed runs with T of
+    1e178): --resume refuses the checkpoint by name before unpickling it and writes nothing;
+    the work folder is left as it was."""
+    from demstudy.errors import EngineError
+
+    scene = engine_scene({"run.production": 1.0})
+    out = tmp_path / "r.h5"
+    with pytest.raises(EngineError, match="--resume"):
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, wall_limit=0.0))
+    ckpt = tmp_path / "r.edmd" / "checkpoint.pkl"
+    data = bytearray(ckpt.read_bytes())
+    at = int(where * len(data))
+    data[at:at + 4] = bytes(b ^ 0xFF for b in data[at:at + 4])
+    ckpt.write_bytes(bytes(data))
+    before = sorted((p.name, p.stat().st_mtime_ns) for p in ckpt.parent.iterdir())
+    with pytest.raises(EngineError) as info:
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, resume=True))
+    assert str(info.value) == (f"--resume: checkpoint {ckpt} is damaged (checksum mismatch); "
+                               "remove the work folder to start afresh")
+    assert not out.exists()
+    assert sorted((p.name, p.stat().st_mtime_ns) for p in ckpt.parent.iterdir()) == before
 
 
 def test_a_stop_inside_a_sample_interval_resumes_bit_identically(tmp_path, monkeypatch):

@@ -16,6 +16,7 @@ from demstudy.errors import EngineError, UnsupportedByEngine
 from demstudy.io.results import read_results
 from demstudy.scene import load_scene, validate_scene
 from demstudy.simulation import RunOptions, Simulation, run_scene
+from demstudy.simulation.checkpoint import pickle_atomically
 
 ROOT = Path(__file__).resolve().parent.parent
 CHUTE = ROOT / "inputs" / "campbell1982" / "chute-30.toml"
@@ -206,13 +207,35 @@ def test_resume_refuses_what_it_cannot_continue(tmp_path, monkeypatch):
         run(scene, tmp_path, "r.h5", resume=True, keep_frames=True)
     with pytest.raises(EngineError, match="--dump"):
         run(scene, tmp_path, "r.h5", resume=True, dump=tmp_path / "new.dump")
-    state.write_bytes(pickle.dumps(saved)[:200])
-    with pytest.raises(EngineError, match=r"checkpoint.pkl is not readable"):
+    intact = state.read_bytes()
+    state.write_bytes(intact[:200])
+    with pytest.raises(EngineError, match=r"checkpoint .*checkpoint.pkl is damaged"):
         run(scene, tmp_path, "r.h5", resume=True)
-    state.write_bytes(pickle.dumps({**saved, "version": "demstudy 0.0"}))
+    pickle_atomically(state, {**saved, "version": "demstudy 0.0"})
     with pytest.raises(EngineError, match="written by demstudy 0.0"):
         run(scene, tmp_path, "r.h5", resume=True)
-    state.write_bytes(pickle.dumps(saved))
+    state.write_bytes(intact)
+    assert run(scene, tmp_path, "r.h5", resume=True).attrs["engine"] == "lammps"
+
+
+def test_resume_refuses_a_damaged_restart_file(tmp_path, monkeypatch):
+    """Bytes flipped in the LAMMPS restart file the checkpoint names (read_restart then spun
+    for minutes, past --wall-limit): --resume refuses it by name before LAMMPS reads it and
+    writes nothing; put back, the same checkpoint resumes."""
+    scene = rolling_pair()
+    run_interrupted(scene, tmp_path, "r.h5", monkeypatch, 0.6)
+    (restart,) = (tmp_path / "r.lammps").glob("checkpoint-*.restart")
+    intact = restart.read_bytes()
+    data = bytearray(intact)
+    data[len(data) // 2] ^= 0x55
+    restart.write_bytes(bytes(data))
+    with pytest.raises(EngineError) as info:
+        run(scene, tmp_path, "r.h5", resume=True)
+    assert str(info.value) == (f"--resume: checkpoint {restart} is damaged (checksum "
+                               "mismatch); remove the work folder to start afresh")
+    assert not (tmp_path / "r.h5").exists()
+    assert restart.read_bytes() == bytes(data)  # nothing rewritten
+    restart.write_bytes(intact)
     assert run(scene, tmp_path, "r.h5", resume=True).attrs["engine"] == "lammps"
 
 

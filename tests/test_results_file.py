@@ -33,6 +33,35 @@ def results(scale: float) -> Results:
                    groups={"stress": {"collisional": scale * np.ones((5, 3, 3, 3))}})
 
 
+def test_a_damaged_results_file_is_refused_by_name(tmp_path, capsys):
+    """A results file whose tail was zeroed (a crash of the disk, not of the writer) or that
+    is no HDF5 at all: read_results raises BadInputFile naming the file, and `analyze` and
+    `plot` end with exit 2 and that message, no traceback, nothing written."""
+    from demstudy.cli import main
+    from demstudy.errors import BadInputFile
+
+    big = results(1.0)
+    big.timeseries = {"time": np.linspace(0.0, 1.0, 20000),
+                      "kinetic_energy": np.linspace(1.0, 2.0, 20000)}
+    path = write_results(tmp_path / "r.h5", big)
+    assert read_results(path).timeseries["time"].size == 20000  # intact: it reads
+    size = path.stat().st_size
+    with open(path, "r+b") as fh:
+        fh.seek(size // 2)
+        fh.write(bytes(size - size // 2))
+    junk = tmp_path / "junk.h5"
+    junk.write_bytes(b"not hdf5" * 10)
+    for bad in (path, junk, tmp_path / "absent.h5"):
+        with pytest.raises(BadInputFile, match=f"results file {bad}"):
+            read_results(bad)
+        for argv in (["analyze", str(bad), "--what", "profiles"],
+                     ["plot", str(bad), "--out", str(tmp_path / "f.png")]):
+            assert main(argv) == 2, argv
+            err = capsys.readouterr().err
+            assert err.startswith(f"error: results file {bad}") and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["junk.h5", "r.h5"]
+
+
 def full_disk(monkeypatch):
     def fail(fd):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))

@@ -2,8 +2,12 @@
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. The dump must hold the
 columns ``id type radius x y z vx vy vz`` (+ ``omegax omegay omegaz``), as written by
-``demstudy run --dump`` or ``demstudy deck --dump``. MDAnalysis shifts coordinates so the box
-starts at the origin; the box lower bounds are read from the dump's headers and added back.
+``demstudy run --dump`` or ``demstudy deck --dump``. A foreign dump is checked first
+(:func:`check_dump_columns`): missing columns, or scaled/unwrapped coordinates, are refused
+naming the file and the columns (:class:`~demstudy.errors.BadInputFile`); without the omega
+columns the frames carry NaN angular velocities, so rotational fields come out NaN and the
+translational ones are computed as usual. MDAnalysis shifts coordinates so the box starts at
+the origin; the box lower bounds are read from the dump's headers and added back.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import BadInputFile
 from .frames import Frame
 from .results import Results
 
@@ -28,12 +33,48 @@ def box_headers(path: str | Path) -> list[tuple[np.ndarray, float]]:
             for m in _BOUNDS.finditer(Path(path).read_bytes())]
 
 
+_REQUIRED = ("id", "type", "radius", "x", "y", "z", "vx", "vy", "vz")
+_OMEGA = ("omegax", "omegay", "omegaz")
+_OTHER_COORDINATES = {kind: tuple(a + suffix for a in "xyz")  # LAMMPS's other conventions
+                      for suffix, kind in (("s", "scaled"), ("u", "unwrapped"),
+                                           ("su", "scaled unwrapped"))}
+
+
+def dump_columns(path: str | Path) -> list[str]:
+    """The column names of the first ``ITEM: ATOMS`` header of the dump at ``path``;
+    :class:`BadInputFile` when it has none (not a LAMMPS custom dump)."""
+    with open(path, "rb") as fh:
+        for line in fh:
+            if line.startswith(b"ITEM: ATOMS"):
+                return line.decode(errors="replace").split()[2:]
+    raise BadInputFile(f"dump {path}: no 'ITEM: ATOMS' line: not a LAMMPS custom dump")
+
+
+def check_dump_columns(path: str | Path) -> bool:
+    """Refuse (:class:`BadInputFile`, naming ``path`` and the columns) a dump lacking any of
+    ``id type radius x y z vx vy vz`` (z too in 2D: LAMMPS writes it there, both readers need
+    it), saying so when it holds scaled or unwrapped coordinates instead of x y z (positions
+    in box fractions would be read as lengths). True when it has ``omegax omegay omegaz``."""
+    names = dump_columns(path)
+    missing = [c for c in _REQUIRED if c not in names]
+    if missing:
+        kinds = [f"{kind} ({' '.join(c for c in names if c in cols)})"
+                 for kind, cols in _OTHER_COORDINATES.items() if set(cols) & set(names)]
+        found = f"; it has {', '.join(kinds)} coordinates instead" if kinds else ""
+        raise BadInputFile(
+            f"dump {path} lacks the columns {' '.join(missing)}{found}: demstudy reads "
+            f"'{' '.join(_REQUIRED)}' (+ '{' '.join(_OMEGA)}'), unscaled coordinates in "
+            f"d = 1 units, as 'demstudy run --dump' writes (columns found: {' '.join(names)})")
+    return all(c in names for c in _OMEGA)
+
+
 def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
               start_time: float = 0.0) -> Iterator[Frame]:
     """Frames of a LAMMPS custom dump (time = step × dt); only atoms of ``mobile_type``."""
     import MDAnalysis as mda  # noqa: PLC0415 - heavy import, only when reading dumps
 
-    extra = ["radius", "omegax", "omegay", "omegaz"]
+    rotation = check_dump_columns(path)
+    extra = ["radius", *_OMEGA] if rotation else ["radius"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # masses guessed / no dt: we use our own
         universe = mda.Universe(str(path), format="LAMMPSDUMP", additional_columns=extra,
@@ -54,7 +95,8 @@ def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
             ts = universe.trajectory[index]
         box, tilt = headers[index]
         pos = ts.positions.astype(float)[mobile] + box[:, 0]
-        omega = np.column_stack([ts.data[c] for c in extra[1:]]).astype(float)[mobile]
+        omega = (np.column_stack([ts.data[c] for c in _OMEGA]).astype(float)[mobile]
+                 if rotation else np.full((len(mobile), 3), np.nan))
         yield Frame(
             time=time, box_lo=box[:dim, 0].copy(), box_hi=box[:dim, 1].copy(),
             position=pos[:, :dim], velocity=ts.velocities.astype(float)[mobile, :dim],
@@ -63,8 +105,7 @@ def read_dump(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int = 1,
         )
 
 
-_FAST_COLUMNS = ("id", "type", "radius", "x", "y", "z", "vx", "vy", "vz",
-                 "omegax", "omegay", "omegaz")
+_FAST_COLUMNS = _REQUIRED  # the omega columns are optional (NaN angular velocities)
 
 
 def _box_from_header(words: list[bytes], lines: list[bytes]) -> tuple[np.ndarray, float]:
@@ -145,10 +186,11 @@ def read_dump_fast(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int
             if data.size != n * len(names):
                 raise ValueError(f"{path}: truncated or malformed atom block at step {step}")
             data = data.reshape(n, len(names))
-            col = {c: names.index(c) for c in _FAST_COLUMNS}
+            col = {c: names.index(c) for c in (*_FAST_COLUMNS, *_OMEGA) if c in names}
             data = data[np.argsort(data[:, col["id"]], kind="stable")]
             data = data[data[:, col["type"]] == mobile_type]
-            omega = data[:, [col["omegax"], col["omegay"], col["omegaz"]]]
+            omega = (data[:, [col[c] for c in _OMEGA]] if all(c in col for c in _OMEGA)
+                     else np.full((len(data), 3), np.nan))
             yield Frame(
                 time=time, box_lo=box[:dim, 0].copy(), box_hi=box[:dim, 1].copy(),
                 position=np.ascontiguousarray(data[:, [col[c] for c in "xyz"[:dim]]]),
@@ -156,6 +198,10 @@ def read_dump_fast(path: str | Path, dim: int, dt: float = 1.0, mobile_type: int
                 angular_velocity=np.ascontiguousarray(omega[:, 2:3] if dim == 2 else omega),
                 radius=data[:, col["radius"]].copy(), tilt=tilt,
             )
+
+
+NO_ROTATION = ("absent: the dump has no omegax omegay omegaz columns, so rotational fields "
+               "(rotational temperature, spin) are NaN; translational ones are computed")
 
 
 def dump_source(path: str | Path, scene, dt: float | None, reader: str = "auto",
@@ -168,6 +214,9 @@ def dump_source(path: str | Path, scene, dt: float | None, reader: str = "auto",
     from ..scene import scene_to_toml
 
     path = Path(path)
+    if not path.is_file():
+        raise BadInputFile(f"dump {path}: no such file")
+    rotation = check_dump_columns(path)  # before any reading: names the file and columns
     dt = dt if dt is not None else contact_setup(scene).timestep
     fast = reader == "fast" or (reader == "auto" and has_fast_columns(path))
     read = read_dump_fast if fast else read_dump
@@ -176,6 +225,8 @@ def dump_source(path: str | Path, scene, dt: float | None, reader: str = "auto",
                        "engine_version": "numpy fast reader" if fast else "MDAnalysis",
                        "scene_toml": scene_to_toml(scene), "scene_name": scene.meta.name,
                        "seed": scene.run.seed, "wall_seconds": 0.0, "source": str(path)})
+    if not rotation:
+        results.attrs["angular_velocity"] = NO_ROTATION
 
     def frames():
         return read(path, scene.dimension, dt=dt, start_time=start)

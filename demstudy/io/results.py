@@ -365,7 +365,23 @@ def write_atomically(path: Path, data: bytes | memoryview) -> None:
 def read_results(path: str | os.PathLike, skip: tuple[str, ...] = ()) -> Results:
     """Read a results file written by any engine; ``skip``: top-level groups not to read
     (e.g. ``("frames", "collisions")``, the large ones, when only the figures are wanted).
-    Attributes come back with the types they were written with (module doc)."""
+    Attributes come back with the types they were written with (module doc).
+
+    A missing, truncated or damaged file (h5py's OSError, KeyError, …, e.g. a zeroed tail)
+    raises :class:`~demstudy.errors.BadInputFile` naming the file and h5py's reason."""
+    from ..errors import BadInputFile
+
+    if not Path(path).is_file():
+        raise BadInputFile(f"results file {path}: no such file")
+    try:
+        return _read_results(path, skip)
+    except (OSError, KeyError, ValueError, RuntimeError, TypeError) as exc:
+        # everything is read inside the h5py.File block, so damage anywhere surfaces here
+        raise BadInputFile(f"results file {path} is damaged or not a demstudy results file "
+                           f"({type(exc).__name__}: {exc})") from exc
+
+
+def _read_results(path: str | os.PathLike, skip: tuple[str, ...]) -> Results:
     with h5py.File(path, "r") as f:
         res = Results(attrs=read_attrs(f), path=Path(path),
                       skipped=tuple(name for name in skip if name in f))

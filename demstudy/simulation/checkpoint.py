@@ -2,28 +2,50 @@
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. A checkpoint is one
 pickle in the run's work folder (``checkpoint.pkl``): the scene, the version of the code
-that wrote it, the output it belongs to, the loop's state and the engine's state. A resumed
-run continues only with the code and the scene that wrote it.
+that wrote it, the output it belongs to, the loop's state and the engine's state, followed
+by a trailer holding the SHA-256 of the pickle's bytes (``pickle.loads`` stops before it). A
+resumed run continues only with the code and the scene that wrote it, and only from bytes whose
+checksum matches: a damaged pickle is refused by name before it is unpickled (unpickling flipped
+bytes resumed runs with temperatures of 1e178). Engines checksum their own files the same way
+(:func:`demstudy.io.checksum.verify_file`, e.g. the LAMMPS restart file a checkpoint names).
 """
 
 from __future__ import annotations
 
+import hashlib
 import pickle
 from pathlib import Path
 from typing import Any
 
 from ..contact.pilot import PilotResult
 from ..errors import EngineError
+from ..io.checksum import DamagedCheckpoint
 from ..io.results import write_atomically
 from ..scene import Scene, flat_fields, scene_to_toml
 
 CHECKPOINT = "checkpoint.pkl"
+TRAILER = b"\n#sha256="  # then the 64 hex digits of the pickle's SHA-256
+_TRAILER_SIZE = len(TRAILER) + 64
 
 
 def pickle_atomically(path: Path, obj: Any) -> None:
-    """Pickle ``obj`` to ``path`` atomically (temporary file, fsync, rename): a checkpoint is
-    whole or absent, also when the disk is full."""
-    write_atomically(path, pickle.dumps(obj))
+    """Pickle ``obj`` to ``path`` atomically (temporary file, fsync, rename), followed by the
+    SHA-256 trailer: a checkpoint is whole or absent, also when the disk is full, and damage
+    done afterwards is detected by :func:`read_checkpoint`."""
+    data = pickle.dumps(obj)
+    write_atomically(path, data + TRAILER + hashlib.sha256(data).hexdigest().encode())
+
+
+def read_checkpoint(path: Path) -> Any:
+    """The object :func:`pickle_atomically` wrote to ``path``; :class:`DamagedCheckpoint` when
+    the bytes do not match their checksum (flipped, truncated, no trailer), before anything is
+    unpickled. ``OSError`` when it cannot be read."""
+    raw = path.read_bytes()
+    data, trailer = raw[:-_TRAILER_SIZE], raw[-_TRAILER_SIZE:]
+    if (len(raw) <= _TRAILER_SIZE or not trailer.startswith(TRAILER)
+            or hashlib.sha256(data).hexdigest().encode() != trailer[len(TRAILER):]):
+        raise DamagedCheckpoint(path)
+    return pickle.loads(data)
 
 
 def load_checkpoint(path: Path, scene: Scene, keys: set[str], version: str,
@@ -31,12 +53,14 @@ def load_checkpoint(path: Path, scene: Scene, keys: set[str], version: str,
     """The pickled checkpoint dict at ``path`` for ``--resume``, refused (``EngineError``
     naming the file) when missing, unreadable, without the ``keys`` the engine needs (besides
     ``scene``), written by another ``version`` (a checkpoint continues only with the code that
-    wrote it) or for a scene other than ``scene`` (naming the keys that differ)."""
+    wrote it) or for a scene other than ``scene`` (naming the keys that differ); damaged
+    (checksum mismatch): :class:`DamagedCheckpoint`."""
     if not path.exists():
         raise EngineError(f"--resume: no checkpoint in {path.parent}")
     try:
-        with open(path, "rb") as fh:
-            saved = pickle.load(fh)
+        saved = read_checkpoint(path)
+    except DamagedCheckpoint:
+        raise
     except Exception as exc:  # truncated, corrupt or written by other code
         raise EngineError(f"--resume: {path} is not readable ({type(exc).__name__}: {exc}); "
                           "remove it to start afresh") from exc
@@ -61,8 +85,7 @@ def saved_pilot(path: Path) -> PilotResult | None:
     contacts even where the pilot's cache is gone; None when there is none (or no readable
     checkpoint: :func:`load_checkpoint` then says why)."""
     try:
-        with open(path, "rb") as fh:
-            text = pickle.load(fh)["backend"]["contact"]["pilot"]
+        text = read_checkpoint(path)["backend"]["contact"]["pilot"]
         return PilotResult.from_json(text)
     except Exception:  # noqa: BLE001 - no checkpoint, no pilot, another format
         return None
@@ -89,8 +112,7 @@ def refuse_foreign_checkpoint(path: Path, out: Path) -> None:
     if not path.exists():
         return
     try:
-        with open(path, "rb") as fh:
-            other = pickle.load(fh).get("out")
+        other = read_checkpoint(path).get("out")
     except Exception:  # unreadable: a fresh run replaces it
         return
     if other is not None and other != str(out):

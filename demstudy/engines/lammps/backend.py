@@ -28,6 +28,7 @@ from ...analysis.stress import branch_sums
 from ...contact.health import contact_sample, impact_speeds
 from ...effects.bumps import bump_rows
 from ...errors import EngineError
+from ...io.checksum import file_digest, verify_file
 from ...io.frames import Frame
 from ...scene import Scene
 from ...scene.initial import build_initial_state
@@ -86,7 +87,7 @@ class LammpsBackend(BackendBase):
     #: False: the deck's data file is written and read (``read_data``), as ``lmp -in``
     #: would; the tests compare the two set-ups
     state_from_memory = True
-    version = f"demstudy {__version__} (lammps checkpoint 5)"  # 5: contact settings
+    version = f"demstudy {__version__} (lammps checkpoint 6)"  # 6: restart checksum
 
     @classmethod
     def check(cls, scene: Scene, options) -> None:
@@ -168,6 +169,8 @@ class LammpsBackend(BackendBase):
             if not restart.exists():
                 raise EngineError(f"--resume: {restart}, the restart file of the checkpoint, "
                                   "is missing")
+            # a damaged restart file made read_restart spin for minutes, past --wall-limit
+            verify_file(restart, saved["restart_sha256"])
         self.session = session = LammpsSession(workdir)
         self.rank, self.nprocs = session.rank, session.nprocs
         self.n_particles = scene.n_particles
@@ -431,12 +434,15 @@ class LammpsBackend(BackendBase):
                   {name: session.gather(name, 3).copy() for name in ("f", "torque")})
         restart = self.workdir / f"checkpoint-{self.step}.restart"
         session.command(f"write_restart {quoted(restart)}")
+        # rank 0 writes the checkpoint; write_restart has closed the file on return
+        digest = file_digest(restart) if self.rank == 0 else ""
         dump_size = 0
         if self.dump is not None and self.rank == 0 and self.dump.exists():
             dump_size = self.dump.stat().st_size
         if not resetup:  # write_restart re-initialised LAMMPS
             self._set_up_again(forces)
-        return {"restart": restart.name, "forces": forces, "step": self.step,
+        return {"restart": restart.name, "restart_sha256": digest, "forces": forces,
+                "step": self.step,
                 "impulse": self.wall_impulse(), "edges": self.edges,
                 "dump": str(self.dump) if self.dump else None, "dump_size": dump_size,
                 # k_n, dt, basis and the pilot: a resume continues with the same contacts
