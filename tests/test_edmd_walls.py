@@ -595,15 +595,17 @@ def test_time_interval_servo_without_clamp_holds_the_time_mean_stress(tmp_path):
 
 def test_width_scaling_that_changes_every_cell_axis_keeps_running():
     """Regression: widening x can exhaust the cell budget, so the cells grow along y too; the
-    particles' y cells must be recomputed (a crash in a 10 × σ_n servo run)."""
+    particles' y cells must be recomputed (a crash in a 10 × σ_n servo run). The budget
+    coarsens the axis with the most cells first: a tall cell (40 rows of cells against 9
+    columns) makes the y rows change as x widens."""
     rng = np.random.default_rng(5)
     n = 30
     pos = np.column_stack([rng.permutation(np.arange(n) % 6) * 1.5 + 0.8,
                            (np.arange(n) // 6) * 1.5 + 0.8])
     vel = rng.normal(size=(n, 2))
     s = walled(pos, vel, np.zeros((n, 1)), 2, [{"side": "lower", "position": 0.0},
-                                                   {"side": "upper", "position": 8.0}],
-               height=8.0, width=9.0)
+                                                   {"side": "upper", "position": 40.0}],
+               height=40.0, width=9.0)
     before = s.cells
     for factor in (3.0, 3.0):
         assert s.scale_width(factor) == factor  # growing never overlaps
