@@ -44,9 +44,18 @@ DESIGN_QUANTILE = 0.999
 TARGET_CONTACT_RATIO = 0.02
 
 
+#: Largest normal impact speed in simple shear, in γ̇ d: the largest overlaps measured in 3D
+#: Lees–Edwards shear at φ = 0.3 (docs/accuracy-cost.md: 0.067, 0.031, 0.0053 d at k* = 1e3,
+#: 1e4, 1e5) are those of impacts at ≈ 4–5 γ̇ d, whatever the box height.
+SHEAR_IMPACT_SPEED = 5.0
+
+
 def reference_speed(scene: Scene) -> float:
     """Typical impact speed: √(g H) under gravity (H = particle-bed height or box), the wall
-    speed in Couette flow, rate × Ly/2 under shear, √T for a free gas; never below 1e-3."""
+    speed in Couette flow, γ̇ min(Ly/2, SHEAR_IMPACT_SPEED d) under shear (the mean flow
+    across the box grows with it, neighbours meet at a few γ̇ d: the pilot measured a q0.999
+    impact speed of 6.6 γ̇ d in the 56 d 2D preset, where γ̇ Ly/2 = 28), √T for a free gas;
+    never below 1e-3."""
     speeds = [abs(w.velocity) for w in scene.walls]
     if scene.gravity is not None:
         height = scene.box.size[1]
@@ -54,7 +63,7 @@ def reference_speed(scene: Scene) -> float:
             height = scene.initial.rows * scene.initial.spacing
         speeds.append(math.sqrt(scene.gravity.magnitude * min(height, 50.0)))
     if scene.shear is not None:
-        speeds.append(scene.shear.rate * scene.box.size[1] / 2)
+        speeds.append(scene.shear.rate * min(scene.box.size[1] / 2, SHEAR_IMPACT_SPEED))
     v = scene.initial.velocity
     speeds += [abs(v.scale), math.sqrt(v.temperature)]
     return max(max(speeds), 1e-3)
@@ -143,30 +152,13 @@ def choose_stiffness(scene: Scene, e: float, m_eff: float,
     return _kn_for_overlap(soft.model, overlap, speed, m_eff, 0.25, e)
 
 
-#: Largest normal impact speed in simple shear, in γ̇ d: the largest overlaps measured in 3D
-#: Lees–Edwards shear at φ = 0.3 (docs/accuracy-cost.md: 0.067, 0.031, 0.0053 d at k* = 1e3,
-#: 1e4, 1e5) are those of impacts at ≈ 4–5 γ̇ d, whatever the box height.
-SHEAR_IMPACT_SPEED = 5.0
-
-
-def impact_speed_estimate(scene: Scene) -> float:
-    """:func:`reference_speed`, except that under shear the mean-flow speed γ̇ Ly/2 (which
-    grows with the box, while neighbours meet at a few γ̇ d) is capped at
-    SHEAR_IMPACT_SPEED γ̇ d."""
-    if scene.shear is None:
-        return reference_speed(scene)
-    rest = reference_speed(scene.model_copy(update={"shear": None}))
-    rate = scene.shear.rate
-    return max(rest, rate * min(scene.box.size[1] / 2, SHEAR_IMPACT_SPEED))
-
-
 def estimated_overlap(scene: Scene) -> float:
     """Largest overlap (in d) of a head-on impact at the scene's impact speed
-    (:func:`impact_speed_estimate`; a hardness target's ``impact_speed`` if higher), over the pair
+    (:func:`reference_speed`; a hardness target's ``impact_speed`` if higher), over the pair
     contact (m_eff = m/2) and every wall's (m_eff = m); NaN when the stiffness is defined only
     by a pilot or by nothing an engine accepts (hardness k* without shear, κ for Hertz)."""
     e, model = scene.contact.restitution, scene.soft.model
-    speed = impact_speed_estimate(scene)
+    speed = reference_speed(scene)
     h = scene.soft.hardness
     if h is not None and h.impact_speed is not None:
         speed = max(speed, h.impact_speed)
@@ -194,7 +186,7 @@ def overlap_warning(scene: Scene) -> str | None:
              f"soft.hardness = {soft.hardness.model_dump(exclude_none=True)}"
              if soft.hardness is not None else "the default stiffness")
     return (f"{given}: contacts this soft overlap by about {overlap:.3g} d at the estimated "
-            f"impact speed {impact_speed_estimate(scene):.3g}, above the health limit {limit:g} d "
+            f"impact speed {reference_speed(scene):.3g}, above the health limit {limit:g} d "
             "(results group 'health' will flag max_overlap); raise the stiffness or set "
             "soft.hardness.overlap")
 
