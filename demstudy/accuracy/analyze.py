@@ -41,9 +41,9 @@ def run_error(comparison) -> RunError:
     """The error rule of the module doc, from one ``Comparison``."""
     worst, name, raw = -1.0, "—", math.nan
     counted = {f: fc for f, fc in comparison.fields.items()
-               if f in HEADLINE_FIELDS and not getattr(fc, "reference_is_zero", False)}
+               if f in HEADLINE_FIELDS and not fc.reference_is_zero}
     for field, fc in counted.items():
-        excess = getattr(fc, "rel_l2_debiased", max(fc.rel_l2 - fc.rel_l2_floor, 0.0))
+        excess = fc.rel_l2_debiased
         if excess > worst:
             worst, name, raw = excess, field, fc.rel_l2
     floor = max((fc.rel_l2_floor for fc in counted.values()), default=math.nan)
