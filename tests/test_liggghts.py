@@ -253,3 +253,33 @@ def test_running_in_this_process_is_refused(tmp_path):
     with pytest.raises(UnsupportedByEngine, match="isolate"):
         demstudy.run("campbell1982/chute-30", "liggghts", tmp_path / "x.h5", isolate=False)
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_the_deck_runs_unchanged_in_bare_liggghts(tmp_path):
+    """`demstudy deck --engine liggghts` writes deck.in and its data file; `liggghts -in
+    deck.in` runs them without demstudy and prints the same kinetic energies, sample by
+    sample, as the driven run (to 1e-9)."""
+    import shutil
+
+    if shutil.which("liggghts") is None:
+        pytest.skip("the liggghts executable is not installed")
+    scene = write_scene(tmp_path / "gas.toml", GAS | {"run": GAS["run"] | {"production": 0.5}})
+    deck = tmp_path / "deck"
+    assert cli("deck", str(scene), "--engine", "liggghts", "-o", str(deck)).returncode == 0
+    bare = subprocess.run(["liggghts", "-in", "deck.in", "-screen", "/dev/null", "-log",
+                           "bare.log"], cwd=deck, capture_output=True, text=True, timeout=60)
+    assert bare.returncode == 0, bare.stderr
+    lines = (deck / "bare.log").read_text().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.split() == ["Step", "Atoms", "ke"])
+    rows = []
+    for line in lines[start + 1:]:
+        if line.startswith("Loop time"):
+            break
+        rows.append([float(v) for v in line.split()])
+    driven = tmp_path / "driven.h5"
+    assert cli("run", str(scene), "--engine", "liggghts", "--out", str(driven), "-q"
+               ).returncode == 0
+    with h5py.File(driven) as f:
+        ke = f["timeseries/kinetic_energy"][:]
+    assert len(rows) == len(ke) == 6 and all(r[1] == 98 for r in rows)
+    np.testing.assert_allclose([r[2] for r in rows], ke, rtol=1e-9)

@@ -44,6 +44,7 @@ from .deck import (
     data_text,
     initial_atoms,
     state_rows,
+    write_deck,
     y_bounds,
     z_bounds,
 )
@@ -78,7 +79,7 @@ class LiggghtsBackend(BackendBase):
 
     name = "liggghts"
     kind = "soft-contact"
-    capabilities = Capabilities(time_step=True)
+    capabilities = Capabilities(time_step=True, inputs=True)
     translations = TRANSLATIONS
     version = f"demstudy {__version__} (liggghts checkpoint 1)"
 
@@ -105,6 +106,15 @@ class LiggghtsBackend(BackendBase):
     @staticmethod
     def crash_report(workdir: Path) -> str:
         return crash_report(workdir)
+
+    @classmethod
+    def write_inputs(cls, scene: Scene, folder: Path, dump: str | None = None) -> Path:
+        setup = check_scene(scene)
+        return write_deck(scene, setup, sample_steps(scene, setup.timestep), folder, dump)
+
+    @staticmethod
+    def run_inputs_hint(path: Path) -> str:
+        return f"liggghts -in {path.name}"
 
     @classmethod
     def calibrate(cls, **settings) -> list:

@@ -38,7 +38,7 @@ from ..lammps.deck.base import fmt
 from ..lammps.deck.system import format_rows
 
 __all__ = ["DATA_FILE", "TRANSLATIONS", "LiggghtsDeck", "build_deck", "data_text",
-           "state_rows"]
+           "run_commands", "state_rows", "write_deck"]
 
 DATA_FILE = "initial.data"
 DENSITY = {2: 4 / math.pi, 3: 6 / math.pi}  # m = 1 for d = 1 (per area in 2D)
@@ -314,3 +314,37 @@ def build_deck(scene: Scene, setup: ContactSetup, sample_steps: int,
         deck.notes.append("damping is set per type pair for equal particles: a pair of unequal "
                           "sizes restitutes e only approximately (ζ ∝ √(m_eff/m_eff,0))")
     return deck
+
+
+def run_commands(scene: Scene, setup: ContactSetup, sample_steps: int,
+                 dump: str | None = None) -> list[str]:
+    """What makes the deck run unchanged in bare LIGGGHTS (``liggghts -in deck.in``): the
+    mobile particles' kinetic energy every sample, an optional dump, equilibration and
+    production (``demstudy run`` drives its own segments instead)."""
+    dt = setup.timestep
+    cmds = ["compute ke mobile ke", "thermo_style custom step atoms c_ke",
+            "thermo_modify norm no format float %.17g", f"thermo {sample_steps}"]
+    if dump:
+        cmds += [f"dump frames mobile custom {sample_steps} {dump} id type radius x y z vx vy "
+                 "vz omegax omegay omegaz", "dump_modify frames sort id"]
+    for what, duration in (("equilibration", scene.run.equilibration),
+                           ("production", scene.run.production)):
+        n = max(0, math.ceil(duration / dt - 1e-9))
+        if n:
+            cmds.append(f"run {n}  # {what}: {duration:g} time units")
+    return cmds
+
+
+def write_deck(scene: Scene, setup: ContactSetup, sample_steps: int, folder: Path,
+               dump: str | None = None) -> Path:
+    """``deck.in`` and its data file (the scene's initial state) in ``folder``."""
+    from ...scene.initial import build_initial_state
+
+    folder.mkdir(parents=True, exist_ok=True)
+    atoms, velocities = initial_atoms(scene, build_initial_state(scene))
+    (folder / DATA_FILE).write_text(data_text(scene, atoms, velocities))
+    deck = build_deck(scene, setup, sample_steps)
+    deck.final += run_commands(scene, setup, sample_steps, dump)
+    path = folder / "deck.in"
+    path.write_text(deck.render(scene.meta.name))
+    return path
