@@ -126,7 +126,8 @@ def write_scene(path: Path, data: dict) -> Path:
 def test_elastic_gas_conserves_energy_and_momentum(tmp_path):
     """e = 1, smooth: ~19 000 steps of 98 spheres. Samples between contacts carry all the
     energy as kinetic: their median stays within 2e-4 of the start (a drift would move it);
-    the total momentum stays zero to round-off."""
+    in samples with one contact, kinetic plus spring energy is the start's; the total
+    momentum stays zero to round-off."""
     scene = write_scene(tmp_path / "gas.toml", GAS)
     out = tmp_path / "gas.h5"
     res = cli("run", str(scene), "--engine", "liggghts", "--out", str(out), "-q")
@@ -136,10 +137,20 @@ def test_elastic_gas_conserves_energy_and_momentum(tmp_path):
         momentum = f["timeseries/momentum"][:]
         assert f.attrs["engine"] == "liggghts"
         steps = (t := f["timeseries/time"][:])[-1] / f.attrs["timestep"]
+        contacts = f["health/contacts"][:]
+        overlap = f["health/max_overlap"][:]
+        at = np.searchsorted(t, f["health/time"][:])  # health: production samples only
+        kn = f.attrs["kn"]
     assert steps > 5000 and t[0] == 0.0
     late = np.median(ke[len(ke) // 2:]) / ke[0]
     assert abs(late - 1.0) < 2e-4
     assert np.abs(momentum).max() < 1e-9
+    # a sample with one contact holds its missing energy in that spring, ½ k_n δ² (the
+    # health sample's overlap, found from the gathered positions)
+    one = contacts == 1
+    assert one.sum() >= 3 and np.all(overlap[one] < 0.005)
+    total = ke[at][one] + 0.5 * kn * overlap[one] ** 2
+    np.testing.assert_allclose(total, ke[0], rtol=5e-5)
 
 
 def test_chute_runs_with_momentum_balance_and_is_analysed(tmp_path):
@@ -283,3 +294,30 @@ def test_the_deck_runs_unchanged_in_bare_liggghts(tmp_path):
         ke = f["timeseries/kinetic_energy"][:]
     assert len(rows) == len(ke) == 6 and all(r[1] == 98 for r in rows)
     np.testing.assert_allclose([r[2] for r in rows], ke, rtol=1e-9)
+
+
+def test_health_contacts_are_found_across_the_periodic_edge_and_on_walls():
+    """Two discs overlapping by 0.1 through the periodic x edge, one resting 0.02 into the
+    lower wall, one bump touching a particle by 0.05: the health sample counts 1 pair and 2
+    wall contacts with those overlaps, and the pair's impact speed from v_n and δ."""
+    from demstudy.engines.liggghts.health import health_values
+
+    scene = validate_scene({"dimension": 2, "box": {"size": [10.0, 10.0]},
+                            "particles": {"count": 4},
+                            "walls": [{"side": "lower", "restitution": 0.9},
+                                      {"side": "upper", "restitution": 0.9}],
+                            "contact": {"restitution": 0.9},
+                            "run": {"equilibration": 0.0, "production": 1.0,
+                                    "sample_interval": 0.5}})
+    x = np.array([[0.05, 5.0], [9.15, 5.0], [3.0, 0.48], [6.0, 2.0], [6.0, 2.95]])
+    v = np.zeros((5, 2))
+    v[0, 0] = -1.0  # approaching particle 2 through the edge at v_n = 1
+    radius = np.full(5, 0.5)
+    mobile = np.array([True, True, True, True, False])  # the last: a bump
+    values, keys = health_values(scene, x, v, radius, mobile, 1e4, None)
+    assert values["pair_contacts"] == 1 and values["wall_contacts"] == 2
+    assert values["max_overlap"] == pytest.approx(0.1)
+    assert values["mean_overlap"] == pytest.approx((0.1 + 0.02 + 0.05) / 3)
+    # v0² = v_n² + k δ² / m_eff, m_eff = 1/2
+    assert values["max_impact_speed"] == pytest.approx(math.sqrt(1 + 1e4 * 0.01 / 0.5))
+    assert len(keys) == 1

@@ -48,6 +48,7 @@ from .deck import (
     y_bounds,
     z_bounds,
 )
+from .health import health_values
 from .library import LOG_FILE, Liggghts, crash_report, require_library
 
 __all__ = ["LiggghtsBackend", "check_scene"]
@@ -129,6 +130,7 @@ class LiggghtsBackend(BackendBase):
         self.n_sample = sample_steps(scene, self.time_step)
         self.lmp: Liggghts | None = None
         self._frame: Frame | None = None
+        self._health_keys: np.ndarray | None = None  # the previous sample's touching pairs
 
     # -- set-up ---------------------------------------------------------------------------
     def setup(self, needs: Needs, saved: dict | None, servo) -> None:
@@ -248,6 +250,13 @@ class LiggghtsBackend(BackendBase):
 
     def wall_impulse(self) -> dict[str, np.ndarray]:
         return {side: value.copy() for side, value in self.impulse.items()}
+
+    def health_sample(self) -> dict[str, float]:
+        """The contacts touching now (from the gathered atoms, :mod:`.health`)."""
+        x, v, _w, r = self._gather()
+        values, self._health_keys = health_values(self.scene, x, v, r, self.types == 1,
+                                                  self.contact.kn, self._health_keys)
+        return values
 
     # -- checkpoints, end -----------------------------------------------------------------
     def get_state(self) -> dict:
