@@ -67,6 +67,12 @@ def check_scene(scene: Scene, pilot=None) -> ContactSetup:
         raise UnsupportedByEngine("liggghts", "run.unit", scene.run.unit,
                                   "soft contacts have no collision count: give times")
     check_effects(scene, "liggghts", TRANSLATIONS)
+    if scene.initial.placement == "file":  # positions LIGGGHTS would drop or crash on
+        try:
+            initial_atoms(scene, build_initial_state(scene))
+        except EngineError as exc:
+            raise UnsupportedByEngine("liggghts", "initial.path", scene.initial.path,
+                                      str(exc)) from None
     setup = contact_setup(scene, "liggghts", pilot)
     if setup.pair.model != "hooke":
         raise UnsupportedByEngine("liggghts", "soft.model", setup.pair.model,
