@@ -39,9 +39,10 @@ def measure_machine(dim: int, models: Sequence[str],
     Returns why not (None when all are known): measuring forbidden
     (``DEMSTUDY_MEASURE_RATES=0``) or failed."""
     from ..simulation.forecast import RatesNotMeasured, measure_costs
+    from ..simulation.plan import FORECAST_ENGINES
 
     try:
-        for engine in engines:
+        for engine in (e for e in engines if e in FORECAST_ENGINES):  # others: no benchmark
             for model in models:
                 measure_costs(engine, dim, model)
         measure_costs("edmd", dim)
