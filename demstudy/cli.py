@@ -296,7 +296,9 @@ def _cmd_cost(args: argparse.Namespace) -> int:
                  workers=args.workers, dask=args.dask, out=args.out,
                  replicas=_whole("--replicas", args.replicas),
                  reference_replicas=_whole("--reference-replicas", args.reference_replicas),
-                 dry_run=args.dry_run)
+                 dry_run=args.dry_run,
+                 engines=[e.strip() for e in ",".join(args.engine).split(",") if e.strip()]
+                 if args.engine else None)
     if not args.dry_run:
         print(text_report(study))
     return 0
@@ -501,6 +503,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", metavar="S1,S2,...",
                    help="steps per contact, each >= 10 (default 10,50,200)")
     p.add_argument("--models", metavar="hooke,hertz", help="contact models (default both)")
+    p.add_argument("--engine", action="append", metavar="lammps,liggghts",
+                   help="soft-contact engines of the ladder (default lammps; repeat or list "
+                        "several: every soft setting runs in each)")
     p.add_argument("--tolerance", type=float, default=0.02,
                    help="relative profile error to meet (default 0.02)")
     p.add_argument("--workers", type=int, help="local processes (default: the cores)")
