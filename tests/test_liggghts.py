@@ -321,3 +321,25 @@ def test_health_contacts_are_found_across_the_periodic_edge_and_on_walls():
     # v0² = v_n² + k δ² / m_eff, m_eff = 1/2
     assert values["max_impact_speed"] == pytest.approx(math.sqrt(1 + 1e4 * 0.01 / 0.5))
     assert len(keys) == 1
+
+
+def test_cost_ladder_runs_liggghts_beside_lammps_without_hertz(tmp_path, capsys):
+    """`demstudy cost --engine lammps,liggghts`: every Hooke setting runs in both engines
+    (LIGGGHTS's as soft-liggghts-…), the Hertz ones only in LAMMPS, with a note saying why;
+    LIGGGHTS's rows carry its health figures like LAMMPS's."""
+    from demstudy.cli import main
+
+    out = tmp_path / "ladder"
+    code = main(["cost", "accuracy-cost/couette-rough-nu0.55", "--kstar", "1e3", "--steps",
+                 "10", "--models", "hooke,hertz", "--engine", "lammps,liggghts", "--workers",
+                 "1", "--out", str(out), "--set", "run.equilibration=2", "--set",
+                 "run.production=4"])
+    text = capsys.readouterr().out
+    assert code == 0
+    assert "note: liggghts runs no hertz contacts" in text
+    rows = {r["name"]: r for r in json.loads((out / "ladder.json").read_text())["runs"]}
+    assert {"soft-hooke-k1e+3-s10", "soft-hertz-k1e+3-s10",
+            "soft-liggghts-hooke-k1e+3-s10"} <= set(rows)
+    assert not any("liggghts-hertz" in name for name in rows)
+    lig, lmp = rows["soft-liggghts-hooke-k1e+3-s10"], rows["soft-hooke-k1e+3-s10"]
+    assert lig["steps"] == lmp["steps"] and lig["max_overlap"] > 0

@@ -73,12 +73,11 @@ def check_scene(scene: Scene, pilot=None) -> ContactSetup:
         except EngineError as exc:
             raise UnsupportedByEngine("liggghts", "initial.path", scene.initial.path,
                                       str(exc)) from None
-    setup = contact_setup(scene, "liggghts", pilot)
-    if setup.pair.model != "hooke":
-        raise UnsupportedByEngine("liggghts", "soft.model", setup.pair.model,
+    if scene.soft.model != "hooke":
+        raise UnsupportedByEngine("liggghts", "soft.model", scene.soft.model,
                                   "the LIGGGHTS engine maps Hooke contacts only "
                                   "(model hooke/stiffness); use soft.model = 'hooke'")
-    return setup
+    return contact_setup(scene, "liggghts", pilot)
 
 
 class LiggghtsBackend(BackendBase):
