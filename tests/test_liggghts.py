@@ -153,16 +153,23 @@ def test_elastic_gas_conserves_energy_and_momentum(tmp_path):
     np.testing.assert_allclose(total, ke[0], rtol=5e-5)
 
 
-def test_chute_runs_with_momentum_balance_and_is_analysed(tmp_path):
-    """Campbell's 30° chute (flat lower wall, gravity, rough discs): the run's results file
-    is read by analyze and compare, and momentum balances: the change of the total momentum
+BUMPY = ("--set", "walls[0].kind=bumpy", "--set",
+         "walls[0].bumps={spacing = 1.2, diameter = 1.0}")
+
+
+@pytest.mark.parametrize("walls", [(), BUMPY], ids=["flat", "bumpy"])
+def test_chute_runs_with_momentum_balance_and_is_analysed(tmp_path, walls):
+    """Campbell's 30° chute (flat or bumpy lower wall, gravity, rough discs): the run's
+    results file is read by analyze and compare, and momentum balances (the bumps' share of
+    the wall's impulse included): the change of the total momentum
     over each sample is the wall's impulse plus gravity's N g Δt, to 1 % of N g Δt (the wall
     force is averaged at step ends; velocity Verlet weighs a segment's first and last step
     by half: a mismatch of dt (F_0 − F_n)/2, ~1e-3 of N g Δt here; a wall impulse lost or
     of the wrong sign would miss by ~N g Δt)."""
     out = tmp_path / "chute.h5"
     res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out", str(out), "-q",
-              "--keep-frames", "--set", "run.equilibration=1", "--set", "run.production=4")
+              "--keep-frames", "--set", "run.equilibration=1", "--set", "run.production=4",
+              *walls)
     assert res.returncode == 0, res.stderr
     with h5py.File(out) as f:
         t = f["timeseries/time"][:]
