@@ -370,3 +370,16 @@ def test_contact_stress_of_a_resting_bed_carries_its_weight(tmp_path):
     inside = slice(1, 7)
     assert np.all(np.abs(total[inside, 1, 1] - balance[inside]) < 0.02 * balance[0])
     assert np.all(np.abs(total[:, 0, 1]) < 1e-3 * balance[0])
+
+
+def test_forecast_benchmarks_only_what_liggghts_runs():
+    """The forecast's benchmark leaves out the cases LIGGGHTS refuses (Lees–Edwards shear)
+    and no Hertz costs are measured for it; LAMMPS runs them all."""
+    from demstudy.engines import get_backend
+    from demstudy.simulation.forecast import _benchmark_scene, _expresses, runs_model
+
+    lig, lmp = get_backend("liggghts"), get_backend("lammps")
+    sheared = _benchmark_scene(2, 20, 0.3, 1.0, 1.0, "hooke", True, False)
+    assert not _expresses(lig, sheared) and _expresses(lmp, sheared)
+    assert runs_model("liggghts", "hooke") and not runs_model("liggghts", "hertz")
+    assert runs_model("lammps", "hertz") and runs_model("edmd", None)
