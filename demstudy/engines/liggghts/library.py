@@ -110,7 +110,6 @@ class Liggghts:
         self.lib.lammps_open_no_mpi(len(args), argv, ctypes.byref(self.handle))
         if not self.handle:
             raise EngineError(f"LIGGGHTS did not open (see {self.log})")
-        self.history: list[str] = []
 
     def _note(self, cmd: str) -> None:
         # written before the command runs: a LIGGGHTS error exits the process at once
@@ -121,7 +120,6 @@ class Liggghts:
         if "\n" in cmd:
             raise ValueError(f"one LIGGGHTS command at a time, not {cmd!r}")
         self._note(cmd)
-        self.history.append(cmd)
         self.lib.lammps_command(self.handle, cmd.encode())
 
     def natoms(self) -> int:
