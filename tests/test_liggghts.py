@@ -383,3 +383,14 @@ def test_forecast_benchmarks_only_what_liggghts_runs():
     assert not _expresses(lig, sheared) and _expresses(lmp, sheared)
     assert runs_model("liggghts", "hooke") and not runs_model("liggghts", "hertz")
     assert runs_model("lammps", "hertz") and runs_model("edmd", None)
+
+
+def test_coulomb_wall_impact_follows_walton():
+    """A 2D disc on a wall with Coulomb friction μ = 0.3 and β0 = e = 0.9 (the damped Walton
+    copy): β within 0.02 (the tolerance scenes accept) of Walton's rule at each angle, from
+    sticking (20°: β = β0) to sliding throughout (70°)."""
+    rows = calibrate(dim=2, kind="wall", e=0.9, mu=0.3, angles=(20.0, 45.0, 70.0),
+                     steps_per_contact=50)
+    assert rows[0].beta_target == pytest.approx(0.9) and rows[2].beta_target < 0.5
+    for row in rows:
+        assert row.beta == pytest.approx(row.beta_target, abs=0.02), row.angle
