@@ -31,7 +31,7 @@ def case_names() -> list[str]:
     """Every registered case, in the table's order."""
     from . import hard, soft  # noqa: F401 - registers the cases
 
-    return list(CASES)
+    return sorted(CASES, key=lambda n: CASES[n].kind != SOFT)  # the table's order
 
 
 def stability(engines: Iterable[str] | None = None, cases: Iterable[str] | None = None,

@@ -18,6 +18,9 @@ from .registry import Row, Suite
 
 __all__ = ["format_markdown", "format_text", "machine", "write_outputs"]
 
+#: a Markdown file's text after this line is kept when the table is written again
+HAND_WRITTEN = "<!-- hand-written below: kept when demstudy stability rewrites the table -->"
+
 COLUMNS = ("case", "engine", "checks", "measured", "limit", "status", "seconds", "note")
 
 
@@ -109,12 +112,18 @@ def format_json(suite: Suite, command: str, when: _dt.datetime) -> str:
 def write_outputs(suite: Suite, out: str | os.PathLike,
                   command: str = "demstudy stability") -> list[Path]:
     """Write the table as Markdown to ``out`` and as CSV and JSON next to it (same name,
-    suffixes .csv and .json); returns the paths. Each file is replaced atomically."""
+    suffixes .csv and .json); returns the paths. Each file is replaced atomically; the text
+    after :data:`HAND_WRITTEN` in an existing ``out`` is kept."""
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     when = _dt.datetime.now(_dt.UTC)
+    markdown = format_markdown(suite, command, when)
+    if out.exists():  # keep the hand-written part of a committed table (findings)
+        old = out.read_text(encoding="utf-8")
+        if HAND_WRITTEN in old:
+            markdown += "\n" + HAND_WRITTEN + old.split(HAND_WRITTEN, 1)[1]
     written = []
-    for path, text in ((out, format_markdown(suite, command, when)),
+    for path, text in ((out, markdown),
                        (out.with_suffix(".csv"), format_csv(suite)),
                        (out.with_suffix(".json"), format_json(suite, command, when))):
         tmp = path.with_name(path.name + ".tmp")
