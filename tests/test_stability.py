@@ -187,3 +187,29 @@ def test_ds_stability_is_callable_after_importing_the_package():
 
     assert ds.stability is module and callable(ds.stability)
     assert "stiff-contacts" in CASES
+
+
+class HookeOnly(engines.get_backend("lammps")):
+    """LAMMPS refusing Hertz contacts, as the LIGGGHTS engine does (module level: an isolated
+    run's child process imports it)."""
+
+    @classmethod
+    def check(cls, scene, options):
+        from demstudy.errors import UnsupportedByEngine
+
+        if scene.soft.model == "hertz":
+            raise UnsupportedByEngine("hooke-only", "soft.model", "hertz", "Hooke only")
+        super().check(scene, options)
+
+
+def test_an_engine_refusing_part_of_a_case_still_gets_its_row(monkeypatch, tmp_path):
+    """An engine without Hertz contacts: fast-impacts reports its Hooke runs and names the
+    refused Hertz ones; timestep-too-large keeps its validation check."""
+    from demstudy.stability.soft import fast_impacts, timestep_too_large
+
+    monkeypatch.setattr(engines, "_BACKENDS", {**engines._BACKENDS, "lammps": HookeOnly})
+    impacts = fast_impacts("lammps", True, tmp_path)
+    assert "hooke pairs" in impacts.measured and "hertz" not in impacts.measured
+    assert "hertz pairs: unsupported by hooke-only" in impacts.note
+    step = timestep_too_large("lammps", True, tmp_path)
+    assert step.passed and "Hertz refused" in step.measured
