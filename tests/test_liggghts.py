@@ -394,3 +394,22 @@ def test_coulomb_wall_impact_follows_walton():
     assert rows[0].beta_target == pytest.approx(0.9) and rows[2].beta_target < 0.5
     for row in rows:
         assert row.beta == pytest.approx(row.beta_target, abs=0.02), row.angle
+
+
+def test_tunnelling_through_a_wall_is_an_engine_error(tmp_path):
+    """A sphere thrown at the lower wall at 100 with k_n = 1e4 would overlap it by about
+    its diameter: its centre crosses the wall plane, which LIGGGHTS's primitive wall then
+    pushes on out of the box. The run stops at once with the particle, the wall and the
+    remedy named."""
+    rows = tmp_path / "p.txt"
+    rows.write_text("5.0 0.7 5.0 0.0 -100.0 0.0\n")
+    scene = write_scene(tmp_path / "wall.toml", {
+        "dimension": 3, "box": {"size": [10.0, 10.0, 10.0]}, "particles": {"count": 1},
+        "contact": {"restitution": 0.8},
+        "walls": [{"side": "lower", "restitution": 0.8}, {"side": "upper", "restitution": 0.8}],
+        "initial": {"placement": "file", "path": str(rows)},
+        "run": {"equilibration": 0.0, "production": 0.05, "sample_interval": 0.001},
+        "soft": {"model": "hooke", "stiffness": 1e4}})
+    res = cli("run", str(scene), "--engine", "liggghts", "--out", str(tmp_path / "x.h5"), "-q")
+    assert res.returncode == 1
+    assert "particle 1 crossed the lower wall" in res.stderr and "soft.stiffness" in res.stderr

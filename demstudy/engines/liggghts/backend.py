@@ -203,7 +203,24 @@ class LiggghtsBackend(BackendBase):
         if n != self.n_atoms:
             raise EngineError(f"LIGGGHTS lost {self.n_atoms - n} of {self.n_atoms} atoms "
                               f"{when} (at t = {self.time:.6g}): a particle left the box "
-                              f"through a fixed boundary; see {self.workdir / LOG_FILE}")
+                              "through a fixed boundary")
+
+    def _check_walls(self) -> None:
+        """A centre beyond a wall plane has tunnelled (an overlap deeper than its radius):
+        LIGGGHTS's primitive wall would push it on, out of the box."""
+        if not self.scene.walls:
+            return
+        y = self._gather()[0][self.types == 1, 1]
+        for wall in self.scene.walls:
+            plane = self.scene.wall_position(wall.side)
+            beyond = y < plane if wall.side == "lower" else y > plane
+            if beyond.any():
+                i = int(np.flatnonzero(beyond)[0])
+                raise EngineError(f"particle {i + 1} crossed the {wall.side} wall (y = "
+                                  f"{y[i]:.6g}, the wall at {plane:g}) at t = "
+                                  f"{self.time:.6g}: an overlap deeper than its radius; "
+                                  "the contacts are too soft for the impact speeds "
+                                  "(raise soft.stiffness or soft.hardness.impact_speed)")
 
     # -- advancing ------------------------------------------------------------------------
     @property
@@ -218,6 +235,7 @@ class LiggghtsBackend(BackendBase):
         self.lmp.command(f"run {n} pre no post no")
         self.step += n
         self._count("during the run")
+        self._check_walls()
         if self.deck.wall_sides:
             means = self.lmp.fix_vector(WALL_FORCES, 3 * len(self.deck.wall_sides))
             for side, row in zip(self.deck.wall_sides, means.reshape(-1, 3), strict=True):
@@ -246,7 +264,7 @@ class LiggghtsBackend(BackendBase):
         dim = self.scene.dimension
         x, v, w, r = self._gather()
         mobile = self.types == 1
-        (ylo, yhi), (zlo, zhi) = y_bounds(self.scene), z_bounds(self.scene)
+        (ylo, yhi), (zlo, zhi) = y_bounds(self.scene, margin=False), z_bounds(self.scene)
         if self.scene.has_open_top:  # the `m` boundary: the box reaches the highest particle
             yhi = max(yhi, float(x[mobile, 1].max(initial=yhi)))
         lo, hi = np.array([0.0, ylo, zlo]), np.array([self.scene.box.size[0], yhi, zhi])

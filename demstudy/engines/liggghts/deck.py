@@ -47,6 +47,8 @@ UNCAPPED_MU = 1e20  # an uncapped β spring
 WALL_FORCES = "wall_forces"  # fix ave/time of every wall's summed force
 #: how far inside a fixed y boundary a particle must lie (LIGGGHTS drops atoms on it)
 BOUNDARY_MARGIN = 1e-9
+#: room between a wall plane and the box boundary behind it, in d (``y_bounds``)
+WALL_MARGIN = 1.0
 
 
 @dataclass
@@ -79,12 +81,15 @@ def n_types(scene: Scene) -> int:
     return 1 + len(scene.walls)
 
 
-def y_bounds(scene: Scene) -> tuple[float, float]:
+def y_bounds(scene: Scene, margin: bool = True) -> tuple[float, float]:
     """The box along y: the periodic length, else from wall to wall (an open top: the box
-    height, which the ``m`` boundary then grows as particles rise)."""
+    height, which the ``m`` boundary then grows as particles rise). ``margin``: the LIGGGHTS
+    box reaches WALL_MARGIN beyond each wall (and its bumps), so that a centre pushed
+    through a wall plane by a deep overlap stays an atom whose position the run reports,
+    rather than one LIGGGHTS drops silently at the boundary; False: the walls themselves."""
     if scene.y_periodic:
         return 0.0, scene.box.size[1]
-    pad = bump_padding(scene)
+    pad = bump_padding(scene) + (WALL_MARGIN if margin else 0.0)
     lo = scene.wall_position("lower") - pad if scene.wall("lower") else 0.0
     hi = scene.wall_position("upper") + pad if scene.wall("upper") else scene.box.size[1]
     return lo, hi
