@@ -229,12 +229,14 @@ def test_lost_particle_is_an_engine_error(tmp_path):
 
 
 def test_positions_liggghts_would_choke_on_are_refused():
-    """On the fixed y boundary, outside it or NaN: refused naming the particle; periodic
-    coordinates on the upper edge are folded to the lower one."""
+    """On a wall plane, outside the box (which reaches 1 d beyond the walls) or NaN:
+    refused naming the particle; periodic coordinates on the upper edge are folded to the
+    lower one."""
     walls = [{"side": side, "restitution": 0.9} for side in ("lower", "upper")]
     scene = validate_scene({**GAS, "walls": walls})
     d, types, zero = np.ones(2), np.ones(2), np.zeros((2, 3))
     for bad in ([[1.0, 0.0, 1.0], [2.0, 4.0, 2.0]], [[1.0, 4.0, 1.0], [2.0, 9.0, 2.0]],
+                [[1.0, 4.0, 1.0], [2.0, 8.0, 2.0]], [[1.0, -1.0, 1.0], [2.0, 4.0, 2.0]],
                 [[1.0, 4.0, 1.0], [2.0, np.nan, 2.0]]):
         with pytest.raises(EngineError, match="particle [12]"):
             state_rows(scene, np.array(bad), zero, zero, d, types)

@@ -141,8 +141,15 @@ def state_rows(scene: Scene, x: np.ndarray, v: np.ndarray, omega: np.ndarray,
             raise EngineError(f"particle {i + 1} at y = {pos[i, 1]:.17g} is on or outside the "
                               f"box's fixed y boundary [{lo[1]:g}, {hi[1]:g}] (LIGGGHTS would "
                               "drop it without a word)")
-        if scene.has_open_top and pos[:, 1].max() >= hi[1]:
-            hi[1] = pos[:, 1].max() + 1.0  # the `m` boundary follows from here on
+        mobile = types == 1  # bumps sit on their wall plane
+        for wall in scene.walls:  # a centre on or beyond a wall plane has tunnelled
+            plane = scene.wall_position(wall.side)
+            beyond = mobile & ((pos[:, 1] <= plane) if wall.side == "lower"
+                               else (pos[:, 1] >= plane))
+            if beyond.any():
+                i = int(np.flatnonzero(beyond)[0])
+                raise EngineError(f"particle {i + 1} at y = {pos[i, 1]:.17g} is on or beyond "
+                                  f"the {wall.side} wall at y = {plane:g}")
     density = np.where(types > 1, BUMP_MASS_FACTOR, 1.0) * DENSITY[scene.dimension]
     ids = np.arange(1, n + 1)
     atoms = np.column_stack([ids, types, diameter, density, pos])
