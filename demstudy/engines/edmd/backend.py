@@ -114,6 +114,10 @@ class EdmdBackend(BackendBase):
     def __init__(self, scene: Scene, options, workdir):
         super().__init__(scene, options, workdir)
         self.tc = float(options.extra.get("tc", DEFAULT_TC))
+        # whether a collision can lose energy: with t_c = 0 a stall is then inelastic collapse
+        self.dissipative = (scene.contact.restitution < 1.0
+                            or scene.contact.law.model != "constant"
+                            or any(w.restitution < 1.0 for w in scene.walls))
 
     # -- set-up ---------------------------------------------------------------------------
     def setup(self, needs: Needs, saved: dict | None, servo) -> None:
@@ -168,7 +172,9 @@ class EdmdBackend(BackendBase):
         if collisions > 0:
             budget = 1000 * max(1, collisions - self.core.collisions) + 10_000_000
         return advance_watched(self.core, t, tc=self.tc, max_events=budget,
-                               stop_collisions=collisions, stop_requested=stop)
+                               stop_collisions=collisions, stop_requested=stop,
+                               dissipative=self.dissipative,
+                               bumps=any(w.kind == "bumpy" for w in self.scene.walls))
 
     # -- sampling -------------------------------------------------------------------------
     def observe(self, production: bool) -> dict:
