@@ -2,8 +2,10 @@
 
 ``SceneError`` (invalid scene, :mod:`demstudy.scene.load`) and ``UnsupportedByEngine`` (an
 engine cannot express what the scene or a run option asks for) are raised before any engine
-starts (exit 2); ``EngineError`` is a failure during a run (exit 1), ``RunStopped`` a run that
-stopped on request after a checkpoint (exit 3, continue with ``--resume``).
+starts (exit 2); ``EngineError`` is a failure during a run (exit 1; its subclass
+``RunRefused``, also ``demstudy.io.checksum.DamagedCheckpoint``, means nothing ran: exit 2),
+``RunStopped`` a run that stopped on request after a checkpoint (exit 3, continue with
+``--resume``).
 """
 
 from __future__ import annotations

@@ -222,6 +222,7 @@ def worker(job: str) -> int:
 def run_in_child(backend, scene: Scene, options: RunOptions, error: Path) -> int:
     """Run the loop here, in the child; the child's exit code (its message, if any, in the
     file ``error`` for the parent)."""
+    from ..io.checksum import DamagedCheckpoint
     from ..scene.load import SceneError
     from .loop import Simulation
 
@@ -229,7 +230,7 @@ def run_in_child(backend, scene: Scene, options: RunOptions, error: Path) -> int
         Simulation(scene, backend, options).run()
     except RunStopped:
         return STOPPED  # the parent says so, once
-    except (UnsupportedByEngine, SceneError) as exc:  # refused before anything ran
+    except (UnsupportedByEngine, SceneError, DamagedCheckpoint) as exc:  # nothing ran
         print(f"error: {exc}", file=sys.stderr)
         _tell_parent(error, str(exc))
         return REFUSED
