@@ -30,6 +30,11 @@ class RunStopped(EngineError):
     """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint."""
 
 
+class RunAborted(EngineError):
+    """A second Ctrl-C aborted the run without a new checkpoint (exit 130); the last one
+    written, if any, stays and ``--resume`` continues from it."""
+
+
 class StatisticUnavailable(ValueError):
     """A statistic cannot be computed from what it is given (no frames, no collision log, the
     wrong dimension): nothing was computed (exit 2 on the command line)."""
@@ -61,6 +66,7 @@ class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["BadInputFile", "BadOption", "EngineError", "NotComparable", "RunRefused", "RunStopped",
+__all__ = ["BadInputFile", "BadOption", "EngineError", "NotComparable", "RunAborted", "RunRefused",
+           "RunStopped",
            "StatisticUnavailable",
            "UnsupportedByEngine"]

@@ -12,6 +12,7 @@ m = 1, g = 1 when gravity acts.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
@@ -23,9 +24,10 @@ import time
 from pathlib import Path
 
 from .. import UNITS_NOTE
-from ..errors import EngineError, RunRefused, RunStopped, UnsupportedByEngine
+from ..errors import EngineError, RunAborted, RunRefused, RunStopped, UnsupportedByEngine
 from ..scene import Scene
 from .options import RunOptions, work_folder
+from .schedule import stop_notice
 
 WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
 FAILED, REFUSED, STOPPED = 1, 2, 3  # the child's exit codes
@@ -91,14 +93,19 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     try:
         returncode = proc.wait()
     except KeyboardInterrupt:
-        print(f"\n{backend.name}: stopping after the current segment and a checkpoint "
-              "(Ctrl-C again aborts without one)", file=sys.stderr, flush=True)
+        print(stop_notice(backend.name), file=sys.stderr, flush=True)
         proc.send_signal(signal.SIGINT)  # a terminal's Ctrl-C reached it already: harmless
         try:
             returncode = proc.wait(timeout=300)
-        except (subprocess.TimeoutExpired, KeyboardInterrupt):
-            proc.kill()
-            returncode = -9
+        except KeyboardInterrupt:  # the second Ctrl-C: abort now, keeping the last checkpoint
+            _end(proc)
+            raise RunAborted(f"aborted by Ctrl-C: the {backend.name} run was ended; "
+                             f"{_last_checkpoint(work_folder(out, backend.name))}") from None
+        except subprocess.TimeoutExpired:
+            _end(proc)
+            raise EngineError(f"the {backend.name} run did not stop within 300 s of Ctrl-C "
+                              "and was ended; "
+                              f"{_last_checkpoint(work_folder(out, backend.name))}") from None
     finally:
         job.unlink(missing_ok=True)
     message = error.read_text().strip() if error.exists() else ""
@@ -119,6 +126,24 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
         raise EngineError(f"the {backend.name} run on {options.np} rank(s) {how}{said}"
                           + (f" (and {log_file})" if message and log else ""))
     return out
+
+
+def _end(proc) -> None:
+    """End the child at once: SIGTERM (mpirun passes it on to its ranks), SIGKILL after
+    2 s. A checkpoint is written atomically, so the last whole one stays."""
+    with contextlib.suppress(ProcessLookupError):
+        proc.send_signal(signal.SIGTERM)
+    with contextlib.suppress(subprocess.TimeoutExpired, KeyboardInterrupt):
+        proc.wait(timeout=2.0)
+        return
+    with contextlib.suppress(ProcessLookupError, ChildProcessError):
+        proc.kill()
+
+
+def _last_checkpoint(workdir: Path) -> str:
+    from .checkpoint import resume_note  # noqa: PLC0415 - pickle and h5py helpers: only here
+
+    return resume_note(workdir)
 
 
 def can_fork(backend, options: RunOptions) -> bool:
