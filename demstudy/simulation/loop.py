@@ -407,6 +407,8 @@ class Simulation:
         warning = warning_text(results.group_attrs.get("health", {}))
         if warning:  # the results stand, but not for the hard-particle limit
             print(warning, file=sys.stderr)
+        for line in self.backend.end_notes(results.attrs):
+            print(line, file=sys.stderr)
         failed = results.attrs.get("statistics_failed")
         if failed:  # the run's results are safe; say what is missing from them
             raise EngineError(f"the run finished and its results are in {path}, but these "

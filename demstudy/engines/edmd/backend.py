@@ -26,6 +26,7 @@ from ...scene.initial import InitialState, build_initial_state
 from ..backend import BackendBase, Capabilities, EngineOption, Needs
 from .core import DEFAULT_TC, EventDriven, advance_watched, from_initial_state
 from .effects import TRANSLATIONS, core_options
+from .tc_share import TcShare, tc_share
 
 __all__ = ["EdmdBackend", "with_bumps", "y_range"]
 
@@ -269,6 +270,12 @@ class EdmdBackend(BackendBase):
         if servo is not None and servo.scale_width:
             notes.append("servo width scaling: x positions are rescaled affinely at each "
                          "servo update")
+        share = tc_share(core.elastic_tc_collisions, core.collisions, self.tc)
         return {"tc": self.tc, "elastic_tc_collisions": core.elastic_tc_collisions,
                 "events": core.events, "cell_crossings": core.cell_crossings,
-                "wall_collisions": core.wall_collisions, "approximations": "\n".join(notes)}
+                "wall_collisions": core.wall_collisions, "approximations": "\n".join(notes),
+                **share.attrs()}
+
+    def end_notes(self, attrs: dict) -> list[str]:
+        share = TcShare.from_attrs(attrs)
+        return [share.line()] + ([share.warning()] if share.warning() else [])
