@@ -31,6 +31,9 @@ INERTIA_K = {"disc": 0.5, "sphere": 0.4, "shell": 2.0 / 3.0, "point": 0.0}
 # below any contact time; more than 1e9 samples per run would not fit in memory anyway.
 #: Largest speed (walls, impacts, initial flow) and shear rate, in particle units.
 MAX_SPEED = 1e6
+#: Slowest design impact speed of a hardness target: k_n ∝ v², so 5e-324 gave k_n = 0 (a
+#: division by zero); particle speeds are O(1), and 1e-6 still gives a finite k_n.
+MIN_SPEED = 1e-6
 #: Shortest sample, checkpoint and servo interval, in time units.
 MIN_INTERVAL = 1e-9
 #: Most samples per run ((equilibration + production) / sample_interval).
@@ -335,7 +338,7 @@ class Hardness(StrictModel):
     """Stiffness chosen by a hardness target (one of them)."""
 
     overlap: Float | None = Field(default=None, ge=1e-6, lt=0.5)
-    impact_speed: Float | None = Field(default=None, gt=0.0, le=MAX_SPEED)
+    impact_speed: Float | None = Field(default=None, ge=MIN_SPEED, le=MAX_SPEED)
     k_star: Float | None = Field(default=None, gt=0.0)
     kappa: Float | None = Field(default=None, gt=0.0)
     pressure: Float | None = Field(default=None, gt=0.0)
