@@ -71,7 +71,7 @@ ODD_VALUES = st.one_of(
     st.sampled_from([[], [1.0], [1, "a"], [[1.0, 2.0]], [True, False], [0.0, 0.0, 0.0],
                      [1e300, 1e300], [-5.0, 10.0], [10.0, 10.0, 10.0, 10.0]]),
     st.sampled_from([{}, {"x": 1}, {"model": "nonsense"}, {"model": 3}]),
-)
+).map(copy.deepcopy)  # a fresh copy: the mutant changes it in place (two values)
 INVALID_UTF8 = [b"\xff", b"\xfe\xff", b"\xc3\x28", b"\xed\xa0\x80", b"\x80", b"\xf8\x88\x80"]
 
 
@@ -118,10 +118,17 @@ def mutants(draw) -> Mutant:
     name = draw(st.sampled_from(sorted(SCENES)))
     data = copy.deepcopy(SCENES[name])
     keys = {k for p in places(data) for k in p if isinstance(k, str)}
-    kind = draw(st.sampled_from(["value", "value", "value", "delete", "unknown", "nest",
-                                 "utf8"]))
+    kind = draw(st.sampled_from(["value", "value", "value", "two values", "delete",
+                                 "unknown", "nest", "utf8"]))
     how, depth = kind, 0
-    if kind in ("value", "delete", "nest"):
+    if kind == "two values":  # two fields at once: rules that relate fields
+        changed = []
+        for _ in range(2):
+            path = draw(st.sampled_from(places(data)))
+            at(data, path[:-1])[path[-1]] = value = draw(ODD_VALUES)
+            changed.append(f"{'.'.join(map(str, path))} = {value!r}")
+        how = f"values {'; '.join(changed)}"
+    elif kind in ("value", "delete", "nest"):
         path = draw(st.sampled_from(places(data)))
         parent, key = at(data, path[:-1]), path[-1]
         if kind == "delete":
@@ -234,14 +241,18 @@ def test_mutated_scenes_are_refused_by_name_or_agree(mutant, engine, folder, cap
     ("cooling/hcs-3d", "soft={ stiffness = 1e-6 }", "soft.stiffness = 1e-06"),
     # an overlap of 7e-151 d is lost in the positions: the model collision never touched
     ("cooling/hcs-3d", "soft={ stiffness = 1e300 }", "soft.stiffness = 1e+300"),
+    # k_n = k* γ̇² d underflowed to 0: ZeroDivisionError traceback in validate
+    ("shear/lees-edwards-2d", "shear.rate=5e-324", "shear.rate = 4.94066e-324"),
+    # the soft engines' damping root search failed: "error: math domain error", exit 1
+    ("cooling/hcs-3d", "contact.restitution=5e-324", "contact.restitution = 5e-324"),
 ])
 @pytest.mark.parametrize("engine", ["lammps", "edmd"])
-def test_contacts_no_engine_can_model_are_refused_by_validate_and_run(
+def test_values_the_fuzzer_broke_are_refused_by_validate_and_run(
         scene, change, named, engine, tmp_path, capsys):
     """Contacts so soft that particles pass through each other, or so stiff that the overlap
-    is lost in double precision: validate and run (also the event-driven engine, for which
-    the scene as a whole is invalid) refuse them with exit 2 naming the field, and write
-    nothing."""
+    is lost in double precision, and restitutions no soft engine can damp for: validate and
+    run (also the event-driven engine, for which the scene as a whole is invalid) refuse them
+    with exit 2 naming the field, and write nothing."""
     code, err = cli(capsys, "validate", scene, "--set", change)
     assert code == 2 and named in err, err
     out = tmp_path / "out"

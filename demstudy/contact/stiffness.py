@@ -185,7 +185,10 @@ def stiffness_problem(scene: Scene) -> str | None:
     """Why the scene's given stiffness or hardness target cannot model hard particles (its
     estimated overlap, :func:`estimated_overlap`, outside ``OVERLAP_RANGE``), naming the
     field; None when it can or when nothing fixes k_n before a run (a pilot)."""
-    overlap = estimated_overlap(scene)
+    try:
+        overlap = estimated_overlap(scene)
+    except (ZeroDivisionError, OverflowError):  # k_n underflowed to 0 (k* at γ̇ = 5e-324)
+        overlap = math.inf
     low, high = OVERLAP_RANGE
     if math.isnan(overlap):
         return None  # the stiffness is not defined by the scene alone
@@ -196,6 +199,8 @@ def stiffness_problem(scene: Scene) -> str | None:
                     else ("soft.hardness", soft.hardness.model_dump(exclude_none=True)))
     what = ("so soft that the particles would pass through each other" if overlap >= high
             else "so stiff that the overlap is lost in double-precision positions")
+    if soft.hardness is not None and soft.hardness.k_star is not None and scene.shear:
+        what += f" (k_n = k* γ̇² d with shear.rate = {scene.shear.rate:g})"
     return (f"{field} = {value}: contacts {what} (estimated head-on overlap {overlap:.3g} d "
             f"at the impact speed {reference_speed(scene):.3g}); allowed: a stiffness giving "
             f"an overlap between {low:g} d and {high:g} d (hard particles: about 0.001-0.01 d)")

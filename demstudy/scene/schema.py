@@ -34,6 +34,10 @@ MAX_SPEED = 1e6
 #: Slowest design impact speed of a hardness target: k_n ∝ v², so 5e-324 gave k_n = 0 (a
 #: division by zero); particle speeds are O(1), and 1e-6 still gives a finite k_n.
 MIN_SPEED = 1e-6
+#: Smallest normal restitution: the soft engines' damping for e is found by root search over
+#: model collisions, which fails below ~1e-100 (e = 5e-324 ended in "math domain error");
+#: measured restitutions are ≥ 0.1, so 1e-6 loses nothing.
+MIN_RESTITUTION = 1e-6
 #: Shortest sample, checkpoint and servo interval, in time units.
 MIN_INTERVAL = 1e-9
 #: Most samples per run ((equilibration + production) / sample_interval).
@@ -146,7 +150,7 @@ class RestitutionLaw(StrictModel):
 class Contact(StrictModel):
     """Particle–particle collisions: normal restitution e and a tangential rule."""
 
-    restitution: Float = Field(gt=0.0, le=1.0)
+    restitution: Float = Field(ge=MIN_RESTITUTION, le=1.0)
     law: RestitutionLaw = RestitutionLaw()
     tangential: Tangential = Smooth(model="smooth")
 
@@ -231,7 +235,7 @@ class Wall(StrictModel):
     side: Literal["lower", "upper"]
     position: Float | None = None
     kind: Literal["flat", "bumpy"] = "flat"
-    restitution: Float = Field(gt=0.0, le=1.0)
+    restitution: Float = Field(ge=MIN_RESTITUTION, le=1.0)
     tangential: WallTangential = Smooth(model="smooth")
     velocity: Float = Field(default=0.0, ge=-MAX_SPEED, le=MAX_SPEED)
     servo: Servo | None = None
