@@ -3,8 +3,9 @@
 ``demstudy run`` in this process, through the CLI's ``main``.
 
 Mutations: a value replaced (wrong types, booleans, strings for numbers, NaN, ±inf, huge,
-tiny, negative, zero, arrays, tables), a key removed, an unknown key added, a value nested
-far too deep, invalid UTF-8 bytes inserted. Asserted for each mutant:
+tiny, negative, zero, arrays, tables), two values at once, a key removed, an unknown key
+added, a value nested far too deep, invalid UTF-8 bytes inserted, a ``--set`` override as
+typed. Asserted for each mutant:
 
 * no traceback and no uncaught exception: ``validate`` exits 0 or 2;
 * every refusal names the file, and each of its problems names a field of the scene (or,
@@ -72,6 +73,8 @@ ODD_VALUES = st.one_of(
                      [1e300, 1e300], [-5.0, 10.0], [10.0, 10.0, 10.0, 10.0]]),
     st.sampled_from([{}, {"x": 1}, {"model": "nonsense"}, {"model": 3}]),
 ).map(copy.deepcopy)  # a fresh copy: the mutant changes it in place (two values)
+SET_TEXTS = ["nan", "inf", "-1", "0", "1e400", "5e-324", "true", "'0.5'", "[1,", "{a = 1}",
+             "", "[]", "[[[[[[1]]]]]]", "x" * 200, "1e300", "{ model = 'beta' }", "\u00e9"]
 INVALID_UTF8 = [b"\xff", b"\xfe\xff", b"\xc3\x28", b"\xed\xa0\x80", b"\x80", b"\xf8\x88\x80"]
 
 
@@ -108,6 +111,7 @@ class Mutant:
     how: str
     text: bytes
     keys: set[str]  # every key name of the original and the mutant (what a message may name)
+    overrides: tuple[str, ...] = ()  # --set arguments given with it
 
     def __repr__(self) -> str:  # what hypothesis prints for a failing example
         return f"Mutant({self.scene}: {self.how})"
@@ -119,7 +123,7 @@ def mutants(draw) -> Mutant:
     data = copy.deepcopy(SCENES[name])
     keys = {k for p in places(data) for k in p if isinstance(k, str)}
     kind = draw(st.sampled_from(["value", "value", "value", "two values", "delete",
-                                 "unknown", "nest", "utf8"]))
+                                 "unknown", "nest", "utf8", "--set"]))
     how, depth = kind, 0
     if kind == "two values":  # two fields at once: rules that relate fields
         changed = []
@@ -140,6 +144,13 @@ def mutants(draw) -> Mutant:
             parent[key] = draw(ODD_VALUES)
             how = f"{kind} {'.'.join(map(str, path))} = {parent[key]!r}"
         how = how if kind == "value" else f"{kind} {'.'.join(map(str, path))}"
+    elif kind == "--set":  # the file intact, a command-line override as typed
+        path = draw(st.sampled_from(places(data)))
+        dotted = ".".join(map(str, path))
+        text = draw(st.sampled_from(SET_TEXTS))
+        keys |= {k for p in places(data) for k in p if isinstance(k, str)}
+        return Mutant(name, f"--set {dotted}={text}", dump_toml(data).encode(), keys,
+                      ("--set", f"{dotted}={text}"))
     elif kind == "unknown":
         path = draw(st.sampled_from(tables(data)))
         at(data, path)["unknown_key"] = draw(ODD_VALUES)
@@ -204,7 +215,7 @@ def test_mutated_scenes_are_refused_by_name_or_agree(mutant, engine, folder, cap
     monkeypatch.setattr(plan, "run_pilot", skip_pilot)
     path = folder / "scene.toml"
     path.write_bytes(mutant.text)
-    code, err = cli(capsys, "validate", str(path))
+    code, err = cli(capsys, "validate", str(path), *mutant.overrides)
     event(f"validate exit {code}")
     assert code in (0, 2), f"{mutant}: validate exit {code}: {err}"
     if code == 2:
@@ -212,14 +223,14 @@ def test_mutated_scenes_are_refused_by_name_or_agree(mutant, engine, folder, cap
         out = folder / "out"
         out.mkdir(exist_ok=True)
         for extra in (["--dry-run"], []):
-            run_code, run_err = cli(capsys, "run", str(path), "--engine", engine, "--out",
-                                    str(out / "r.h5"), "-q", *extra)
+            run_code, run_err = cli(capsys, "run", str(path), *mutant.overrides, "--engine",
+                                    engine, "--out", str(out / "r.h5"), "-q", *extra)
             assert run_code == 2, f"{mutant}: validate refused, run exit {run_code}: {run_err}"
             assert not list(out.iterdir()), f"{mutant}: refused, yet wrote {list(out.iterdir())}"
         return
     try:
-        run_code, run_err = cli(capsys, "run", str(path), "--engine", engine, "--out",
-                                str(folder / "r.h5"), "-q", "--dry-run")
+        run_code, run_err = cli(capsys, "run", str(path), *mutant.overrides, "--engine",
+                                engine, "--out", str(folder / "r.h5"), "-q", "--dry-run")
     except PilotSkipped:
         event("dry run reached the pilot")
         return  # the scene got as far as the engine's pilot: not refused
