@@ -212,12 +212,15 @@ def _die_with_parent() -> None:
 
 
 def _tell_parent(path: Path, message: str) -> None:
-    """The child's error, for the parent's exception (rank 0 writes it; best effort)."""
+    """The child's error, for the parent's exception, which prints it (rank 0 writes it; best
+    effort: where it could not, the child prints it itself, so it is said once)."""
     if os.environ.get("PMI_RANK", "0") == "0":
         try:
             path.write_text(message)
+            return
         except OSError:
             pass
+    print(f"error: {message}", file=sys.stderr)
 
 
 def worker(job: str) -> int:
@@ -256,11 +259,9 @@ def run_in_child(backend, scene: Scene, options: RunOptions, error: Path) -> int
     except RunStopped:
         return STOPPED  # the parent says so, once
     except (UnsupportedByEngine, SceneError, DamagedCheckpoint) as exc:  # nothing ran
-        print(f"error: {exc}", file=sys.stderr)
         _tell_parent(error, str(exc))
         return REFUSED
     except Exception as exc:  # one line, never a bare traceback
-        print(f"error: {type(exc).__name__}: {exc}", file=sys.stderr)
         _tell_parent(error, f"{type(exc).__name__}: {exc}")
         return FAILED
     return 0
