@@ -1,5 +1,5 @@
 """Command line: ``demstudy validate | deck | run | plot | analyze | compare | forecast |
-calibrate | cost | engine-map``.
+calibrate | cost | engine-map | stability``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
@@ -296,7 +296,9 @@ def _cmd_cost(args: argparse.Namespace) -> int:
                  workers=args.workers, dask=args.dask, out=args.out,
                  replicas=_whole("--replicas", args.replicas),
                  reference_replicas=_whole("--reference-replicas", args.reference_replicas),
-                 dry_run=args.dry_run)
+                 dry_run=args.dry_run,
+                 engines=[e.strip() for e in ",".join(args.engine).split(",") if e.strip()]
+                 if args.engine else None)
     if not args.dry_run:
         print(text_report(study))
     return 0
@@ -320,6 +322,27 @@ def _cmd_engine_map(args: argparse.Namespace) -> int:
                         workers=args.workers)
     print("outputs: " + ", ".join(str(p) for p in result.written))
     return 0
+
+
+def _cmd_stability(args: argparse.Namespace) -> int:
+    from .stability import case_names, run_suite
+    from .stability.report import format_row, format_text, write_outputs
+
+    if args.list:
+        from .stability import CASES
+
+        for name in case_names():
+            c = CASES[name]
+            print(f"{name} ({c.engine or c.kind}): {c.checks}; limit: {c.limit}")
+        return 0
+    suite = run_suite(args.engine, args.case, quick=args.quick,
+                      progress=lambda row: print(format_row(row), flush=True))
+    print(format_text(suite).rsplit("\n", 1)[-1])
+    command = " ".join(["demstudy", "stability", *(sys.argv[1:] if args.argv is None
+                                                   else args.argv)[1:]])
+    written = write_outputs(suite, args.out, command=command)
+    print("written: " + ", ".join(str(p) for p in written))
+    return 1 if suite.failed else 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -501,6 +524,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", metavar="S1,S2,...",
                    help="steps per contact, each >= 10 (default 10,50,200)")
     p.add_argument("--models", metavar="hooke,hertz", help="contact models (default both)")
+    p.add_argument("--engine", action="append", metavar="lammps,liggghts",
+                   help="soft-contact engines of the ladder (default lammps; repeat or list "
+                        "several: every soft setting runs in each)")
     p.add_argument("--tolerance", type=float, default=0.02,
                    help="relative profile error to meet (default 0.02)")
     p.add_argument("--workers", type=int, help="local processes (default: the cores)")
@@ -541,6 +567,26 @@ def build_parser() -> argparse.ArgumentParser:
                    help="two points per dimension (fraction 0.3, e = 0.7 and 0.9), very "
                         "short runs, one repeat")
     p.set_defaults(func=_cmd_engine_map)
+
+    p = sub.add_parser("stability", help="hard cases in every engine where they mean "
+                                         "something: a pass/fail table (docs/stability.md)",
+                       description="Runs the suite of hard cases (very stiff and very soft "
+                                   "contacts, energy drift, fast impacts, too large time "
+                                   "steps, dense shear, servo walls, inelastic collapse, "
+                                   "resting beds, t_c dependence) in every engine whose kind "
+                                   "they suit, prints the table and writes it as Markdown, "
+                                   "CSV and JSON. Exit 1 when a row fails.")
+    p.add_argument("--engine", action="append", metavar="ENGINE",
+                   help=f"engines ({', '.join(engines)}; default all; repeatable)")
+    p.add_argument("--case", action="append", metavar="NAME",
+                   help="cases (default all; repeatable; --list shows them)")
+    p.add_argument("--quick", action="store_true",
+                   help="the short version of every case (about a minute in all)")
+    p.add_argument("--out", default=str(Path("results") / "stability.md"),
+                   help="Markdown table (default results/stability.md; .csv and .json "
+                        "next to it); the committed one is docs/stability.md")
+    p.add_argument("--list", action="store_true", help="list the cases and stop")
+    p.set_defaults(func=_cmd_stability)
     return parser
 
 
@@ -559,6 +605,7 @@ def main(argv: list[str] | None = None) -> int:
     from .io.results import COMMAND_LINE_ENV, set_command_line
 
     args = build_parser().parse_args(argv)
+    args.argv = argv
     previous = os.environ.get(COMMAND_LINE_ENV)
     set_command_line(["demstudy", *(sys.argv[1:] if argv is None else argv)])
     try:

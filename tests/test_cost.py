@@ -79,6 +79,22 @@ def test_recommendation_names_the_cheaper_engine_and_the_cost_ratio():
     assert "caution" in recommend(None, 1.0, 0.02, 0.05)
 
 
+def test_every_soft_setting_runs_in_each_soft_engine_under_its_own_name():
+    from demstudy.accuracy.plan import soft_ladder
+
+    specs = soft_ladder([1e3], [10.0], ["hooke"], ["lammps", "liggghts"])
+    assert [(s.engine, s.name) for s in specs] == [
+        ("lammps", "soft-hooke-k1e+3-s10"), ("liggghts", "soft-liggghts-hooke-k1e+3-s10")]
+    soft = {"name": specs[1].name, "engine": "liggghts", "wall_seconds": 2.0, "error": 0.01}
+    assert recommend_text(soft).startswith("soft contacts (liggghts)")
+
+
+def recommend_text(choice: dict) -> str:
+    from demstudy.accuracy.analyze import recommend
+
+    return recommend(choice, 8.0, 0.02, 0.005)
+
+
 def test_pareto_front_keeps_the_non_dominated_runs():
     points = [(1.0, 0.5), (2.0, 0.6), (3.0, 0.1), (4.0, 0.1), (5.0, 0.01)]
     assert pareto_front(points) == [(1.0, 0.5), (3.0, 0.1), (5.0, 0.01)]
@@ -210,6 +226,8 @@ def test_ladder_runs_on_a_dask_local_cluster(tmp_path):
     (["--replicas", "-2"], "--replicas"),
     (["--replicas", "two"], "--replicas"),
     (["--replicas", "2", "--reference-replicas", "0"], "--reference-replicas"),
+    (["--engine", "edmd"], "--engine"),  # the reference is not a soft engine
+    (["--engine", "lammps,gromacs"], "gromacs"),
 ])
 def test_cli_refuses_bad_input_naming_the_option(argv, named, capsys, tmp_path):
     (tmp_path / "FILE").write_text("not a folder")

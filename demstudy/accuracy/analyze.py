@@ -140,7 +140,8 @@ def recommend(choice: dict | None, reference_seconds: float, tolerance: float,
         return (f"event-driven (edmd): no soft run met the tolerance {tolerance:g}; the "
                 f"reference took {reference_seconds:.3g} s{caveat}")
     ratio = choice["wall_seconds"] / reference_seconds
-    engine = "soft contacts (lammps)" if ratio < 1 else "event-driven (edmd)"
+    engine = (f"soft contacts ({choice.get('engine', 'lammps')})" if ratio < 1
+              else "event-driven (edmd)")
     return (f"{engine} at tolerance {tolerance:g}: cheapest soft run {choice['name']} "
             f"({choice['wall_seconds']:.3g} s, error {choice['error']:.3g}) costs "
             f"{ratio:.3g} x the event-driven reference ({reference_seconds:.3g} s){caveat}")

@@ -32,15 +32,19 @@ MAYBE = "tc-ladder?"
 PHASES = ("reference", "tc-ladder", MAYBE, "soft")
 
 
-def measure_machine(dim: int, models: Sequence[str]) -> str | None:
-    """Measure (or find cached) this machine's costs for the ladder's engines: LAMMPS with
-    each contact model and the event-driven engine, in ``dim`` dimensions. Returns why not
-    (None when all are known): measuring forbidden (``DEMSTUDY_MEASURE_RATES=0``) or failed."""
+def measure_machine(dim: int, models: Sequence[str],
+                    engines: Sequence[str] = ("lammps",)) -> str | None:
+    """Measure (or find cached) this machine's costs for the ladder's engines: each soft
+    engine with each contact model and the event-driven engine, in ``dim`` dimensions.
+    Returns why not (None when all are known): measuring forbidden
+    (``DEMSTUDY_MEASURE_RATES=0``) or failed."""
     from ..simulation.forecast import RatesNotMeasured, measure_costs
+    from ..simulation.plan import FORECAST_ENGINES
 
     try:
-        for model in models:
-            measure_costs("lammps", dim, model)
+        for engine in (e for e in engines if e in FORECAST_ENGINES):  # others: no benchmark
+            for model in models:
+                measure_costs(engine, dim, model)
         measure_costs("edmd", dim)
     except RatesNotMeasured as exc:
         return str(exc)

@@ -18,6 +18,7 @@ with errors from their scatter (``demstudy.comparison.combine_replicas``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from ..contact import mapping
@@ -57,8 +58,9 @@ def stiffness_scale(scene: Scene) -> StiffnessScale:
 @dataclass(frozen=True)
 class RunSpec:
     """One run of the ladder: the reference (``engine = 'edmd'``, ``tc``) or a soft run
-    (``engine = 'lammps'``, ``model``, ``kstar``, ``steps`` per contact); ``replica`` i of
-    several: the scene's seed + i (``None``: the run alone, the scene's seed)."""
+    (``engine = 'lammps'`` or another soft engine, ``model``, ``kstar``, ``steps`` per
+    contact); ``replica`` i of several: the scene's seed + i (``None``: the run alone, the
+    scene's seed)."""
 
     engine: str
     model: str | None = None
@@ -90,7 +92,10 @@ class RunSpec:
     def settings(self) -> str:
         """The name without the replica suffix: one row of the ladder."""
         if self.soft:
-            return f"soft-{self.model}-k{self.kstar:.3g}-s{self.steps:g}".replace("+0", "+")
+            # LAMMPS's runs keep their names from before other soft engines existed
+            engine = "" if self.engine == "lammps" else f"{self.engine}-"
+            return (f"soft-{engine}{self.model}-k{self.kstar:.3g}-s{self.steps:g}"
+                    .replace("+0", "+"))
         return f"ref-{self.engine}-tc{self.tc:.3g}"
 
     def options(self) -> dict:
@@ -130,10 +135,12 @@ def replicate(specs: list[RunSpec], replicas: int) -> list[RunSpec]:
     return [replace(s, replica=i) for s in specs for i in range(replicas)]
 
 
-def soft_ladder(kstars: list[float], steps: list[float], models: list[str]) -> list[RunSpec]:
-    """Every combination, cheapest first (soft stiffness and steps raise the cost)."""
-    return [RunSpec("lammps", m, k, s) for k in sorted(kstars) for s in sorted(steps)
-            for m in models]
+def soft_ladder(kstars: list[float], steps: list[float], models: list[str],
+                engines: Sequence[str] = ("lammps",)) -> list[RunSpec]:
+    """Every combination, in each soft engine, cheapest first (soft stiffness and steps
+    raise the cost)."""
+    return [RunSpec(e, m, k, s) for k in sorted(kstars) for s in sorted(steps)
+            for m in models for e in engines]
 
 
 def reference_ladder(default_tc: float) -> list[RunSpec]:

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..engines import backend_names, get_backend
 from ..errors import BadOption
 from ..scene import Scene, load_scene, scene_to_toml
 from . import analyze
@@ -120,6 +121,17 @@ def connect(address: str):
                         "scheduler) or check the address") from None
 
 
+def _soft_engines(engines: Sequence[str] | None) -> list[str]:
+    """The ladder's soft engines, checked: registered, time-stepped (soft contacts)."""
+    names = ["lammps"] if engines is None else list(dict.fromkeys(engines))
+    known = [n for n in backend_names() if get_backend(n).capabilities.time_step]
+    bad = [n for n in names if n not in known]
+    if bad or not names:
+        raise BadOption("--engine", bad or names,
+                        f"soft-contact engines ({', '.join(known)}) are allowed")
+    return names
+
+
 def _count(name: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise BadOption(name, value, "a whole number of runs >= 1 is allowed")
@@ -132,7 +144,7 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
          out: str | os.PathLike | None = None, overrides: Sequence[str] = (),
          quick: bool = False, tc_ladder: bool | None = None, figure: bool = True,
          replicas: int = 1, reference_replicas: int | None = None, dry_run: bool = False,
-         progress=print) -> CostStudy:
+         engines: Sequence[str] | None = None, progress=print) -> CostStudy:
     """Run (or resume) the cost ladder of ``scene`` and write its table, summary and figure
     into ``out`` (default ``results/cost/<scene name>/``, made absolute). ``kstars``:
     dimensionless stiffnesses (``plan.stiffness_scale``; default 1e3…1e6), ``steps``: steps
@@ -146,6 +158,10 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
     times; ``reference_replicas``: the same for the reference (default ``replicas``; the
     event-driven reference is cheap). The forecast of the whole ladder (``study.forecast``)
     is printed first; ``dry_run``: print it and stop (nothing runs, nothing is written).
+    ``engines``: the soft-contact engines of the ladder (default ``lammps``; ``liggghts`` too:
+    every soft setting runs in each, runs of other engines than LAMMPS are named
+    ``soft-ENGINE-…``); an engine that cannot express the scene is refused before anything
+    runs.
     ``progress``: called with one line per event. Bad values raise ``BadOption`` before
     anything runs."""
     replicas = _count("--replicas", replicas)
@@ -166,6 +182,7 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
     bad = [m for m in models if m not in ("hooke", "hertz")]
     if bad or not models:
         raise BadOption("--models", bad or list(models), "hooke and/or hertz are allowed")
+    engines = _soft_engines(engines)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                 or workers < 1):
         raise BadOption("--workers", workers, "a whole number of processes >= 1 is allowed")
@@ -176,6 +193,8 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
         scene = load_scene(scene, overrides, **sections)
     elif quick:
         scene = scene.model_copy(update={"run": scene.run.model_copy(update=QUICK["run"])})
+    for engine in engines:  # refuse before anything runs, naming the field
+        get_backend(engine).check(scene, None)
     # absolute: Dask workers (and pool workers) in another directory write into this folder
     folder = check_folder(Path(out or Path("results") / "cost" / scene.meta.name))
     workers = workers or os.cpu_count() or 1
@@ -194,7 +213,7 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
                            f"run (seeds {scene.run.seed}, {scene.run.seed + 1}, …); errors "
                            "from their scatter, cost = the SUM of their wall times")
     refs = [replicate([r], reference_replicas) for r in reference_ladder(DEFAULT_TC)]
-    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, models)]
+    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, models, engines)]
     # an unreachable scheduler is refused before anything runs (a dry run runs nothing)
     client = connect(dask) if isinstance(dask, str) and not dry_run else dask
     try:
@@ -221,7 +240,8 @@ def _study(study: CostStudy, scene: Scene, client: Any, dask: Any,
     phases.pop("none", None)
     study.forecast = ladder_forecast(phases, None if dask is not None else workers,
                                      measure_machine(scene.dimension, sorted(
-                                         {g[0].model for g in softs})))
+                                         {g[0].model for g in softs}), sorted(
+                                         {g[0].engine for g in softs})))
     study.timings["forecast"] = time.perf_counter() - started
     for line in study.forecast.lines():
         progress(line)
