@@ -96,12 +96,19 @@ def fake_cases(monkeypatch):
     def breaking(engine, quick, folder):
         raise ZeroDivisionError("division by zero in the case")
 
+    def explaining(engine, quick, folder):
+        return Outcome("9.0", False, "9 is above the limit", "a documented cause, measured")
+
+    def passing_with_cause(engine, quick, folder):  # within the limit: a cause changes nothing
+        return Outcome("2.0", True, "fine", "a documented cause, measured")
+
     def scene_run(engine, quick, folder):  # a real scene through the loop
         from demstudy.stability.soft import very_soft
         return very_soft(engine, quick, folder)
 
     cases = {name: Case(name, SOFT, f"{name} checks", "< 5", run) for name, run in
-             (("p", passing), ("f", failing), ("b", breaking), ("s", scene_run))}
+             (("p", passing), ("f", failing), ("b", breaking), ("s", scene_run),
+              ("x", explaining), ("px", passing_with_cause))}
     monkeypatch.setattr("demstudy.stability.registry.CASES", cases)
 
     class RefusingSoft(BallisticBackend):
@@ -132,6 +139,22 @@ def test_fail_refused_and_error_rows(fake_cases, tmp_path):
     assert {r.case for r in suite.failed} == {"f", "b"}
     text = format_text(suite)
     assert "FAIL    f [refusing-soft]" in text and "refused" in text
+
+
+def test_an_explained_row_is_neither_pass_nor_fail(fake_cases, tmp_path, capsys):
+    """A figure outside its limit whose cause the case measured is "explained": listed with
+    the cause in its note, counted apart, not a failure (the CLI exits 0)."""
+    suite = run_suite(["lammps"], ["x", "px", "p"], quick=True, workdir=tmp_path)
+    status = {r.case: r.status for r in suite.rows}
+    assert status == {"x": "explained", "px": "pass", "p": "pass"}
+    row = row_of(suite.rows, "x", "lammps")
+    assert row.note == "explained: a documented cause, measured; 9 is above the limit"
+    assert suite.failed == []
+    assert "1 explained" in format_text(suite)
+    assert "| **explained** |" in format_markdown(suite)
+    assert main(["stability", "--engine", "lammps", "--case", "x",
+                 "--out", str(tmp_path / "s.md")]) == 0
+    assert "explained x [lammps]" in capsys.readouterr().out
 
 
 def test_unknown_case_or_engine_is_refused_before_running():
