@@ -59,6 +59,17 @@ def test_a_time_step_too_large_for_the_contact_is_flagged():
     assert "min_steps_per_contact" in row.note and "greater than or equal to 10" in row.note
 
 
+def test_dense_rough_shear_is_explained_as_the_elastic_regime():
+    """Rough soft discs (β = 0) sheared at ν = 0.82: outside the limits (overlaps, heat), and
+    the case measures why: 10 x k_n leaves the mean overlap (quick: 0.74 of it; a collisional
+    flow: 10^-1/2) and doubles the heat about the shear profile (2.3 x), contacts persist."""
+    (row,) = ds.stability(engines=["lammps"], cases=["dense-shear-2d"], quick=True)
+    assert row.status == "explained", row.note
+    assert row.note.startswith("explained: elastic regime")
+    heat = float(row.measured.split("(heat ")[1].split(" x")[0])
+    assert heat > 2.0  # soft heat against the event-driven run's (quick: 6.9 x)
+
+
 def test_hard_resting_cases_pass_in_edmd():
     rows = ds.stability(engines=["edmd"], cases=["ball-rests-on-floor", "rests-on-bump",
                                                   "tc-prevents-collapse"], quick=True)
