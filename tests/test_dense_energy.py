@@ -63,7 +63,7 @@ def test_dense_elastic_free_cooling_never_gains_energy(tmp_path, tangential):
 
 def test_dense_rough_shear_heat_is_shear_work(tmp_path):
     """Lees–Edwards shear at ν = 0.82, e = 0.7, β = 0, the automatic k_n: the dissipated
-    energy W − ΔE never decreases (measured: largest dip 5e-7 W), while the shear stress is
+    energy W − ΔE never decreases (measured: largest dip 1e-6 W), while the shear stress is
     ~65 x that of smooth contacts (946 vs 14 in m/τ² per d over t in [0.5, 2]): the rough
     flow is shear-jammed in the elastic regime, its heat is work done on stiff contacts."""
     work = {}
@@ -84,4 +84,4 @@ def test_dense_rough_shear_heat_is_shear_work(tmp_path):
         work[name] = a.work[-1]
         if name == "rough":
             assert np.mean(a.coordination[late]) > 2.5  # measured 3.2: a contact network
-    assert work["rough"] > 10 * work["smooth"]  # measured ~30 x over t <= 1
+    assert work["rough"] > 10 * work["smooth"]  # measured 21 x over t <= 1
