@@ -151,6 +151,7 @@ def fast_impacts(engine: str, quick: bool, folder: Path) -> Outcome:
     walls = [[18.0, 0.7, 2.5, 0.0, -v, 0.0],  # head-on onto the lower wall
              [24.0, 0.7, 7.5, s, -c, 0.0]]  # 30° from the wall normal
     figures, notes, refused, ok = [], [], [], True
+    undetected = False  # a failure other than a loss the engine stopped on and named
     for model in ("hooke", "hertz"):
         soft = {"model": model, "hardness": {"overlap": DEFAULT_OVERLAP,
                                              "impact_speed": TYPICAL_SPEED}}
@@ -167,14 +168,15 @@ def fast_impacts(engine: str, quick: bool, folder: Path) -> Outcome:
                 continue
             except EngineError as exc:
                 ok = False
-                lost = "Lost atoms" in str(exc)
+                lost = "lost" in str(exc).lower()
+                undetected |= not (lost and model == "hooke")
                 figures.append(f"{model} {what}: " + ("lost" if lost else "failed"))
                 notes.append(f"{model} {what}: the run stopped: "
                              f"{str(exc).splitlines()[0][-160:]}")
                 continue
             broken = all_there(res, len(rows))
             if broken:
-                ok = False
+                ok, undetected = False, True
                 figures.append(f"{model} {what}: {broken}")
                 continue
             pos, vel = np.asarray(res.frames["position"]), np.asarray(res.frames["velocity"])
@@ -183,19 +185,33 @@ def fast_impacts(engine: str, quick: bool, folder: Path) -> Outcome:
                 for i, j in ((0, 1), (2, 3)):
                     dist = _min_pair_distance(pos, i, j, 30.0)
                     closest = min(closest, float(dist.min()))
-                    ok &= bool(dist.min() > 0.0 and vel[-1, j, 0] > vel[-1, i, 0]
-                               and pos[-1, j, 0] > pos[-1, i, 0])
+                    # receding along the line of centres at the end (an oblique pair may
+                    # pass each other in x without any overlap: that is no tunnelling)
+                    sep = pos[-1, j] - pos[-1, i]
+                    sep[0] -= 30.0 * np.round(sep[0] / 30.0)
+                    held = bool(dist.min() > 0.0 and sep @ (vel[-1, j] - vel[-1, i]) > 0)
+                    ok &= held
+                    undetected |= not held
                 figures.append(f"{model} pairs {closest:.2g} d")
             else:
                 lowest = float(pos[..., 1].min())  # the lower wall stays at y = 0
-                ok &= bool(lowest > 0.0 and (vel[-1, :, 1] > 0).all())
+                held = bool(lowest > 0.0 and (vel[-1, :, 1] > 0).all())
+                ok &= held
+                undetected |= not held
                 figures.append(f"{model} walls {lowest:.2g} d")
             notes.append(f"{model} {what}: dt {setup.timestep:.3g}, max overlap "
                          f"{res.group_attrs['health']['max_overlap']:.3g} d")
     if not figures:  # the engine refused every run: the row is "refused"
         raise UnsupportedByEngine(engine, "fast-impacts", "all runs", "; ".join(refused))
+    # a Hooke contact made for an overlap of 0.005 d at speed 1 overlaps ≈ v √(m_eff/k_n):
+    # 0.5 d for a pair, 0.71 d at a wall (m_eff = m) at 100 x, so the centre passes the wall
+    # plane; what matters is that the engine stops and names it, never silently
+    explained = "" if ok or undetected else (
+        "a Hooke wall contact sized for speed 1 overlaps ~0.71 d at 100 x (v sqrt(m/k_n)): "
+        "the centre crosses the wall plane and the engine stops with its lost-atom error "
+        "naming the cause (too soft for the impact speeds); pairs and Hertz contacts hold")
     return Outcome("; ".join(figures), ok, "closest centre distance (pairs) and lowest "
-                   "centre above the wall (walls); " + "; ".join(notes + refused))
+                   "centre above the wall (walls); " + "; ".join(notes + refused), explained)
 
 
 # -- a time step too large for the contact ----------------------------------------------------
