@@ -598,6 +598,7 @@ def main(argv: list[str] | None = None) -> int:
         BadOption,
         EngineError,
         NotComparable,
+        RunAborted,
         RunRefused,
         RunStopped,
         StatisticUnavailable,
@@ -615,6 +616,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         if isinstance(exc, RunStopped):
             return 3  # checkpoint written: run again with --resume
+        if isinstance(exc, RunAborted):
+            return 130  # a second Ctrl-C: as a shell reports SIGINT (128 + 2)
         refused = (SceneError | UnsupportedByEngine | RunRefused | StatisticUnavailable
                    | BadOption | NotComparable | BadInputFile)
         return 2 if isinstance(exc, refused) else 1  # 2: nothing ran or was computed

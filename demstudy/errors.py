@@ -2,8 +2,10 @@
 
 ``SceneError`` (invalid scene, :mod:`demstudy.scene.load`) and ``UnsupportedByEngine`` (an
 engine cannot express what the scene or a run option asks for) are raised before any engine
-starts (exit 2); ``EngineError`` is a failure during a run (exit 1), ``RunStopped`` a run that
-stopped on request after a checkpoint (exit 3, continue with ``--resume``).
+starts (exit 2); ``EngineError`` is a failure during a run (exit 1; its subclass
+``RunRefused``, also ``demstudy.io.checksum.DamagedCheckpoint``, means nothing ran: exit 2),
+``RunStopped`` a run that stopped on request after a checkpoint (exit 3, continue with
+``--resume``).
 """
 
 from __future__ import annotations
@@ -26,6 +28,11 @@ class EngineError(RuntimeError):
 
 class RunStopped(EngineError):
     """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint."""
+
+
+class RunAborted(EngineError):
+    """A second Ctrl-C aborted the run without a new checkpoint (exit 130); the last one
+    written, if any, stays and ``--resume`` continues from it."""
 
 
 class StatisticUnavailable(ValueError):
@@ -59,6 +66,7 @@ class RunRefused(EngineError):
     """The engine refused the scene or the options (reported by an engine's child process)."""
 
 
-__all__ = ["BadInputFile", "BadOption", "EngineError", "NotComparable", "RunRefused", "RunStopped",
+__all__ = ["BadInputFile", "BadOption", "EngineError", "NotComparable", "RunAborted", "RunRefused",
+           "RunStopped",
            "StatisticUnavailable",
            "UnsupportedByEngine"]

@@ -208,3 +208,26 @@ def test_deep_values_refused_without_recursion(tmp_path):
     with pytest.raises(SceneError, match="meta.name = ") as info:
         load_scene(CHUTE, meta={"name": shallow})
     assert "nested" not in str(info.value)
+
+
+def test_damaged_checkpoint_given_to_resume_exits_2_naming_it(tmp_path, capsys):
+    """A damaged checkpoint is bad input given with --resume: the CLI refuses it with exit 2
+    (README: 2 = nothing ran) naming the file, for the isolated child run as for the
+    in-process one, writes no results file, and the intact checkpoint then resumes."""
+    scene = tmp_path / "couette.toml"
+    scene.write_text(dump_toml(COUETTE | {"particles": {"count": 20}}))
+    out = tmp_path / "r.h5"
+    args = ["run", str(scene), "--engine", "edmd", "--out", str(out), "-q"]
+    assert main([*args, "--wall-limit", "0"]) == 3  # stopped after a checkpoint
+    ckpt = tmp_path / "r.edmd" / "checkpoint.pkl"
+    intact = ckpt.read_bytes()
+    flipped = bytearray(intact)
+    flipped[len(flipped) // 2] ^= 0xFF
+    ckpt.write_bytes(bytes(flipped))
+    capsys.readouterr()
+    assert main([*args, "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert f"checkpoint {ckpt} is damaged" in err and "Traceback" not in err
+    assert not out.exists()
+    ckpt.write_bytes(intact)
+    assert main([*args, "--resume"]) == 0 and out.exists()

@@ -160,7 +160,8 @@ def test_generic_inputs():
     ("section", "key", "value", "expected"),
     [
         ("contact", "restitution", 1.5, ["contact.restitution", "1.5", "less than or equal to 1"]),
-        ("contact", "restitution", 0.0, ["contact.restitution", "0.0", "greater than 0"]),
+        ("contact", "restitution", 0.0,
+         ["contact.restitution", "0.0", "greater than or equal to 0.000001"]),
         ("contact", "tangential", {"model": "beta", "beta": 2.0},
          ["contact.tangential.beta", "2.0", "less than or equal to 1"]),
         ("contact", "tangential", {"model": "sticky"},

@@ -59,6 +59,17 @@ def test_a_time_step_too_large_for_the_contact_is_flagged():
     assert "min_steps_per_contact" in row.note and "greater than or equal to 10" in row.note
 
 
+def test_dense_rough_shear_is_explained_as_the_elastic_regime():
+    """Rough soft discs (β = 0) sheared at ν = 0.82: outside the limits (overlaps, heat), and
+    the case measures why: 10 x k_n leaves the mean overlap (quick: 0.74 of it; a collisional
+    flow: 10^-1/2) and doubles the heat about the shear profile (2.3 x), contacts persist."""
+    (row,) = ds.stability(engines=["lammps"], cases=["dense-shear-2d"], quick=True)
+    assert row.status == "explained", row.note
+    assert row.note.startswith("explained: elastic regime")
+    heat = float(row.measured.split("(heat ")[1].split(" x")[0])
+    assert heat > 2.0  # soft heat against the event-driven run's (quick: 6.9 x)
+
+
 def test_hard_resting_cases_pass_in_edmd():
     rows = ds.stability(engines=["edmd"], cases=["ball-rests-on-floor", "rests-on-bump",
                                                   "tc-prevents-collapse"], quick=True)
@@ -96,12 +107,19 @@ def fake_cases(monkeypatch):
     def breaking(engine, quick, folder):
         raise ZeroDivisionError("division by zero in the case")
 
+    def explaining(engine, quick, folder):
+        return Outcome("9.0", False, "9 is above the limit", "a documented cause, measured")
+
+    def passing_with_cause(engine, quick, folder):  # within the limit: a cause changes nothing
+        return Outcome("2.0", True, "fine", "a documented cause, measured")
+
     def scene_run(engine, quick, folder):  # a real scene through the loop
         from demstudy.stability.soft import very_soft
         return very_soft(engine, quick, folder)
 
     cases = {name: Case(name, SOFT, f"{name} checks", "< 5", run) for name, run in
-             (("p", passing), ("f", failing), ("b", breaking), ("s", scene_run))}
+             (("p", passing), ("f", failing), ("b", breaking), ("s", scene_run),
+              ("x", explaining), ("px", passing_with_cause))}
     monkeypatch.setattr("demstudy.stability.registry.CASES", cases)
 
     class RefusingSoft(BallisticBackend):
@@ -132,6 +150,22 @@ def test_fail_refused_and_error_rows(fake_cases, tmp_path):
     assert {r.case for r in suite.failed} == {"f", "b"}
     text = format_text(suite)
     assert "FAIL    f [refusing-soft]" in text and "refused" in text
+
+
+def test_an_explained_row_is_neither_pass_nor_fail(fake_cases, tmp_path, capsys):
+    """A figure outside its limit whose cause the case measured is "explained": listed with
+    the cause in its note, counted apart, not a failure (the CLI exits 0)."""
+    suite = run_suite(["lammps"], ["x", "px", "p"], quick=True, workdir=tmp_path)
+    status = {r.case: r.status for r in suite.rows}
+    assert status == {"x": "explained", "px": "pass", "p": "pass"}
+    row = row_of(suite.rows, "x", "lammps")
+    assert row.note == "explained: a documented cause, measured; 9 is above the limit"
+    assert suite.failed == []
+    assert "1 explained" in format_text(suite)
+    assert "| **explained** |" in format_markdown(suite)
+    assert main(["stability", "--engine", "lammps", "--case", "x",
+                 "--out", str(tmp_path / "s.md")]) == 0
+    assert "explained x [lammps]" in capsys.readouterr().out
 
 
 def test_unknown_case_or_engine_is_refused_before_running():

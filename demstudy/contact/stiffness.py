@@ -172,6 +172,40 @@ def estimated_overlap(scene: Scene) -> float:
     return max(mapping.hooke_max_overlap(kn, e_, m, speed) for e_, m, _ in cases)
 
 
+#: Range of the estimated head-on overlap (in d) a given stiffness or hardness may give.
+#: Above half a diameter a "collision" lets the particles pass through each other: no hard
+#: particle is modelled, and the restitution compensation's model collision never ends
+#: (k_n = 1e-6 and an impact_speed of 1e-6 ended in RuntimeError tracebacks). Below 1e-12 d
+#: the overlap is lost in double-precision positions (1e-16 relative: 1e-13 d in a box of
+#: 10³ d; the model collision never touched from 1e-15 d on, k_n = 1e30 in a unit-speed gas).
+OVERLAP_RANGE = (1e-12, 0.5)
+
+
+def stiffness_problem(scene: Scene) -> str | None:
+    """Why the scene's given stiffness or hardness target cannot model hard particles (its
+    estimated overlap, :func:`estimated_overlap`, outside ``OVERLAP_RANGE``), naming the
+    field; None when it can or when nothing fixes k_n before a run (a pilot)."""
+    try:
+        overlap = estimated_overlap(scene)
+    except (ZeroDivisionError, OverflowError):  # k_n underflowed to 0 (k* at γ̇ = 5e-324)
+        overlap = math.inf
+    low, high = OVERLAP_RANGE
+    if math.isnan(overlap):
+        return None  # the stiffness is not defined by the scene alone
+    if low <= overlap < high:
+        return None
+    soft = scene.soft
+    field, value = (("soft.stiffness", f"{soft.stiffness:g}") if soft.stiffness is not None
+                    else ("soft.hardness", soft.hardness.model_dump(exclude_none=True)))
+    what = ("so soft that the particles would pass through each other" if overlap >= high
+            else "so stiff that the overlap is lost in double-precision positions")
+    if soft.hardness is not None and soft.hardness.k_star is not None and scene.shear:
+        what += f" (k_n = k* γ̇² d with shear.rate = {scene.shear.rate:g})"
+    return (f"{field} = {value}: contacts {what} (estimated head-on overlap {overlap:.3g} d "
+            f"at the impact speed {reference_speed(scene):.3g}); allowed: a stiffness giving "
+            f"an overlap between {low:g} d and {high:g} d (hard particles: about 0.001-0.01 d)")
+
+
 def overlap_warning(scene: Scene) -> str | None:
     """A warning when the scene's contacts are so soft that the overlap at its reference
     speed exceeds the health limit LIMITS['max_overlap'] (the run would be valid but far

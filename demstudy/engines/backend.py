@@ -198,6 +198,11 @@ class BackendBase:
     def result_attrs(self) -> dict[str, Any]:
         return {}
 
+    def end_notes(self, attrs: dict[str, Any]) -> list[str]:
+        """Lines printed (stderr) when the run's results are written, from the results
+        file's root attributes ``attrs`` (the event-driven engine: the TC model's share)."""
+        return []
+
     def close(self) -> None:
         """Release the engine (called on every rank, also after a failure)."""
 

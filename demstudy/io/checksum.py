@@ -10,11 +10,13 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from ..errors import EngineError
+from ..errors import RunRefused
 
 
-class DamagedCheckpoint(EngineError):
-    """A checkpoint file whose bytes do not match the checksum written with them."""
+class DamagedCheckpoint(RunRefused):
+    """A checkpoint file whose bytes do not match the checksum written with them: bad input
+    given with ``--resume``, refused before the engine reads it (exit 2 on the command line,
+    like every refused run; an ``EngineError`` still, for callers that catch those)."""
 
     def __init__(self, path: Path):
         self.path = path

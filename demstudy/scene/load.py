@@ -73,12 +73,18 @@ def validate_scene(data: Mapping[str, Any], source: str = "<scene>") -> Scene:
         raise SceneError(source, [f"(top level): expected a table, got {type(data).__name__}"])
     check_depth(data, source)
     try:
-        return Scene.model_validate(dict(data))
+        scene = Scene.model_validate(dict(data))
     except ValidationError as exc:
         problems = list(dict.fromkeys(_describe(e) for e in exc.errors(include_url=False)))
         raise SceneError(source, problems) from None
     except (ValueError, TypeError, ArithmeticError) as exc:  # a rule that tripped on bad input
         raise SceneError(source, [f"(top level): {exc}"]) from None
+    from ..contact.stiffness import stiffness_problem  # numpy: the contact mapping
+
+    problem = stiffness_problem(scene)
+    if problem:  # every soft engine would fail on it, so the scene is refused for all
+        raise SceneError(source, [problem])
+    return scene
 
 
 def parse_value(text: str) -> Any:

@@ -31,6 +31,13 @@ INERTIA_K = {"disc": 0.5, "sphere": 0.4, "shell": 2.0 / 3.0, "point": 0.0}
 # below any contact time; more than 1e9 samples per run would not fit in memory anyway.
 #: Largest speed (walls, impacts, initial flow) and shear rate, in particle units.
 MAX_SPEED = 1e6
+#: Slowest design impact speed of a hardness target: k_n ∝ v², so 5e-324 gave k_n = 0 (a
+#: division by zero); particle speeds are O(1), and 1e-6 still gives a finite k_n.
+MIN_SPEED = 1e-6
+#: Smallest normal restitution: the soft engines' damping for e is found by root search over
+#: model collisions, which fails below ~1e-100 (e = 5e-324 ended in "math domain error");
+#: measured restitutions are ≥ 0.1, so 1e-6 loses nothing.
+MIN_RESTITUTION = 1e-6
 #: Shortest sample, checkpoint and servo interval, in time units.
 MIN_INTERVAL = 1e-9
 #: Most samples per run ((equilibration + production) / sample_interval).
@@ -143,7 +150,7 @@ class RestitutionLaw(StrictModel):
 class Contact(StrictModel):
     """Particle–particle collisions: normal restitution e and a tangential rule."""
 
-    restitution: Float = Field(gt=0.0, le=1.0)
+    restitution: Float = Field(ge=MIN_RESTITUTION, le=1.0)
     law: RestitutionLaw = RestitutionLaw()
     tangential: Tangential = Smooth(model="smooth")
 
@@ -228,7 +235,7 @@ class Wall(StrictModel):
     side: Literal["lower", "upper"]
     position: Float | None = None
     kind: Literal["flat", "bumpy"] = "flat"
-    restitution: Float = Field(gt=0.0, le=1.0)
+    restitution: Float = Field(ge=MIN_RESTITUTION, le=1.0)
     tangential: WallTangential = Smooth(model="smooth")
     velocity: Float = Field(default=0.0, ge=-MAX_SPEED, le=MAX_SPEED)
     servo: Servo | None = None
@@ -335,7 +342,7 @@ class Hardness(StrictModel):
     """Stiffness chosen by a hardness target (one of them)."""
 
     overlap: Float | None = Field(default=None, ge=1e-6, lt=0.5)
-    impact_speed: Float | None = Field(default=None, gt=0.0, le=MAX_SPEED)
+    impact_speed: Float | None = Field(default=None, ge=MIN_SPEED, le=MAX_SPEED)
     k_star: Float | None = Field(default=None, gt=0.0)
     kappa: Float | None = Field(default=None, gt=0.0)
     pressure: Float | None = Field(default=None, gt=0.0)

@@ -106,6 +106,15 @@ def scene_difference(saved_toml: str, scene: Scene, most: int = 3) -> str:
     return "; ".join(diffs[:most]) + more
 
 
+def resume_note(workdir: Path) -> str:
+    """What an aborted run leaves: the last checkpoint in ``workdir`` to ``--resume`` from,
+    or none."""
+    if (workdir / CHECKPOINT).exists():
+        return (f"the last checkpoint stays in {workdir}: run the same command again with "
+                "--resume to continue from it")
+    return "no checkpoint was written yet, so the run starts afresh next time"
+
+
 def refuse_foreign_checkpoint(path: Path, out: Path) -> None:
     """Outputs that differ only in their suffix share a work folder: a fresh run must not
     delete the checkpoint another output's interrupted run left there."""

@@ -12,6 +12,7 @@ m = 1, g = 1 when gravity acts.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
@@ -23,9 +24,10 @@ import time
 from pathlib import Path
 
 from .. import UNITS_NOTE
-from ..errors import EngineError, RunRefused, RunStopped, UnsupportedByEngine
+from ..errors import EngineError, RunAborted, RunRefused, RunStopped, UnsupportedByEngine
 from ..scene import Scene
 from .options import RunOptions, work_folder
+from .schedule import stop_notice
 
 WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
 FAILED, REFUSED, STOPPED = 1, 2, 3  # the child's exit codes
@@ -91,14 +93,19 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     try:
         returncode = proc.wait()
     except KeyboardInterrupt:
-        print(f"\n{backend.name}: stopping after the current segment and a checkpoint "
-              "(Ctrl-C again aborts without one)", file=sys.stderr, flush=True)
+        print(stop_notice(backend.name), file=sys.stderr, flush=True)
         proc.send_signal(signal.SIGINT)  # a terminal's Ctrl-C reached it already: harmless
         try:
             returncode = proc.wait(timeout=300)
-        except (subprocess.TimeoutExpired, KeyboardInterrupt):
-            proc.kill()
-            returncode = -9
+        except KeyboardInterrupt:  # the second Ctrl-C: abort now, keeping the last checkpoint
+            _end(proc)
+            raise RunAborted(f"aborted by Ctrl-C: the {backend.name} run was ended; "
+                             f"{_last_checkpoint(work_folder(out, backend.name))}") from None
+        except subprocess.TimeoutExpired:
+            _end(proc)
+            raise EngineError(f"the {backend.name} run did not stop within 300 s of Ctrl-C "
+                              "and was ended; "
+                              f"{_last_checkpoint(work_folder(out, backend.name))}") from None
     finally:
         job.unlink(missing_ok=True)
     message = error.read_text().strip() if error.exists() else ""
@@ -124,6 +131,24 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
                           + (f" (and {log_file})" if message and log else "")
                           + (f"\n  {report}" if report else ""))
     return out
+
+
+def _end(proc) -> None:
+    """End the child at once: SIGTERM (mpirun passes it on to its ranks), SIGKILL after
+    2 s. A checkpoint is written atomically, so the last whole one stays."""
+    with contextlib.suppress(ProcessLookupError):
+        proc.send_signal(signal.SIGTERM)
+    with contextlib.suppress(subprocess.TimeoutExpired, KeyboardInterrupt):
+        proc.wait(timeout=2.0)
+        return
+    with contextlib.suppress(ProcessLookupError, ChildProcessError):
+        proc.kill()
+
+
+def _last_checkpoint(workdir: Path) -> str:
+    from .checkpoint import resume_note  # noqa: PLC0415 - pickle and h5py helpers: only here
+
+    return resume_note(workdir)
 
 
 def can_fork(backend, options: RunOptions) -> bool:
@@ -192,12 +217,15 @@ def _die_with_parent() -> None:
 
 
 def _tell_parent(path: Path, message: str) -> None:
-    """The child's error, for the parent's exception (rank 0 writes it; best effort)."""
+    """The child's error, for the parent's exception, which prints it (rank 0 writes it; best
+    effort: where it could not, the child prints it itself, so it is said once)."""
     if os.environ.get("PMI_RANK", "0") == "0":
         try:
             path.write_text(message)
+            return
         except OSError:
             pass
+    print(f"error: {message}", file=sys.stderr)
 
 
 def worker(job: str) -> int:
@@ -227,6 +255,7 @@ def worker(job: str) -> int:
 def run_in_child(backend, scene: Scene, options: RunOptions, error: Path) -> int:
     """Run the loop here, in the child; the child's exit code (its message, if any, in the
     file ``error`` for the parent)."""
+    from ..io.checksum import DamagedCheckpoint
     from ..scene.load import SceneError
     from .loop import Simulation
 
@@ -234,12 +263,10 @@ def run_in_child(backend, scene: Scene, options: RunOptions, error: Path) -> int
         Simulation(scene, backend, options).run()
     except RunStopped:
         return STOPPED  # the parent says so, once
-    except (UnsupportedByEngine, SceneError) as exc:  # refused before anything ran
-        print(f"error: {exc}", file=sys.stderr)
+    except (UnsupportedByEngine, SceneError, DamagedCheckpoint) as exc:  # nothing ran
         _tell_parent(error, str(exc))
         return REFUSED
     except Exception as exc:  # one line, never a bare traceback
-        print(f"error: {type(exc).__name__}: {exc}", file=sys.stderr)
         _tell_parent(error, f"{type(exc).__name__}: {exc}")
         return FAILED
     return 0

@@ -36,7 +36,7 @@ from ..analysis.suite import profile_bounds
 from ..contact.health import warning_text
 from ..effects.servo import ServoController, has_servo, servo_samples, servo_settings
 from ..engines.backend import LOG_CAPACITY, BackendBase, Needs, frame_mass
-from ..errors import EngineError, RunStopped
+from ..errors import EngineError, RunAborted, RunStopped
 from ..io.frames import Frame
 from ..io.results import write_results
 from ..scene import Scene, scene_to_toml
@@ -45,7 +45,9 @@ from .checkpoint import (
     load_checkpoint,
     pickle_atomically,
     refuse_foreign_checkpoint,
+    resume_note,
 )
+from .isolation import in_worker
 from .options import RunOptions, check_run, frames_on_resume, work_folder
 from .results import run_results
 from .schedule import Schedule, StopInInterval, StopRequest
@@ -85,7 +87,9 @@ class Simulation:
         self.log_every, self.log_capacity = log_every, LOG_CAPACITY
         self.servo_by_time = has_servo(scene) and (
             self.backend.capabilities.time_step or servo_settings(scene).interval_unit == "time")
-        self.stop = StopRequest(options.wall_limit)
+        # the first Ctrl-C's notice comes from the process the user sees (an engine's child
+        # leaves it to its parent)
+        self.stop = StopRequest(options.wall_limit, None if in_worker() else backend.name)
 
     # -- set-up ---------------------------------------------------------------------------
     def _needs(self) -> Needs:
@@ -341,9 +345,9 @@ class Simulation:
                 extra = backend.result_attrs()
                 if self.options.forecast is not None:  # next to wall_seconds: forecast vs actual
                     extra.update(self.options.forecast.attrs())
-        except KeyboardInterrupt:  # no handler (not the main thread): keep the last checkpoint
-            raise EngineError("interrupted: run again with --resume to continue from the last "
-                              "checkpoint (if any)") from None
+        except KeyboardInterrupt:  # a second Ctrl-C (or no handler: not the main thread)
+            raise RunAborted(f"aborted by Ctrl-C at t = {backend.time:.6g}: "
+                             f"{resume_note(self.workdir)}") from None
         finally:
             backend.close()
         path = self._write(state, extra) if backend.rank == 0 else self.out
@@ -403,6 +407,8 @@ class Simulation:
         warning = warning_text(results.group_attrs.get("health", {}))
         if warning:  # the results stand, but not for the hard-particle limit
             print(warning, file=sys.stderr)
+        for line in self.backend.end_notes(results.attrs):
+            print(line, file=sys.stderr)
         failed = results.attrs.get("statistics_failed")
         if failed:  # the run's results are safe; say what is missing from them
             raise EngineError(f"the run finished and its results are in {path}, but these "

@@ -1,6 +1,6 @@
 """``demstudy stability`` / ``ds.stability``: a suite of hard cases run in every engine where
 they mean something, as a table (case, engine, what is checked, measured figure, limit,
-pass/fail) written to docs/stability.md (and CSV, JSON).
+pass/fail/explained) written to docs/stability.md (and CSV, JSON).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise the wall speed
 or shear rate sets the time unit τ).

@@ -51,7 +51,7 @@ def format_row(row: Row) -> str:
 
 def format_text(suite: Suite) -> str:
     counts = {s: sum(r.status == s for r in suite.rows)
-              for s in ("pass", "fail", "refused", "error")}
+              for s in ("pass", "fail", "explained", "refused", "error")}
     summary = ", ".join(f"{n} {s}" for s, n in counts.items() if n)
     return ("\n".join(format_row(r) for r in suite.rows)
             + f"\n{len(suite.rows)} rows: {summary or 'none'} "
@@ -75,7 +75,9 @@ def format_markdown(suite: Suite, command: str = "demstudy stability",
         "",
         f"Units: {UNITS_NOTE}; overlaps and distances in d, stiffness k_n in m/τ² (Hooke).",
         "",
-        "Status: pass; fail (the measured figure is outside the limit); refused (the engine "
+        "Status: pass; fail (the measured figure is outside the limit); explained (outside "
+        "the limit for a documented cause, not a bug: the case measured that cause's "
+        "signature, and the note says which); refused (the engine "
         "cannot express the case: it refused before running, a legitimate outcome); error "
         "(the case itself broke). Each case is described in `demstudy/stability/`; the "
         "notes below the table say how each figure was measured.",

@@ -26,6 +26,7 @@ from ...scene.initial import InitialState, build_initial_state
 from ..backend import BackendBase, Capabilities, EngineOption, Needs
 from .core import DEFAULT_TC, EventDriven, advance_watched, from_initial_state
 from .effects import TRANSLATIONS, core_options
+from .tc_share import TcShare, tc_share
 
 __all__ = ["EdmdBackend", "with_bumps", "y_range"]
 
@@ -114,6 +115,10 @@ class EdmdBackend(BackendBase):
     def __init__(self, scene: Scene, options, workdir):
         super().__init__(scene, options, workdir)
         self.tc = float(options.extra.get("tc", DEFAULT_TC))
+        # whether a collision can lose energy: with t_c = 0 a stall is then inelastic collapse
+        self.dissipative = (scene.contact.restitution < 1.0
+                            or scene.contact.law.model != "constant"
+                            or any(w.restitution < 1.0 for w in scene.walls))
 
     # -- set-up ---------------------------------------------------------------------------
     def setup(self, needs: Needs, saved: dict | None, servo) -> None:
@@ -168,7 +173,9 @@ class EdmdBackend(BackendBase):
         if collisions > 0:
             budget = 1000 * max(1, collisions - self.core.collisions) + 10_000_000
         return advance_watched(self.core, t, tc=self.tc, max_events=budget,
-                               stop_collisions=collisions, stop_requested=stop)
+                               stop_collisions=collisions, stop_requested=stop,
+                               dissipative=self.dissipative,
+                               bumps=any(w.kind == "bumpy" for w in self.scene.walls))
 
     # -- sampling -------------------------------------------------------------------------
     def observe(self, production: bool) -> dict:
@@ -263,6 +270,12 @@ class EdmdBackend(BackendBase):
         if servo is not None and servo.scale_width:
             notes.append("servo width scaling: x positions are rescaled affinely at each "
                          "servo update")
+        share = tc_share(core.elastic_tc_collisions, core.collisions, self.tc)
         return {"tc": self.tc, "elastic_tc_collisions": core.elastic_tc_collisions,
                 "events": core.events, "cell_crossings": core.cell_crossings,
-                "wall_collisions": core.wall_collisions, "approximations": "\n".join(notes)}
+                "wall_collisions": core.wall_collisions, "approximations": "\n".join(notes),
+                **share.attrs()}
+
+    def end_notes(self, attrs: dict) -> list[str]:
+        share = TcShare.from_attrs(attrs)
+        return [share.line()] + ([share.warning()] if share.warning() else [])

@@ -32,6 +32,7 @@ impulse). ``DEFAULT_TC`` = 1e-5 time units (the engine's default; 0 disables the
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -46,7 +47,7 @@ STALL_CHUNK = 10_000_000
 STALL_CHUNK_PER_PARTICLE = 1000
 
 __all__ = ["DEFAULT_TC", "STALL_CHUNK", "EventDriven", "advance_watched", "collide_pair",
-           "from_initial_state"]
+           "from_initial_state", "stall_message"]
 
 
 def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
@@ -72,17 +73,22 @@ def from_initial_state(state: InitialState, box, e: float = 1.0, beta: float = -
 
 def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int = 0,
                     stop_collisions: int = 0,
-                    stop_requested: Callable[[], bool] | None = None) -> bool:
+                    stop_requested: Callable[[], bool] | None = None,
+                    dissipative: bool = False, bumps: bool = False) -> bool:
     """``core.advance_to(t, max_events, stop_collisions)``, watched for a stall.
 
     Events (collisions, crossings and stale predictions) are processed in chunks of
     ``STALL_CHUNK`` (10⁷). A window of at least max(``STALL_CHUNK``, 1000 N) events that
-    moves the simulated time by no more than max(t_c, 1e-9) means a zero-time collision loop,
-    for example a particle caged between two fixed bumps at exactly zero gaps, bouncing
-    between them without time passing. Such a run could never finish, so it raises
-    ``EngineError`` naming the time and the cause, instead of hanging. A legitimately slow run
-    is not caught: a bed resting under the TC model costs about N/t_c events per time unit,
-    so one window still moves the time by about 1000 t_c.
+    moves the simulated time by no more than max(t_c, 1e-9) means the run can never finish,
+    so it raises ``EngineError`` naming the time and the cause (:func:`stall_message`)
+    instead of hanging: with the TC model off (t_c = 0) and dissipative collisions
+    (``dissipative``: some restitution below 1) an inelastic collapse, otherwise (or when
+    the stalled events are mostly collisions with the fixed particles of bumpy walls,
+    ``bumps``) a zero-time
+    collision loop of exactly touching particles (a particle caged at zero gaps between
+    fixed bumps, a crystalline row). A legitimately slow run is not caught: a bed resting
+    under the TC model costs about N/t_c events per time unit, so one window still moves the
+    time by about 1000 t_c.
 
     Returns True when t is reached. Returns False when the run stopped early at
     ``max_events`` (> 0, counted from the call), at ``stop_collisions``, or because
@@ -95,7 +101,7 @@ def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int =
     """
     chunk = max(STALL_CHUNK, STALL_CHUNK_PER_PARTICLE * core.n)
     start = _processed(core)
-    t0, e0 = core.time, start  # the stall window: at least `chunk` events
+    window = _Window.at(core)  # the stall window: at least `chunk` events
     while True:
         budget = STALL_CHUNK  # a large system's window in steps, so stops come in time
         if max_events > 0:
@@ -106,22 +112,64 @@ def advance_watched(core: EventDriven, t: float, *, tc: float, max_events: int =
             return True
         if stop_collisions > 0 and core.collisions >= stop_collisions:
             return False
-        if _processed(core) - e0 >= chunk:
-            if core.time - t0 <= max(tc, 1e-9):
-                raise EngineError(
-                    f"the event-driven run stalled at t = {core.time:.9g}: "
-                    f"{_processed(core) - e0} events moved the time by {core.time - t0:.3g} "
-                    f"(at most max(t_c, 1e-9) = {max(tc, 1e-9):.3g}). Most likely a cluster "
-                    "of exactly touching particles is colliding in a loop that takes no time, "
-                    "for example a particle caged at zero gaps between fixed bumps or in a "
-                    "crystalline row. Perturb the start (another seed, random bumps) or use "
-                    "the LAMMPS engine")
-            t0, e0 = core.time, _processed(core)
+        if _processed(core) - window.events >= chunk:
+            if core.time - window.time <= max(tc, 1e-9):
+                raise EngineError(stall_message(core, window, tc, dissipative, bumps))
+            window = _Window.at(core)
         if stop_requested is not None and stop_requested():
             return False
+
+
+@dataclass(frozen=True)
+class _Window:
+    """The core's counters where a stall window starts."""
+
+    time: float
+    events: int
+    pairs: int
+    walls: int
+
+    @classmethod
+    def at(cls, core: EventDriven) -> _Window:
+        return cls(core.time, _processed(core), core.collisions, core.wall_collisions)
+
+
+def stall_message(core: EventDriven, window: _Window, tc: float, dissipative: bool,
+                  bumps: bool = False) -> str:
+    """Why the run stalled, diagnosed from what the window's events were.
+
+    With t_c = 0 and dissipative collisions: collisions (mostly between particles, or of
+    particles with a flat wall) whose intervals shrink geometrically while the relative
+    velocities go to zero, so infinitely many of them fall before a finite time: inelastic
+    collapse (McNamara & Young 1994), which the TC model exists to stop. Otherwise, and when
+    the window's collisions are mostly with walls that carry bumps (``bumps``: a particle
+    caged at zero gaps keeps bouncing, elastically within t_c, for any t_c), exactly
+    touching particles bouncing in a loop that takes no time, which no t_c cures."""
+    events = _processed(core) - window.events
+    pairs, walls = core.collisions - window.pairs, core.wall_collisions - window.walls
+    head = (f"the event-driven run stalled at t = {core.time:.9g}: {events} events "
+            f"({pairs} pair and {walls} wall collisions) moved the time by "
+            f"{core.time - window.time:.3g} (at most max(t_c, 1e-9) = {max(tc, 1e-9):.3g}). ")
+    if tc == 0.0 and dissipative and pairs + walls > 0 and (pairs >= walls or not bumps):
+        partners = "particles" if pairs >= walls else "particles and a wall"
+        return head + (f"This is inelastic collapse: with the TC model switched off (--tc 0) "
+                       f"and a restitution below 1, a cluster of {partners} collides ever "
+                       "faster while their relative velocities go to zero, infinitely often "
+                       f"before a finite time. Rerun with --tc {_short(DEFAULT_TC)}, the default "
+                       "(a collision within t_c of a partner's previous one is elastic), or "
+                       "use the LAMMPS engine")
+    return head + ("Most likely a cluster of exactly touching particles is colliding in a "
+                   "loop that takes no time, for example a particle caged at zero gaps "
+                   "between fixed bumps or in a crystalline row. Perturb the start (another "
+                   "seed, random bumps) or use the LAMMPS engine")
 
 
 def _processed(core: EventDriven) -> int:
     """Events the core has worked through: collisions, crossings and stale predictions (the
     budget of ``advance_to(max_events=…)`` counts all three)."""
     return core.events + core.invalid_events
+
+
+def _short(value: float) -> str:
+    """1e-05 → 1e-5 (as one types it on the command line)."""
+    return f"{value:g}".replace("e-0", "e-").replace("e+0", "e+")

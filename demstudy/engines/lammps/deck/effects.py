@@ -155,8 +155,9 @@ def _beta_note(scene: Scene, draft: DeckDraft) -> None:
     if any(rule.model in ("beta", "rough") for rule in rules):
         draft.notes.append(
             "constant tangential restitution beta is realised by an uncapped tangential spring "
-            "(beta = -cos(omega_t t_c)); exact for binary collisions, approximate for lasting "
-            "contacts")
+            "(beta = -cos(omega_t t_c)); exact for binary collisions, but a lasting contact "
+            "never slides: near jamming (measured: 2D nu >= 0.8, 3D phi = 0.62) a sheared rough "
+            "flow jams into a stiffness-dependent solid (docs/contact.md); use a Coulomb mu there")
 
 
 # ---------------------------------------------------------------- body force, shear, 2D
