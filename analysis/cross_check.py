@@ -1,5 +1,5 @@
-"""Main job (`make run`): soft contacts against the hard-particle limit on a small steady seed
-flow, with what each step closer costs.
+"""Main job (`make run`): soft contacts (LAMMPS and LIGGGHTS) against the hard-particle limit
+on a small steady seed flow, with what each step closer costs.
 
 The flow: Campbell's (1982) Couette cell of rough inelastic discs at ν ≈ 0.55 (10 × 10 discs,
 his rough walls, fixed gap: inputs/accuracy-cost/couette-rough-nu0.55.toml). The job
@@ -7,10 +7,12 @@ his rough walls, fixed gap: inputs/accuracy-cost/couette-rough-nu0.55.toml). The
 1. prints the forecast of every run it is about to make and of the whole ladder on its
    workers (`ds.cost` does, first: demstudy.accuracy.forecast; this machine's measured
    speed, measured first if it never was, ~20 s),
-2. runs the event-driven reference and a ladder of soft LAMMPS runs over stiffness
-   k* = k_n/(m U_T²/d) and steps per contact (`demstudy cost`, resumable, both cores),
-3. overlays the reference and the stiffest soft run with their difference per bin
-   (`demstudy compare`) and prints the error table,
+2. runs the event-driven reference and a ladder of soft runs over stiffness
+   k* = k_n/(m U_T²/d) and steps per contact, each in LAMMPS and in LIGGGHTS (`demstudy cost
+   --engine lammps,liggghts`, resumable, both cores),
+3. compares the three engines: the stiffest soft run of each engine overlaid on the
+   reference with their differences per bin (`demstudy compare`), and prints the error
+   tables,
 
 and writes into results/: cross-check/ (the ladder's runs, ladder.csv, ladder.json),
 cross-check-pareto.png (accuracy against cost), cross-check-profiles.png (overlay and
@@ -29,10 +31,12 @@ from pathlib import Path
 
 import demstudy as ds
 from demstudy.accuracy.report import table
+from demstudy.engines.liggghts.library import INSTALL_HINT, library_path
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENE = ROOT / "inputs" / "accuracy-cost" / "couette-rough-nu0.55.toml"
 KSTARS, STEPS = (1e2, 1e3, 1e4), (10, 50)
+ENGINES = ("lammps", "liggghts")  # the soft-contact engines, beside the event-driven one
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -43,6 +47,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     scene = ds.load_scene(SCENE, args.set)
+    engines = ENGINES
+    if library_path() is None:  # `make run` installs it when it runs as root
+        engines = ("lammps",)
+        print(f"note: LIGGGHTS is not installed, the ladder runs in LAMMPS only ({INSTALL_HINT})")
     print(f"scene: {SCENE.relative_to(ROOT)} ({scene.n_particles} discs, "
           f"{scene.run.equilibration:g} + {scene.run.production:g} d/U_T)")
     workers = args.workers or 2
@@ -50,20 +58,22 @@ def main(argv: list[str] | None = None) -> int:
     # the event-driven reference is cheap: four replicas (other seeds) give its errors from
     # their scatter (this cell's wall slip is slower than one run: docs/results-format.md)
     study = ds.cost(scene, kstars=KSTARS, steps=STEPS, models=["hooke"], workers=workers,
-                    out=folder, reference_replicas=4)
+                    out=folder, reference_replicas=4, engines=engines)
     shutil.copyfile(folder / "pareto.png", args.out / "cross-check-pareto.png")
 
     # replicas: their files, comma-joined (compare combines a list)
     reference = next(r for r in study.rows if r.get("reference"))["path"].split(",")
-    stiffest = max((r for r in study.rows if r["engine"] == "lammps"),
-                   key=lambda r: (r["kstar"], r["steps_per_contact"]))["path"]
-    (comparison,) = ds.compare(reference, stiffest)
-    figure = ds.plot_comparison(comparison, args.out / "cross-check-profiles.png",
+    stiffest = [max((r for r in study.rows if r["engine"] == engine),
+                    key=lambda r: (r["kstar"], r["steps_per_contact"]))["path"]
+                for engine in engines]
+    comparisons = ds.compare(reference, *stiffest)  # the three engines on one scene
+    figure = ds.plot_comparison(comparisons, args.out / "cross-check-profiles.png",
                                 fields=["solid_fraction", "velocity[x]", "temperature",
                                         "rotational_temperature"])
     report = "\n\n".join([
         table(study),
-        "stiffest soft run against the event-driven reference:\n" + comparison.table(),
+        *(f"stiffest {engine} run against the event-driven reference:\n" + c.table()
+          for engine, c in zip(engines, comparisons, strict=True)),
         f"recommendation: {study.recommendation}"]).strip() + "\n"
     (args.out / "cross-check.txt").write_text(report)
     print("\n" + report)
