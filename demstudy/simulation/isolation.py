@@ -1,7 +1,7 @@
 """Run a simulation in a child process (on MPI ranks when asked), so that a crash in compiled
 code (a segfault, an MPI abort) ends the child and reaches the caller as an ``EngineError``.
 
-``python -m demstudy.simulation.isolation JOB.json`` is the child's entry point: exit 0 when
+``python -m demstudy.simulation.child JOB.json`` is the child's entry point: exit 0 when
 done, 2 when the engine refused the run, 3 when it stopped after a checkpoint (Ctrl-C or the
 wall-clock limit), 1 on an engine error. On one rank the child is a fork of the caller when
 that is safe (Linux, one thread, nothing loaded that a fork must not inherit: the backend's
@@ -85,7 +85,7 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     else:
         job.write_text(json.dumps(payload))
         env = dict(os.environ, **{WORKER_FLAG: "1"})
-        cmd = [sys.executable, "-m", "demstudy.simulation.isolation", str(job)]
+        cmd = [sys.executable, "-m", "demstudy.simulation.child", str(job)]
         if options.np > 1:
             cmd = [*backend.launcher(options.np), *cmd]
         proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL,
@@ -271,10 +271,3 @@ def run_in_child(backend, scene: Scene, options: RunOptions, error: Path) -> int
         return FAILED
     return 0
 
-
-if __name__ == "__main__":
-    try:
-        sys.exit(worker(sys.argv[1]))
-    except KeyboardInterrupt:  # before the engine's own handler (while importing, say)
-        print("error: interrupted before the run started", file=sys.stderr)
-        sys.exit(FAILED)
