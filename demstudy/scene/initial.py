@@ -8,6 +8,7 @@ some engines (LIGGGHTS) crash on particles lying exactly on a boundary.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,7 +56,7 @@ def build_initial_state(scene: Scene) -> InitialState:
     elif init.placement == "file":
         position, velocity = _from_file(scene)
     else:
-        position = _random_placement(scene, rng, d_max=1.0 + spread / 2)
+        position = _random_placement(scene, rng, diameter)
     if init.placement != "file" or velocity is None:
         velocity = _velocity_profile(scene, position, rng)
     spin_dofs = 1 if dim == 2 else 3
@@ -100,20 +101,49 @@ def _campbell_lattice(scene: Scene, rng: np.random.Generator, d_max: float = 1.0
     return position[order]
 
 
-def _random_placement(scene: Scene, rng: np.random.Generator, d_max: float) -> np.ndarray:
+#: Random sequential addition (RSA) up to these solid fractions, Lubachevsky–Stillinger growth
+#: (a fluid) above: about two thirds of RSA's jamming limits (φ ≈ 0.38 spheres, 0.547 discs),
+#: where RSA still fills a box in milliseconds and its structure is close to the fluid's.
+RSA_LIMIT = {2: 0.35, 3: 0.25}
+
+
+def _random_placement(scene: Scene, rng: np.random.Generator, diameter: np.ndarray) -> np.ndarray:
     """Random non-overlapping centres: random sequential addition when dilute, otherwise a
+    fluid grown from a dilute random state (:mod:`demstudy.scene.fluid_start`). Only when the
+    growth jams below the target (too dense for a fluid) or the box is too thin for it, a
     random subset of a close-packed lattice (hexagonal / fcc), jittered within its gaps."""
     dim, n = scene.dimension, scene.n_particles
+    d_max = float(diameter.max())
     lo_y, hi_y = y_range(scene, radius=d_max / 2)
     lo = np.array([0.0, lo_y] + ([0.0] if dim == 3 else []))
     hi = np.array([scene.box.size[0], hi_y] + ([scene.box.size[2]] if dim == 3 else []))
     periodic = np.array([True, scene.y_periodic] + ([True] if dim == 3 else []))
-    rsa_limit = 0.30 if dim == 3 else 0.42
-    if scene.solid_fraction < rsa_limit:
+    if scene.solid_fraction < RSA_LIMIT[dim]:
         found = _sequential_addition(n, lo, hi, periodic, d_max, rng)
         if found is not None:
             return found
-    return _lattice_subset(n, lo, hi, periodic, d_max, rng)
+    return _fluid_or_lattice(scene, rng, diameter, lo, hi, periodic)
+
+
+def _fluid_or_lattice(scene, rng, diameter, lo, hi, periodic) -> np.ndarray:
+    from .fluid_start import grow_fluid  # noqa: PLC0415 - loads the native module
+
+    walls = None
+    if not scene.y_periodic:
+        top = scene.wall_surface("upper") if scene.wall("upper") else scene.box.size[1]
+        walls = (scene.wall_surface("lower") + MARGIN, top - MARGIN)
+    reason = ""
+    try:
+        grown = grow_fluid(diameter, lo, hi, periodic, walls, rng)
+        if grown.reached:
+            return grown.position
+        reason = "the growth jammed before the target solid fraction"
+    except ValueError as err:
+        reason = str(err)
+    warnings.warn(f"placement = 'random' at solid fraction {scene.solid_fraction:.3g}: no fluid "
+                  f"start ({reason}); using a random subset of a close-packed lattice, which "
+                  "is crystalline", stacklevel=3)
+    return _lattice_subset(scene.n_particles, lo, hi, periodic, float(diameter.max()), rng)
 
 
 def _sequential_addition(

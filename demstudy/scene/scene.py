@@ -28,8 +28,9 @@ from .schema import (
     Wall,
 )
 
-#: Random sequential placement stalls near these fractions; denser random starts use a
-#: shuffled lattice instead (see demstudy.scene.initial).
+#: Densest 'random' starts: above RSA's range they are grown as a fluid (Lubachevsky–
+#: Stillinger, demstudy.scene.fluid_start), which jams not far above these fractions (and only
+#: if it jams, a shuffled lattice is used; see demstudy.scene.initial).
 RANDOM_PLACEMENT_LIMIT = {2: 0.80, 3: 0.60}
 
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "edmd/edmd.hpp"
+#include "edmd/growth.hpp"
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -242,7 +243,70 @@ nb::tuple collide_py(std::vector<double> n, double ri, double rj, double mi, dou
 
 }  // namespace
 
+nb::dict grow_py(InArr pos, InArr vel, InArr diameter, InArr mass, std::vector<double> box,
+                 int dim, bool periodic_y, std::vector<double> y_range, double s_start,
+                 double s_end, double rate, double relax_time, double chunk, double temperature,
+                 std::int64_t max_events) {
+    require(dim == 2 || dim == 3, "dim must be 2 or 3");
+    require(box.size() == static_cast<std::size_t>(dim), "box needs dim lengths");
+    require(y_range.size() == 2, "y_range needs (lo, hi)");
+    const std::size_t n = rows(pos, dim, "positions (N, dim)");
+    require(rows(vel, dim, "velocities (N, dim)") == n, "velocities: N rows");
+    require(rows(diameter, 1, "diameters (N,)") == n, "diameters: N entries");
+    require(rows(mass, 1, "masses (N,)") == n, "masses: N entries");
+    GrowthParams p;
+    p.dim = dim;
+    for (int a = 0; a < dim; ++a) p.box[a] = box[a];
+    p.periodic_y = periodic_y;
+    p.y_lo = y_range[0];
+    p.y_hi = y_range[1];
+    p.s_start = s_start;
+    p.s_end = s_end;
+    p.rate = rate;
+    p.relax_time = relax_time;
+    p.chunk = chunk;
+    p.temperature = temperature;
+    p.max_events = max_events;
+    std::vector<double> x(3 * n, 0.0), v(3 * n, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+        for (int a = 0; a < dim; ++a) {
+            x[3 * i + a] = pos.data()[i * dim + a];
+            v[3 * i + a] = vel.data()[i * dim + a];
+        }
+    GrowthResult r;
+    try {
+        nb::gil_scoped_release release;
+        r = grow_packing(p, static_cast<std::int64_t>(n), x.data(), v.data(), diameter.data(),
+                         mass.data());
+    } catch (const std::invalid_argument& err) {
+        throw nb::value_error(err.what());
+    }
+    auto xo = owned<double>({n, static_cast<std::size_t>(dim)});
+    auto vo = owned<double>({n, static_cast<std::size_t>(dim)});
+    for (std::size_t i = 0; i < n; ++i)
+        for (int a = 0; a < dim; ++a) {
+            xo.data()[i * dim + a] = x[3 * i + a];
+            vo.data()[i * dim + a] = v[3 * i + a];
+        }
+    nb::dict d;
+    d["positions"] = xo;
+    d["velocities"] = vo;
+    d["reached"] = r.reached;
+    d["scale"] = r.scale;
+    d["collisions"] = r.collisions;
+    d["events"] = r.events;
+    d["time"] = r.time;
+    d["relax_virial"] = r.relax_virial;
+    return d;
+}
+
 void bind(nb::module_& m) {
+    m.def("edmd_grow_packing", &grow_py, "positions"_a, "velocities"_a, "diameters"_a,
+          "masses"_a, "box"_a, "dim"_a, "periodic_y"_a, "y_range"_a, "s_start"_a, "s_end"_a,
+          "rate"_a, "relax_time"_a, "chunk"_a, "temperature"_a, "max_events"_a,
+          "Lubachevsky-Stillinger growth of the diameters from s_start to s_end times "
+          "`diameters` (see demstudy.scene.fluid_start). Returns a dict: positions, "
+          "velocities, reached, scale, collisions, events, time, relax_virial.");
     m.def("edmd_set_simd", &set_pair_simd, "enabled"_a,
           "Use the AVX2 pair-time kernel of the event-driven engine when the CPU has it "
           "(default); returns whether it is used. Both give identical bits (for tests).");
