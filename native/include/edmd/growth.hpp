@@ -11,8 +11,8 @@
 // chunk of time the velocities are rescaled to the temperature T (kinetic, per degree of
 // freedom). After growth an elastic run at s = s_end (rate 0) relaxes the packing.
 //
-// Algorithm: a cell grid of width >= the largest final diameter (at least 3 cells along a
-// periodic axis, so an adjacent cell's image is the only one that can touch), cell-crossing
+// Algorithm: a cell grid of width >= the largest final diameter (periodic lengths >= 2 d_max;
+// with 1 or 2 cells along an axis every image is visited), cell-crossing
 // events, one scheduled event per particle in a binary heap with lazy invalidation (per
 // particle version of its own prediction, collision counter of the partner).
 #pragma once

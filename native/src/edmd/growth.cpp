@@ -46,9 +46,12 @@ public:
             const double len = per ? p_.box[a] : p_.y_hi - p_.y_lo;
             if (!(len > 0.0)) throw std::invalid_argument("growth: empty region along an axis");
             nc_[a] = std::max(1, static_cast<int>(std::floor(len / (dmax * p_.s_end))));
-            if (per && nc_[a] < 3)
+            // 1 or 2 cells along a periodic axis: the neighbour loop then visits every
+            // image at -L, 0, +L (the wrap gives the shift); the nearest image is the touching
+            // one while L >= 2 d_max
+            if (per && len < 2.0 * dmax * p_.s_end)
                 throw std::invalid_argument(
-                    "growth: a periodic box length is below 3 particle diameters (axis " +
+                    "growth: a periodic box length is below 2 particle diameters (axis " +
                     std::to_string(a) + ")");
             cw_[a] = len / nc_[a];
             org_[a] = lo;
@@ -276,7 +279,7 @@ private:
     void collide_pair(std::int32_t i, std::int32_t j) {
         advance(i, now_);
         advance(j, now_);
-        // at contact the nearest image is the touching one (periodic lengths >= 3 d_max)
+        // at contact the nearest image is the touching one (periodic lengths >= 2 d_max)
         double best_shift[3] = {0.0, 0.0, 0.0};
         for (int a = 0; a < p_.dim; ++a) {
             if (!periodic(a)) continue;
