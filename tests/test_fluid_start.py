@@ -132,9 +132,10 @@ def test_sphere_fluid_follows_carnahan_starling(phi):
 @pytest.mark.parametrize("nu", [0.5, 0.65])
 def test_disc_fluid_follows_henderson(nu):
     z, err = measured_z(2, nu)
-    # Henderson's Z is ~2 % high at ν = 0.65 (Luding 2001); its correction is tight
+    # Henderson's Z is 2.2 % above Luding's at ν = 0.65 (0.3 % at 0.5); measured here
+    # (seeds 1-7, N = 1000): 8.38-8.46 against Luding's 8.41 and Henderson's 8.59
     assert z == pytest.approx(luding_z(nu), abs=3 * err + FINITE_N * z)
-    assert z == pytest.approx(float(compressibility(nu, 2)), rel=0.025)
+    assert z == pytest.approx(float(compressibility(nu, 2)), rel=0.03)
 
 
 @pytest.mark.parametrize(("thickness", "grows"), [(2.9, True), (1.9, False)])

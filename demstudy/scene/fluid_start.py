@@ -65,8 +65,9 @@ def grow_fluid(
 
     n, dim = len(diameter), len(lo)
     lengths = hi - lo
-    phi = _volume(diameter, dim).sum() / np.prod(lengths)
-    s0 = min(1.0, (GROWTH_START[dim] / phi) ** (1.0 / dim)) if phi > 0 else 1.0
+    # RSA excludes s0 × the largest diameter around every centre: shrink by that measure
+    phi = n * _volume(diameter.max(), dim) / np.prod(lengths)
+    s0 = min(1.0, (GROWTH_START[dim] / phi) ** (1.0 / dim))
     start = _sequential_addition(n, lo, hi, periodic, s0 * diameter.max(), rng)
     if start is None:
         raise ValueError(f"random sequential addition failed at solid fraction {phi * s0**dim:.3g}")
@@ -89,5 +90,5 @@ def grow_fluid(
                   int(out["events"]), pressure)
 
 
-def _volume(diameter: np.ndarray, dim: int) -> np.ndarray:
+def _volume(diameter, dim: int):
     return np.pi / 4 * diameter**2 if dim == 2 else np.pi / 6 * diameter**3
