@@ -349,14 +349,16 @@ def cooling_temperature(run: Run) -> tuple[np.ndarray, np.ndarray]:
     degree of freedom, T = (2 E_kin − |P|²/M) / (dim (N − 1)) with M the total mass (the
     centre-of-mass motion is not thermal and takes dim degrees of freedom; without a momentum
     record T = 2 E_kin / (dim N))."""
-    from ..scene.initial import build_initial_state
+    from ..scene.initial import particle_diameters
 
     ts, scene = run.results.timeseries, run.scene
     n, dim = scene.n_particles, scene.dimension
     energy = 2 * np.asarray(ts["kinetic_energy"], float)
     dof = dim * n
     if "momentum" in ts:
-        total_mass = float(build_initial_state(scene).mass.sum())
+        # the run's diameters (the first draw of its seed), without building the start
+        diameter = particle_diameters(scene, np.random.default_rng(scene.run.seed))
+        total_mass = float((diameter**dim).sum())
         energy = energy - (np.asarray(ts["momentum"], float) ** 2).sum(axis=1) / total_mass
         dof = dim * (n - 1)
     t = np.asarray(ts["time"], float)
