@@ -40,6 +40,10 @@ count = {n}
 restitution = 1.0
 [initial.velocity]
 temperature = 1.0
+[run]
+equilibration = 0.0
+production = 1.0
+sample_interval = 1.0
 """))
 
 
