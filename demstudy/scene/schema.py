@@ -299,7 +299,10 @@ class Initial(StrictModel):
     ``lattice``: Campbell's jittered square (cubic) lattice of ``rows`` along y, ``columns``
     along x (and ``layers`` along z) with centre spacing ``spacing`` (> 1), each centre moved
     at random by at most the gap (spacing − 1)/2 (``jitter = false`` disables that).
-    ``random``: random non-overlapping placement at the particles' count or solid fraction.
+    ``random``: random non-overlapping placement at the particles' count or solid fraction:
+    random sequential addition when dilute, a fluid grown from a dilute state (Lubachevsky–
+    Stillinger, :mod:`demstudy.scene.fluid_start`) when dense, never a crystal unless the
+    growth jams (then a lattice subset, with a warning).
     ``file``: positions (and optionally velocities) from a text file with columns
     x y [z] [vx vy [vz]] (a relative ``path`` is relative to the working directory). The
     scene's validation checks the file (:mod:`demstudy.scene.particle_file`): it parses,
