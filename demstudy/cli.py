@@ -184,11 +184,13 @@ def _check_figure_file(option: str, path: str) -> None:
 
 
 def _cmd_forecast(args: argparse.Namespace) -> int:
+    from .engines import get_backend
     from .simulation.forecast import cpu_model, load_rates, measure_costs, rates_path
 
     for engine in args.engine or ["lammps", "edmd"]:
         for dim in args.dim or [2, 3]:
-            for model in (args.model or ["hooke"]) if engine == "lammps" else [None]:
+            soft = get_backend(engine).capabilities.time_step
+            for model in (args.model or ["hooke"]) if soft else [None]:
                 measure_costs(engine, dim, model, remeasure=args.measure)
     rates = load_rates()
     print(f"machine rates ({cpu_model()}), cached in {rates_path()}:")
@@ -467,8 +469,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--measure", "--remeasure", action="store_true", dest="measure",
                    help="run the benchmarks again (default: show the cached rates, measuring "
                         "the missing ones)")
-    p.add_argument("--engine", action="append", choices=["lammps", "edmd"],
-                   help="engines to measure (default both; repeatable)")
+    p.add_argument("--engine", action="append", choices=engines,
+                   help="engines to measure (default lammps and edmd; repeatable)")
     p.add_argument("--dim", type=int, action="append", choices=[2, 3],
                    help="dimensions (default 2 and 3; repeatable)")
     p.add_argument("--model", action="append", choices=["hooke", "hertz"],

@@ -132,6 +132,30 @@ def _soft_engines(engines: Sequence[str] | None) -> list[str]:
     return names
 
 
+def _models_left_out(scene: Scene, engines: Sequence[str],
+                     models: Sequence[str]) -> dict[tuple[str, str], str]:
+    """(engine, model) pairs an engine refuses whatever the stiffness (LIGGGHTS: Hertz),
+    with its reason; an engine that runs none of ``models`` is refused (``BadOption``)."""
+    from ..errors import UnsupportedByEngine
+
+    out = {}
+    for engine in engines:
+        for model in models:
+            # the ladder gives k_n itself: check the contact model alone
+            soft = scene.soft.model_copy(update={"model": model, "stiffness": 1e4,
+                                                 "hardness": None})
+            try:
+                get_backend(engine).check(scene.model_copy(update={"soft": soft}), None)
+            except UnsupportedByEngine as exc:
+                if exc.field_name != "soft.model":
+                    raise
+                out[(engine, model)] = exc.reason
+        if all((engine, m) in out for m in models):
+            raise BadOption("--models", list(models), f"{engine} runs none of them: "
+                            + out[(engine, models[0])])
+    return out
+
+
 def _count(name: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise BadOption(name, value, "a whole number of runs >= 1 is allowed")
@@ -195,6 +219,7 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
         scene = scene.model_copy(update={"run": scene.run.model_copy(update=QUICK["run"])})
     for engine in engines:  # refuse before anything runs, naming the field
         get_backend(engine).check(scene, None)
+    left_out = _models_left_out(scene, engines, models)
     # absolute: Dask workers (and pool workers) in another directory write into this folder
     folder = check_folder(Path(out or Path("results") / "cost" / scene.meta.name))
     workers = workers or os.cpu_count() or 1
@@ -213,7 +238,10 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
                            f"run (seeds {scene.run.seed}, {scene.run.seed + 1}, …); errors "
                            "from their scatter, cost = the SUM of their wall times")
     refs = [replicate([r], reference_replicas) for r in reference_ladder(DEFAULT_TC)]
-    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, models, engines)]
+    softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, models, engines)
+             if (s.engine, s.model) not in left_out]
+    for (engine, model), why in left_out.items():
+        progress(f"note: {engine} runs no {model} contacts ({why}): left out of the ladder")
     # an unreachable scheduler is refused before anything runs (a dry run runs nothing)
     client = connect(dask) if isinstance(dask, str) and not dry_run else dask
     try:

@@ -1,5 +1,6 @@
-"""Engine backends, registered by name: ``lammps`` (soft contacts in LAMMPS) and ``edmd``
-(demstudy's event-driven hard particles).
+"""Engine backends, registered by name: ``lammps`` (soft contacts in LAMMPS), ``liggghts``
+(soft contacts in LIGGGHTS, always in a child process) and ``edmd`` (demstudy's
+event-driven hard particles).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. A backend implements
 the small protocol of :mod:`demstudy.engines.backend`; the one simulation loop
@@ -19,6 +20,7 @@ __all__ = ["backend_names", "get_backend", "register_backend"]
 _BACKENDS: dict[str, Any] = {
     "lammps": "demstudy.engines.lammps.backend:LammpsBackend",
     "edmd": "demstudy.engines.edmd.backend:EdmdBackend",
+    "liggghts": "demstudy.engines.liggghts.backend:LiggghtsBackend",
 }
 
 

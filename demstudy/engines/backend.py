@@ -129,6 +129,12 @@ class BackendBase:
         """The engine's own log in the work folder, named in failure messages."""
         return None
 
+    @staticmethod
+    def crash_report(workdir: Path) -> str:
+        """What a dead child's engine left in the work folder (the command it was given last,
+        its log's error), for the parent's ``EngineError``; empty if nothing."""
+        return ""
+
     @classmethod
     def write_inputs(cls, scene: Scene, folder: Path, dump: str | None = None) -> Path:
         """Write the engine's own input files for ``scene`` (``capabilities.inputs``)."""

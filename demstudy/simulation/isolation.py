@@ -120,11 +120,16 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
         how = ("was interrupted" if returncode == -signal.SIGINT
                else f"was killed by signal {-returncode}" if returncode < 0
                else f"failed (exit {returncode})")
-        log_file = backend.log_file(work_folder(out, backend.name))
+        workdir = work_folder(out, backend.name)
+        log_file = backend.log_file(workdir)
         log = f" and {log_file}" if log_file is not None and log_file.exists() else ""
         said = f": {message}" if message else f"; see the messages above{log}"
+        # an engine that ends the process on its own errors (LIGGGHTS) left its last command
+        # and its log's error in the work folder
+        report = "" if message else backend.crash_report(workdir)
         raise EngineError(f"the {backend.name} run on {options.np} rank(s) {how}{said}"
-                          + (f" (and {log_file})" if message and log else ""))
+                          + (f" (and {log_file})" if message and log else "")
+                          + (f"\n  {report}" if report else ""))
     return out
 
 

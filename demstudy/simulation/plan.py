@@ -27,7 +27,7 @@ __all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
 PILOT_WORTH = 20.0
 
 #: engines with a benchmark (``forecast.measure_rate``): the others get no forecast
-FORECAST_ENGINES = ("lammps", "edmd")
+FORECAST_ENGINES = ("lammps", "edmd", "liggghts")
 
 
 @dataclass(frozen=True)

@@ -83,13 +83,16 @@ class Impact:
 
 def impact(dim: int, kind: Kind, params: ContactParameters, speed: float, angle: float,
            dt: float, *, sizes: Sequence[float] = (1.0, 1.0), spin: float = 0.0,
-           phase: float = 0.5, masses: Sequence[float] | None = None) -> Impact:
+           phase: float = 0.5, masses: Sequence[float] | None = None,
+           bodies: tuple = (open_bodies, read_state)) -> Impact:
     """One isolated collision of particle 1 (diameter ``sizes[0]``, spin ``spin`` about z, the
     axis normal to the plane of impact) with particle 2 (``sizes[1]``, no spin) or a wall.
 
     The centres' relative velocity has magnitude ``speed`` at ``angle`` degrees from the inward
     normal (the contact point also moves by the spin); the pair's centre of mass is at rest;
     masses ∝ d^dim unless given; the first overlap arrives ``phase`` steps after the start.
+    ``bodies``: the engine's (open, read) pair (``bodies.open_bodies``, ``read_state``; the
+    LIGGGHTS engine passes its own).
     """
     if not (0.0 <= angle < 90.0 and speed > 0.0 and 0.0 < phase <= 1.0):
         raise ValueError("need 0 <= angle < 90 degrees, speed > 0 and 0 < phase <= 1")
@@ -106,17 +109,18 @@ def impact(dim: int, kind: Kind, params: ContactParameters, speed: float, angle:
         sep, mt = np.array([0.0, r[0] + r[1], 0.0]) - g * t0, m[0] + m[1]
         atoms = [(*(m[1] / mt * sep), *(m[1] / mt * g), spin, d[0], m[0]),
                  (*(-m[0] / mt * sep), *(-m[0] / mt * g), 0.0, d[1], m[1])]
-    lmp = open_bodies(dim, wall, params, dt, atoms)
+    opener, reader = bodies
+    lmp = opener(dim, wall, params, dt, atoms)
     n_at = len(atoms)
     try:
-        x, v, w, _ = read_state(lmp, n_at)
+        x, v, w, _ = reader(lmp, n_at)
         before = (x, v, w)
         prev = _overlap_normal(x, wall, r)[0]
         t_in = t_out = None
         normals, peak = [], 0.0
         for step in range(1, 1_000_000):
             lmp.command("run 1 pre no post no")
-            x, v, w, f = read_state(lmp, n_at)
+            x, v, w, f = reader(lmp, n_at)
             ov, n = _overlap_normal(x, wall, r)
             if t_in is None and ov > 0.0:
                 t_in = (step - 1 + -prev / (ov - prev)) * dt
@@ -187,7 +191,8 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
               kn: float = 1e5, steps_per_contact: float = 200,
               speeds: Sequence[float] = (1.0,), angles: Sequence[float] = (0.0, 30.0, 60.0),
               model: Model = "hooke", sizes: Sequence[float] = (1.0, 1.0),
-              spin: float = 0.0, phases: int = 1) -> list[CollisionRow]:
+              spin: float = 0.0, phases: int = 1, engine: str = "lammps",
+              bodies: tuple = (open_bodies, read_state)) -> list[CollisionRow]:
     """Map (e, beta | mu, beta0) to LAMMPS parameters, then measure them in binary collisions.
 
     ``K`` defaults to the LAMMPS body (disc 1/2 in 2D, sphere 2/5 in 3D); another value is
@@ -200,18 +205,19 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
     An uncapped spring's k_t is compensated for ``steps_per_contact`` (LAMMPS's discrete
     update, ``contact.discrete``), as in scenes. ``phases``: 1 measures each collision with
     its first overlap half a step after a step; n > 1 averages e, beta, t_c, spin and peak
-    force over n impact phases (bin midpoints), as the collisions of a flow do.
+    force over n impact phases (bin midpoints), as the collisions of a flow do. ``engine``
+    and ``bodies``: the engine measured (its name in refusals, its (open, read) pair).
     """
     k_body = inertia_factor(dim)
     if K is not None and abs(K - k_body) > 1e-12:
-        raise UnsupportedByEngine("lammps", "K", K, f"LAMMPS {'discs' if dim == 2 else 'spheres'}"
-                                  f" have K = {k_body}")
+        raise UnsupportedByEngine(engine, "K", K, f"{engine}'s "
+                                  f"{'discs' if dim == 2 else 'spheres'} have K = {k_body}")
     if kind not in ("pair", "wall"):
-        raise UnsupportedByEngine("lammps", "kind", kind, "use 'pair' or 'wall'")
+        raise UnsupportedByEngine(engine, "kind", kind, "use 'pair' or 'wall'")
     if not (isinstance(phases, int) and 1 <= phases <= 256):
-        raise UnsupportedByEngine("lammps", "phases", phases, "a whole number from 1 to 256")
+        raise UnsupportedByEngine(engine, "phases", phases, "a whole number from 1 to 256")
     if len(sizes) != 2 or min(sizes) <= 0.0:
-        raise UnsupportedByEngine("lammps", "sizes", tuple(sizes), "two positive diameters")
+        raise UnsupportedByEngine(engine, "sizes", tuple(sizes), "two positive diameters")
     r0, r1 = 0.5 * sizes[0], 0.5 * sizes[1]
     m0, m1 = sizes[0] ** dim, sizes[1] ** dim
     m_eff = m0 if kind == "wall" else pair_mass(m0, m1)
@@ -226,7 +232,7 @@ def calibrate(dim: int, kind: Kind = "pair", e: float = 0.9, beta: float | None 
     for speed in speeds:
         for angle in angles:
             hits = [impact(dim, kind, params, speed, angle, dt, sizes=sizes, spin=spin,
-                           phase=ph) for ph in offsets]
+                           phase=ph, bodies=bodies) for ph in offsets]
             e_m, b_m, tc_m, spin_m, peak_m = (float(np.mean([getattr(h, k) for h in hits]))
                                               for k in ("e", "beta", "contact_time",
                                                         "spin_after", "peak_force"))
