@@ -115,7 +115,8 @@ _TIMESERIES = {
     "pressure": ("{stress}", "y-periodic boxes: pressure, peculiar kinetic part "
                              "2 E'_kin/(dim V) at the sample + the interaction part: "
                              "event-driven, collisional over the interval ending at the "
-                             "sample (NaN at t = 0); soft, the contact virial at the sample"),
+                             "sample (NaN at t = 0); soft, the contact virial at the "
+                             "sample"),
 }
 
 _FRAMES = {
