@@ -69,6 +69,8 @@ def how_to_get(kind: str) -> str:
 
 LINESTYLES = ("-", "--", ":", "-.")
 MARKERS = ("o", "s", "^", "v", "D", "P")
+#: the resolution of the saved figures (dots per inch)
+DPI = 110
 #: the shades of a run's colour for its bins (1: the colour itself; < 1 darker, > 1 lighter)
 SHADES = (1.0, 0.55, 1.55, 0.3, 1.8)
 
@@ -190,7 +192,9 @@ def units_text(runs: Sequence[Run]) -> str:
 def new_figure(n_rows: int, n_cols: int, width: float = 4.0, height: float = 3.6,
                **kwargs: Any) -> tuple[Figure, np.ndarray]:
     """A Figure on the Agg canvas and its axes as a 2D array."""
-    fig = Figure(figsize=(width * n_cols, height * n_rows + 0.6))
+    # made at the resolution it is saved at: text widths are measured at this resolution
+    # (hinted glyphs are not proportional to the resolution) to keep footers and legends in
+    fig = Figure(figsize=(width * n_cols, height * n_rows + 0.6), dpi=DPI)
     FigureCanvasAgg(fig)
     axes = fig.subplots(n_rows, n_cols, squeeze=False, **kwargs)
     return fig, axes
@@ -248,7 +252,7 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03,
 def save(fig: Figure, out: str | Path) -> Path:
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
+    fig.savefig(out, dpi=DPI)
     return out
 
 
