@@ -143,3 +143,23 @@ def test_periodic_pressure_equals_the_stress_trace(engine, tmp_path):
     assert ts["temperature"].mean() == pytest.approx(np.mean(res.profiles["temperature"]),
                                                      rel=0.02)
     assert ts["temperature"][-1] < 0.9 * ts["temperature"][0]  # it cooled: a live gas
+
+
+def test_lees_edwards_steadiness_is_judged_on_the_fluctuations(tmp_path):
+    """A hot start (T0 = 20) under shear at L = 60 cools towards T ≈ 5 within a few strain
+    units: the peculiar kinetic energy falls by far more than Campbell's 20 %, the total (the
+    mean flow's N γ̇² L²/24 = 150 N of it) by less. The verdict must see the cooling."""
+    scene = validate_scene({
+        "dimension": 2, "box": {"size": [60.0, 60.0]}, "particles": {"solid_fraction": PHI},
+        "contact": {"restitution": 0.9}, "shear": {"rate": RATE},
+        "initial": {"placement": "random", "velocity": {"profile": "linear",
+                                                          "temperature": 20.0}},
+        "run": {"equilibration": 0.0, "production": 3.0, "sample_interval": 0.25, "seed": 1},
+    })
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=tmp_path / "hot.h5",
+                                                           progress=False)))
+    ts = res.timeseries
+    total = ts["kinetic_energy"]
+    assert abs(total[-1] / total[0] - 1) < 0.2  # the total alone would look steady
+    assert ts["peculiar_kinetic_energy"][-1] < 0.5 * ts["peculiar_kinetic_energy"][0]
+    assert res.attrs["kinetic_energy_trend"] < -0.2 and not res.attrs["steady"]
