@@ -84,7 +84,14 @@ _PROFILES = {
 _TIMESERIES = {
     "time": (TIME, "simulation time of the sample"),
     "momentum": (MOMENTUM, "total momentum Σ m v of the mobile particles"),
-    "kinetic_energy": (ENERGY, "translational kinetic energy ½ Σ m v² (total)"),
+    "kinetic_energy": (ENERGY, "translational kinetic energy ½ Σ m v² (total: the mean "
+                               "flow included)"),
+    "peculiar_kinetic_energy": (ENERGY, "y-periodic boxes: ½ Σ m v'², v' the velocity about "
+                                        "the mean flow (Lees–Edwards streaming profile "
+                                        "γ̇ y x̂ and the mean drift removed)"),
+    "temperature": (ENERGY, "y-periodic boxes: granular temperature Σ m v'²/(dim N) per "
+                            "translational degree of freedom, v' as in "
+                            "peculiar_kinetic_energy"),
     "rotational_energy": (ENERGY, "rotational kinetic energy ½ Σ I ω² (total)"),
     "wall_force_lower": (FORCE, "force of the particles on the lower wall, mean over the "
                                 "interval ending at the sample (NaN at t = 0)"),
@@ -105,8 +112,11 @@ _TIMESERIES = {
     "dissipated_energy": (ENERGY, "energy dissipated in collisions since t = 0 "
                                   "(event-driven; translational + rotational)"),
     "gravity_work": (ENERGY, "work done by gravity on the particles since t = 0"),
-    "pressure": ("{stress}", "y-periodic boxes: pressure, kinetic part at the sample + "
-                             "collisional part over the interval ending at it (NaN at t = 0)"),
+    "pressure": ("{stress}", "y-periodic boxes: pressure, peculiar kinetic part "
+                             "2 E'_kin/(dim V) at the sample + the interaction part: "
+                             "event-driven, collisional over the interval ending at the "
+                             "sample (NaN at t = 0); soft, the contact virial at the "
+                             "sample"),
 }
 
 _FRAMES = {

@@ -16,7 +16,9 @@ from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from ..io.results import Results, read_results
 from .kinds import HOW_PLOT_ONLY
@@ -67,6 +69,20 @@ def how_to_get(kind: str) -> str:
 
 LINESTYLES = ("-", "--", ":", "-.")
 MARKERS = ("o", "s", "^", "v", "D", "P")
+#: the resolution of the saved figures (dots per inch)
+DPI = 110
+#: the shades of a run's colour for its bins (1: the colour itself; < 1 darker, > 1 lighter)
+SHADES = (1.0, 0.55, 1.55, 0.3, 1.8)
+
+
+def run_colour(r: int, shade: int = 0) -> tuple[float, float, float]:
+    """Run ``r``'s colour (``C{r}``: one colour per run, in every figure), darkened or
+    lightened for its ``shade``-th bin so that the bins of one run stay apart (they also
+    differ in line style and marker)."""
+    base = np.array(to_rgb(f"C{r % 10}"))
+    f = SHADES[shade % len(SHADES)]
+    rgb = base * f if f <= 1 else base + (1 - base) * (f - 1)
+    return tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))
 
 
 def homogeneous_cooling(scene: Any) -> bool:
@@ -176,25 +192,59 @@ def units_text(runs: Sequence[Run]) -> str:
 def new_figure(n_rows: int, n_cols: int, width: float = 4.0, height: float = 3.6,
                **kwargs: Any) -> tuple[Figure, np.ndarray]:
     """A Figure on the Agg canvas and its axes as a 2D array."""
-    fig = Figure(figsize=(width * n_cols, height * n_rows + 0.6))
+    # made at the resolution it is saved at: text widths are measured at this resolution
+    # (hinted glyphs are not proportional to the resolution) to keep footers and legends in
+    fig = Figure(figsize=(width * n_cols, height * n_rows + 0.6), dpi=DPI)
     FigureCanvasAgg(fig)
     axes = fig.subplots(n_rows, n_cols, squeeze=False, **kwargs)
     return fig, axes
 
 
-def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03) -> Figure:
+def _extent(fig: Figure, artist: Any) -> tuple[float, float]:
+    """An artist's drawn width and height as figure fractions."""
+    box = artist.get_window_extent(fig.canvas.get_renderer())
+    return box.width / fig.bbox.width, box.height / fig.bbox.height
+
+
+def _wrapped(fig: Figure, text: Text, parts: Sequence[str], room: float) -> None:
+    """Set ``text`` to ``parts`` (units, engines), each wrapped at the most characters that
+    keep the drawn text within ``room`` (a figure fraction), measured with the renderer:
+    footers are never cut off at the right edge, whatever the characters."""
+    chars = max(len(p) for p in parts)
+    while True:
+        text.set_text("\n".join(line for p in parts
+                                for line in textwrap.wrap(p, chars, break_on_hyphens=False)))
+        if chars <= 20 or _extent(fig, text)[0] <= room:
+            return
+        chars = int(chars * 0.92)
+
+
+def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03,
+           legend: tuple[Sequence[Any], Sequence[str]] | None = None, max_cols: int = 4,
+           legend_size: float = 7) -> Figure:
     """Title, the units and engine footer, tight layout (applied when the figure is drawn)
-    above ``bottom`` (a figure fraction: room for a legend below the panels)."""
+    above ``bottom`` (a figure fraction). ``legend``: (handles, labels) drawn below the
+    panels, above the footer, with the most columns (≤ ``max_cols``) whose drawn width fits
+    the figure, so that it covers no data and is not cut off; the panels make room for it."""
     engines = ", ".join(dict.fromkeys(run.engine for run in runs))
     fig.suptitle(title, fontsize=10)
-    footer = f"{units_text(runs)}  |  engine: {engines}"
-    chars = int(fig.get_figwidth() * 72 / (7 * 0.56))  # 7 pt characters across the figure
-    if len(footer) > chars:  # the units, then the engines, each wrapped to the figure's width
-        footer = "\n".join(textwrap.wrap(units_text(runs), chars) + textwrap.wrap(
-            f"engine: {engines}", chars, break_on_hyphens=False))
-    fig.text(0.005, 0.005, footer, fontsize=7, ha="left", va="bottom")
-    lines = footer.count("\n") + 1
-    bottom = max(bottom, (lines * 7 * 1.25 / 72 + 0.04) / fig.get_figheight())
+    text = fig.text(0.005, 0.005, "", fontsize=7, ha="left", va="bottom")
+    units, engine = units_text(runs), f"engine: {engines}"
+    one_line = f"{units}  |  {engine}"
+    text.set_text(one_line)
+    if _extent(fig, text)[0] > 0.98:  # the units, then the engines, each wrapped to fit
+        _wrapped(fig, text, (units, engine), 0.98)
+    height = _extent(fig, text)[1] + 0.01
+    if legend is not None and len(legend[1]):
+        handles, labels = legend
+        for ncol in range(min(max_cols, len(labels)), 0, -1):
+            box = fig.legend(handles, labels, fontsize=legend_size, loc="lower center",
+                             ncol=ncol, bbox_to_anchor=(0.5, height), frameon=False)
+            if ncol == 1 or _extent(fig, box)[0] <= 0.98:
+                break
+            box.remove()
+        height += _extent(fig, box)[1] + 0.01
+    bottom = max(bottom, height + 0.01)
     fig.set_layout_engine("tight", rect=(0, bottom, 1, 0.96))  # applied when drawn (saved)
     return fig
 
@@ -202,7 +252,7 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03) -
 def save(fig: Figure, out: str | Path) -> Path:
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
+    fig.savefig(out, dpi=DPI)
     return out
 
 

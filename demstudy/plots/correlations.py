@@ -13,7 +13,16 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .common import LINESTYLES, MARKERS, Run, bin_label, finish, new_figure, pick_bins
+from .common import (
+    LINESTYLES,
+    MARKERS,
+    Run,
+    bin_label,
+    finish,
+    new_figure,
+    pick_bins,
+    run_colour,
+)
 from .profiles import _edges, panels_with_legend_row
 
 
@@ -44,12 +53,15 @@ def draw_gr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
                 (run, name, data, in_bin))
     panels = sorted(variants, key=len)
     fig, axes = new_figure(1, len(panels), width=5.0, height=4.0)
+    entries: dict[str, Any] = {}
     for ax, panel in zip(axes[0], panels, strict=True):
-        for r, (run, name, data, in_bin) in enumerate(variants[panel]):
+        for run, name, data, in_bin in variants[panel]:
+            r = runs.index(run)  # the run's colour in every panel
             g = np.atleast_2d(np.asarray(data["g"], float))
+            g_err = data.get("g_err")
+            g_err = None if g_err is None else np.atleast_2d(np.asarray(g_err, float))
             rr = np.asarray(data["r"], float)
             prefix = f"{run.label}, " if len(runs) > 1 else ""
-            ls = LINESTYLES[r % len(LINESTYLES)]
             if in_bin:
                 y = np.asarray(data["y"], float)
                 valid = np.asarray(data.get("mean_count", np.ones(g.shape[0])), float) > 1
@@ -58,17 +70,21 @@ def draw_gr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
             else:
                 rows, labels = [0], [f"{prefix}whole box".rstrip(", ")]
             for i, (b, label) in enumerate(zip(rows, labels, strict=True)):
-                ax.plot(rr, g[b], ls=ls, color=f"C{i}", lw=1.2, label=label,
-                        gid=f"{run.path.name}:{name}:{b}")
-            if r == 0:
+                ax.errorbar(rr, g[b], yerr=None if g_err is None else g_err[b],
+                            ls=LINESTYLES[i % len(LINESTYLES)], color=run_colour(r, i), lw=1.2,
+                            elinewidth=0.6, label=label, gid=f"{run.path.name}:{name}:{b}")
+            if not any(p.get_label().startswith("beyond") for p in ax.patches):
                 _artefact(ax, np.asarray(data["r_edges"], float), data.get("image_artefact"))
         ax.axhline(1.0, color="0.5", lw=0.8)
         ax.set_title(panel, fontsize=9)
         ax.set_xlabel("r (particle diameters)")
         ax.set_ylabel("g(r)")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
-    return finish(fig, runs, "pair correlation function")
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    # below the panels: g(r) fills them (peaks at contact, tails at 1)
+    return finish(fig, runs, "pair correlation function; error bars: block averages",
+                  legend=(list(entries.values()), list(entries)), max_cols=2)
 
 
 def draw_vcorr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
@@ -86,18 +102,24 @@ def draw_vcorr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure
         c = np.asarray(data["C"], float)
         chosen = pick_bins(np.asarray(data.get("count", np.ones(c.shape[0])), float) > 0, bins)
         prefix = f"{run.label}, " if len(runs) > 1 else ""
-        ls = LINESTYLES[r % len(LINESTYLES)]
-        panels = [(axes[0, a], "xyz"[a] * 2, c[:, a], f"C:{{b}}:{a}") for a in range(c.shape[1])]
+        c_err = data.get("C_err")
+        panels = [(axes[0, a], "xyz"[a] * 2, c[:, a],
+                   None if c_err is None else np.asarray(c_err, float)[:, a], f"C:{{b}}:{a}")
+                  for a in range(c.shape[1])]
         if "C_offdiag" in data:
             c_off = np.asarray(data["C_offdiag"], float)
+            off_err = data.get("C_offdiag_err")
             names = str(attrs.get("offdiag_components", "xy,xz,yz")).split(",")
-            panels += [(axes[1, p], names[p], c_off[:, p], f"C_offdiag:{{b}}:{p}")
-                       for p in range(c_off.shape[1])]
-        for ax, comp, values, gid in panels:
+            panels += [(axes[1, p], names[p], c_off[:, p],
+                        None if off_err is None else np.asarray(off_err, float)[:, p],
+                        f"C_offdiag:{{b}}:{p}") for p in range(c_off.shape[1])]
+        for ax, comp, values, errors, gid in panels:
             for i, b in enumerate(chosen):
-                ax.plot(rr, values[b], ls=ls, marker=".", ms=3, color=f"C{i}",
-                        label=f"{prefix}{bin_label(y, b)}",
-                        gid=f"{run.path.name}:{gid.format(b=b)}")
+                ax.errorbar(rr, values[b], yerr=None if errors is None else errors[b],
+                            ls=LINESTYLES[i % len(LINESTYLES)], marker=MARKERS[i % len(MARKERS)],
+                            ms=2.5, lw=1, elinewidth=0.6, capsize=0, color=run_colour(r, i),
+                            mfc="none" if r else None, label=f"{prefix}{bin_label(y, b)}",
+                            gid=f"{run.path.name}:{gid.format(b=b)}")
             if not ax.get_title():  # first run drawn in this panel
                 _artefact(ax, np.asarray(data["r_edges"], float), data.get("image_artefact"))
                 ax.set_title(f"C_{comp}(r)", fontsize=9)
@@ -105,13 +127,15 @@ def draw_vcorr(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure
                 ax.set_xlabel("r (particle diameters)")
                 ax.grid(alpha=0.3)
     axes[0, 0].set_ylabel("C_αα(r)")
-    axes[0, 0].legend(fontsize=7, loc="upper right")
     if off:
         axes[1, 0].set_ylabel("C_αβ(r), symmetrised")
         for ax in axes[1]:
             ax.set_visible(bool(ax.get_title()))  # 2D: one off-diagonal panel of two
+    # below the panels: the correlations are largest at contact, in the corner a legend
+    # would take
     return finish(fig, runs, "spatial velocity correlations (fluctuations about the "
-                             "run-mean bin velocity)")
+                             "run-mean bin velocity); error bars: block averages",
+                  legend=axes[0, 0].get_legend_handles_labels(), max_cols=3)
 
 
 def draw_lambda(runs: Sequence[Run]) -> Figure:

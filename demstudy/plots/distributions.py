@@ -13,7 +13,16 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
-from .common import LINESTYLES, MARKERS, Run, bin_label, finish, new_figure, pick_bins
+from .common import (
+    LINESTYLES,
+    MARKERS,
+    Run,
+    bin_label,
+    finish,
+    new_figure,
+    pick_bins,
+    run_colour,
+)
 
 X_TITLES = {
     "X1": "X1 = |u′| / √⟨u′²⟩",
@@ -48,16 +57,19 @@ def draw_vdf(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
         y, count = np.asarray(data["y"], float), np.asarray(data["count"], float)
         chosen = pick_bins(count > 0, bins)
         prefix = f"{run.label}, " if len(runs) > 1 else ""
-        ls = LINESTYLES[r % len(LINESTYLES)]
         names = _split(attrs, "X_names", "X1,X2,X3,X4,X5")
         dof = _split(attrs, "X_degrees_of_freedom", "1,1,1,2,3")
         a_vals = _split(attrs, "X_a", "0.5,0.5,0.5,1,1.5")
         xc = np.asarray(data["X_centres"], float)
         for k, name in enumerate(names[:5]):
             ax = axes[0, k]
+            err = data.get("X_err")
             for i, b in enumerate(chosen):
-                ax.plot(xc, data["X"][b, k], ls=ls, marker="o", ms=2, color=f"C{i}",
-                        label=f"{prefix}{bin_label(y, b)}", gid=f"{run.path.name}:X:{b}:{name}")
+                ax.errorbar(xc, data["X"][b, k], yerr=None if err is None else err[b, k],
+                            ls=LINESTYLES[i % len(LINESTYLES)], lw=1,
+                            marker=MARKERS[i % len(MARKERS)], ms=2, elinewidth=0.6,
+                            color=run_colour(r, i), label=f"{prefix}{bin_label(y, b)}",
+                            gid=f"{run.path.name}:X:{b}:{name}")
             if r == 0:
                 ax.plot(xc, data["X_reference"][k], "k--", lw=1,
                         label=f"folded Maxwellian (k = {dof[k]}, a = {a_vals[k]})",
@@ -69,14 +81,17 @@ def draw_vdf(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
         cc = np.asarray(data["malik_centres"], float)
         for c, comp in enumerate(comps[r]):
             ax = axes[1, c]
+            err = data.get("malik_P_err")
             for i, b in enumerate(chosen):
-                ax.semilogy(cc, data["malik_P"][b, c], ls="none", marker=MARKERS[r % 6], ms=3,
-                            mfc="none" if r else None, color=f"C{i}",
-                            label=f"{prefix}{bin_label(y, b)}",
+                ax.errorbar(cc, data["malik_P"][b, c], ls="none",
+                            yerr=None if err is None else err[b, c], elinewidth=0.6,
+                            marker=MARKERS[i % len(MARKERS)], ms=3, mfc="none" if r else None,
+                            color=run_colour(r, i), label=f"{prefix}{bin_label(y, b)}",
                             gid=f"{run.path.name}:malik_P:{b}:{comp}")
+            ax.set_yscale("log")
             if r == 0:
-                ax.semilogy(cc, data["gaussian"], "k--", lw=1, label="Gaussian exp(−x²/2)",
-                            gid=f"{run.path.name}:gaussian:-:{comp}")
+                ax.plot(cc, data["gaussian"], "k--", lw=1, label="Gaussian exp(−x²/2)",
+                        gid=f"{run.path.name}:gaussian:-:{comp}")
             title = MALIK_TITLES.get(comp, comp)
             ax.set_title(f"{title} / σ (P(0) = 1)", fontsize=9)
             ax.set_xlabel(f"{title}/σ")
@@ -90,12 +105,12 @@ def draw_vdf(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
     for ax in (axes[0, 0], axes[0, 4], axes[1, 0]):
         for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             entries.setdefault(label, handle)
-    rows = -(-len(entries) // 4)
-    fig.legend(list(entries.values()), list(entries), fontsize=7, loc="lower center",
-               ncol=min(len(entries), 4), bbox_to_anchor=(0.5, 0.03), frameon=False)
+    references = ("folded Maxwellian", "Gaussian")  # after the runs' bins
+    entries = dict(sorted(entries.items(), key=lambda kv: kv[0].startswith(references)))
     return finish(fig, runs, "velocity distributions: Campbell's P(X) (top), "
-                             "Malik's C/σ (bottom), fluctuations about the bin means",
-                  bottom=(0.4 + 0.16 * rows) / fig.get_figheight())
+                             "Malik's C/σ (bottom), fluctuations about the bin means; error "
+                             "bars: block averages",
+                  legend=(list(entries.values()), list(entries)))
 
 
 def draw_angles(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figure:
@@ -113,7 +128,6 @@ def draw_angles(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figur
         deg = np.degrees(np.asarray(data["theta"], float))
         chosen = pick_bins(np.asarray(data["pair_collisions"]) > 0, bins)
         prefix = f"{run.label}, " if len(runs) > 1 else ""
-        ls = LINESTYLES[r % len(LINESTYLES)]
         for ax, conv in zip(axes, ("text", "listing"), strict=True):
             if f"p_{conv}" not in data:
                 continue
@@ -122,13 +136,14 @@ def draw_angles(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figur
                 s_text = "" if s is None or not np.isfinite(s[b]) else f", S = {float(s[b]):.2f}"
                 err = data.get(f"p_{conv}_err")
                 ax.errorbar(deg, data[f"p_{conv}"][b], yerr=None if err is None else err[b],
-                            ls=ls, marker="o", ms=2, capsize=1, color=f"C{i}",
+                            ls="-", marker=MARKERS[i % len(MARKERS)], ms=2, capsize=1,
+                            color=run_colour(r, i),
                             label=f"{prefix}{bin_label(y, b)}{s_text}",
                             gid=f"{run.path.name}:p_{conv}:{b}")
                 for key, style, what in (("R", "--", "R"), ("C", ":", "C")):
                     sj = data.get(f"sj_{conv}_{key}")
                     if sj is not None and np.any(np.isfinite(sj[b])):
-                        ax.plot(deg, sj[b], ls=style, color=f"C{i}", lw=1,
+                        ax.plot(deg, sj[b], ls=style, color=run_colour(r, i), lw=1,
                                 label=f"Savage–Jeffrey ({what})" if i == 0 and r == 0 else None,
                                 gid=f"{run.path.name}:sj_{conv}_{key}:{b}")
             ax.axhline(1 / np.pi, color="0.5", lw=0.8, label="isotropic 1/π" if r == 0 else None)
@@ -139,13 +154,9 @@ def draw_angles(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Figur
             ax.set_xticks(np.arange(0, 181, 30))
             ax.grid(alpha=0.3)
     # below the panels: the distributions fill the whole θ range, so no corner is free
-    handles, labels = axes[0].get_legend_handles_labels()
-    rows = -(-len(labels) // 4)
-    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=min(len(labels), 4),
-               bbox_to_anchor=(0.5, 0.035), frameon=False)
     return finish(fig, runs, "collision-angle distributions (pair collisions, contact point "
                              "binned in y); dashed/dotted: Savage–Jeffrey with R / C",
-                  bottom=0.05 + 0.035 * rows)
+                  legend=axes[0].get_legend_handles_labels(), max_cols=3)
 
 
 def _fmt(data: dict, key: str, b: int) -> str:
@@ -174,7 +185,6 @@ def draw_freepath(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Fig
         occupied = np.asarray(data.get("flights", data["mean_free_path"]), float) > 0
         chosen = pick_bins(occupied & np.isfinite(data["mean_free_path"]), bins)
         prefix = f"{run.label}, " if len(runs) > 1 else ""
-        ls = LINESTYLES[r % len(LINESTYLES)]
         if "knudsen_width" in attrs:
             widths.append(f"{float(attrs['knudsen_width']):.3g} "
                           f"({attrs.get('knudsen_width_is', 'Kn length')})")
@@ -188,19 +198,26 @@ def draw_freepath(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Fig
                     label += f", Enskog {sym}_E = {float(data[enskog_key][b]):.3g}"
                 err = data.get(f"p_{x_key}_err")
                 ax.errorbar(x, data[f"p_{x_key}"][b], yerr=None if err is None else err[b],
-                            ls=ls, marker="o", ms=2, capsize=1, color=f"C{i}", label=label,
+                            ls="-", marker=MARKERS[i % len(MARKERS)], ms=2, capsize=1,
+                            color=run_colour(r, i), label=label,
                             gid=f"{run.path.name}:p_{x_key}:{b}")
                 # the reference uses the bin's own measured mean: it tests the shape only
                 mean = float(data[mean_key][b])
-                ax.plot(x, np.exp(-x / mean) / mean, ls="--", lw=1, color=f"C{i}",
+                ax.plot(x, np.exp(-x / mean) / mean, ls="--", lw=0.8, color=run_colour(r, i),
                         label="exponential (1/⟨x⟩) e^(−x/⟨x⟩)" if i == 0 and r == 0 else None,
                         gid=f"{run.path.name}:exp_{x_key}:{b}")
             ax.set_yscale("log")
             ax.set_xlabel(xlabel)
             ax.set_ylabel(f"P({sym}) (per unit {'length' if x_key == 'lambda' else 'time'})")
             ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=6, loc="lower left")
     title = "free paths λ and free times τ per y-bin (centre to centre, starting centre's bin)"
     if widths:
         title += "\nKn = ⟨λ⟩/W, W = " + ", ".join(dict.fromkeys(widths))
-    return finish(fig, runs, title)
+    # below the panels (the distributions reach every corner): the λ panel's entries, then
+    # the τ panel's
+    entries: dict[str, object] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    return finish(fig, runs, title, legend=(list(entries.values()), list(entries)),
+                  max_cols=2, legend_size=6)

@@ -15,7 +15,7 @@ from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from .common import MARKERS, Run, finish, new_figure
+from .common import MARKERS, Run, finish, new_figure, run_colour
 
 PANELS = (
     ("solid_fraction", "solid fraction ν"),
@@ -76,7 +76,7 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
     what: set[str] = set()
     # (handle, label) of the strip and cell temperatures: their own legend in those panels
     cells: dict[Axes, list[tuple[ErrorbarContainer, str]]] = {ax: [] for ax in axes}
-    for run in runs:
+    for r, run in enumerate(runs):
         prof = run.results.profiles
         y = np.asarray(prof["y"], float)
         label = run.label
@@ -99,7 +99,7 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
                 val, err = val[:, 0], None if err is None else err[:, 0]
             mask = occupied if key != "solid_fraction" else np.ones_like(occupied)
             strip = ax.errorbar(val[mask], y[mask], xerr=None if err is None else err[mask],
-                                marker="o", ms=3, capsize=2, label=label,
+                                marker="o", ms=3, capsize=2, label=label, color=f"C{r % 10}",
                                 gid=f"{run.path.name}:{key}")
             if f"cell_{key}" in prof and n_cells > 1:
                 # Malik's cells: fluctuations about each z-slab's mean, so a mean velocity
@@ -120,16 +120,12 @@ def draw_profiles(runs: Sequence[Run], scaled: bool = False) -> Figure:
         ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 4))
     set_height_label(axes[0], runs[0].results.profile_attrs.get("axis", "y"), scaled, what,
                      "particle diameters")
-    # the runs' legend below the panels: profiles fill the panels' height, no corner is free
-    handles, labels = axes[0].get_legend_handles_labels()
-    lines = sum(label.count("\n") + 1 for label in labels[::2]) + len(labels) % 2
-    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=min(len(labels), 2),
-               bbox_to_anchor=(0.5, 0.045), frameon=False)
     for ax, pairs in cells.items():
         if pairs:
             ax.legend(*zip(*pairs, strict=True), fontsize=7, loc="upper right")
+    # the runs' legend below the panels: profiles fill the panels' height, no corner is free
     return finish(fig, runs, "profiles: solid fraction, mean velocity, temperatures",
-                  bottom=(0.5 + 0.17 * max(1, lines)) / fig.get_figheight())
+                  legend=axes[0].get_legend_handles_labels(), max_cols=2, legend_size=8)
 
 
 def panels_with_legend_row(n_cols: int, legend_lines: int, width: float, height: float,
@@ -257,7 +253,6 @@ def draw_stress(runs: Sequence[Run]) -> Figure:
     fig, axes = new_figure(1, 2, width=5.0, height=5.0, sharey=True)
     axes = axes[0]
     comps = (("xy", 0, 1), ("yy", 1, 1))
-    colours = [f"C{i}" for i in range(10)]
     for r, run in enumerate(runs):
         data, _attrs = run.group("stress")
         y = np.asarray(data["y"], float)
@@ -271,7 +266,7 @@ def draw_stress(runs: Sequence[Run]) -> Figure:
                 err = data.get(f"{key}_err")
                 err = None if err is None else np.asarray(err, float)[:, a, b]
                 ax.errorbar(val, y, xerr=err, ls=STRESS_STYLE[key], marker=MARKERS[p], ms=3,
-                            capsize=2, color=colours[(r * 4 + p) % 10], label=f"{prefix}{key}",
+                            capsize=2, color=run_colour(r, p), label=f"{prefix}{key}",
                             gid=f"{run.path.name}:{key}:{name}")
             for side, y_wall in (("lower", edges[0]), ("upper", edges[-1])):
                 if f"wall_{side}" not in data:
@@ -280,7 +275,7 @@ def draw_stress(runs: Sequence[Run]) -> Figure:
                 err = data.get(f"wall_{side}_err")
                 ax.errorbar([val], [y_wall], xerr=None if err is None else [float(err[a])],
                             marker="D" if side == "lower" else "v", ms=8, ls="none",
-                            color="k", mfc="none", capsize=3,
+                            color=f"C{r % 10}", mfc="none", mew=1.5, capsize=3,
                             label=f"{prefix}{side} wall", gid=f"{run.path.name}:wall_{side}:{name}")
             key = f"balance_tau_{name}"
             if key in data:
@@ -295,11 +290,12 @@ def draw_stress(runs: Sequence[Run]) -> Figure:
             ax.set_xlabel(f"P_{name} (compressive positive, P = −σ)")
             ax.grid(alpha=0.3)
     axes[0].set_ylabel("y (particle diameters)")
-    axes[1].legend(fontsize=7, loc="upper left")
     dims = {int(run.group("stress")[1].get("dim", 2)) for run in runs}
     per = "force per length (2D)" if dims == {2} else "force per area (3D)" if dims == {3} \
         else "force per length (2D) or area (3D)"
-    return finish(fig, runs, f"stress profiles in {per}; markers: wall stresses at the walls")
+    # below the panels: the profiles span the whole height, no corner is free
+    return finish(fig, runs, f"stress profiles in {per}; markers: wall stresses at the walls",
+                  legend=axes[1].get_legend_handles_labels(), max_cols=3)
 
 
 def draw_eos(runs: Sequence[Run]) -> Figure:
@@ -338,10 +334,10 @@ def draw_eos(runs: Sequence[Run]) -> Figure:
     ax.set_ylabel("χ(ν) = P_yy / (ρ_p Σ⟨v'²⟩)")
     ax.set_yscale("log")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
     g0 = "Henderson g0 (discs)" if dims == {2} else "Carnahan–Starling g0 (spheres)" \
         if dims == {3} else "Henderson / Carnahan–Starling g0"
-    return finish(fig, runs, f"equation of state χ(ν), Campbell (1982); theory: {g0}")
+    return finish(fig, runs, f"equation of state χ(ν), Campbell (1982); theory: {g0}",
+                  legend=ax.get_legend_handles_labels(), max_cols=2)
 
 
 def cooling_temperature(run: Run) -> tuple[np.ndarray, np.ndarray]:

@@ -3,11 +3,13 @@
 Dimensionless particle units: d = 1, m = 1 (mass ∝ d^dim), time in the scene's unit.
 Observables per sample besides the loop's own: ``collisions`` (cumulative pair count),
 ``wall_collisions``, ``dissipated_energy`` (cumulative), ``gravity_work``, ``wall_work_<side>``
-and in y-periodic boxes ``pressure``: the kinetic part 2 E_kin/(dim V) at the sample plus the
-collisional part ΔW/(dim V Δt) over the interval that ends at the sample (NaN at t = 0);
-W = Σ r_ij·J_i. The interaction stress is collisional (cumulative per-bin sums of −J_i ⊗ r_ij).
-Checkpoints restore the synchronised core state, so a resumed run is bit-identical to an
-uninterrupted one.
+and in y-periodic boxes ``peculiar_kinetic_energy`` and ``temperature`` (fluctuations about
+the mean flow, the Lees–Edwards streaming profile included: ``engines.peculiar``) and
+``pressure``: the peculiar kinetic part 2 E'_kin/(dim V) at the sample plus the collisional
+part ΔW/(dim V Δt) over the interval that ends at the sample (NaN at t = 0); W = Σ r_ij·J_i.
+The interaction stress is collisional (cumulative per-bin sums of −J_i ⊗ r_ij). Checkpoints
+restore the synchronised core state, so a resumed run is bit-identical to an uninterrupted
+one.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from ...io.frames import Frame
 from ...scene import Scene
 from ...scene.initial import InitialState, build_initial_state
 from ..backend import BackendBase, Capabilities, EngineOption, Needs
+from ..peculiar import peculiar_observables
 from .core import DEFAULT_TC, EventDriven, advance_watched, from_initial_state
 from .effects import TRANSLATIONS, core_options
 from .tc_share import TcShare, tc_share
@@ -197,11 +200,17 @@ class EdmdBackend(BackendBase):
             values[f"wall_work_{wall.side}"] = core.wall_work(self._wall(wall.side))
         t = core.time
         if scene.y_periodic:
+            # the mean flow (Lees–Edwards streaming profile) is no pressure: peculiar part only
+            rate = scene.shear.rate if scene.shear is not None else 0.0
+            peculiar = peculiar_observables(core.positions()[:self.n_particles], velocity,
+                                            self.mass, rate)
+            values.update(peculiar)
             span = t - self.last_time
             virial = core.virial
             volume = math.prod(scene.box.size)
             values["pressure"] = float("nan") if self.first or span <= 0 else \
-                (2 * kinetic / dim + (virial - self.last_virial) / (dim * span)) / volume
+                (2 * peculiar["peculiar_kinetic_energy"] / dim
+                 + (virial - self.last_virial) / (dim * span)) / volume
             self.last_virial = virial
         self.last_time, self.first = t, False
         return values

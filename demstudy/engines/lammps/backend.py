@@ -33,6 +33,7 @@ from ...io.frames import Frame
 from ...scene import Scene
 from ...scene.initial import build_initial_state
 from ..backend import BackendBase, Capabilities, Needs, frame_mass
+from ..peculiar import peculiar_observables
 from .deck import build_deck, check_scene, write_deck
 from .deck.effects import TRANSLATIONS, wall_fix_id, wall_force_sources
 from .deck.output import (
@@ -42,6 +43,7 @@ from .deck.output import (
     STRESS_COLUMNS,
     STRESS_IDS,
     STRESS_PAIRS,
+    VIRIAL_PRESSURE,
     WALL_FORCES,
     sample_steps,
 )
@@ -313,12 +315,24 @@ class LammpsBackend(BackendBase):
             self.session.command(
                 f"write_dump mobile custom {quoted(self.dump)} id type radius x y z vx vy vz "
                 "omegax omegay omegaz modify sort id append yes format float %.17g")
+        scene = self.scene
         mass = frame_mass(frame)
-        inertia = self.scene.inertia_k * mass * frame.radius**2
-        return {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
-                "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
-                "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
-                                                        frame.angular_velocity**2))}
+        inertia = scene.inertia_k * mass * frame.radius**2
+        values = {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
+                  "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
+                  "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
+                                                          frame.angular_velocity**2))}
+        if scene.y_periodic:
+            # the mean flow (Lees–Edwards streaming profile) is no pressure: peculiar part
+            # from the velocities, contact part from LAMMPS's virial at this step
+            rate = scene.shear.rate if scene.shear is not None else 0.0
+            peculiar = peculiar_observables(frame.position, frame.velocity, mass, rate)
+            volume = float(np.prod(frame.box_hi - frame.box_lo))
+            values.update(peculiar)
+            values["pressure"] = (2 * peculiar["peculiar_kinetic_energy"]
+                                  / (scene.dimension * volume)
+                                  + self.session.compute_scalar(VIRIAL_PRESSURE))
+        return values
 
     def wall_impulse(self) -> dict[str, np.ndarray]:
         return {side: value.copy() for side, value in self.impulse.items()}

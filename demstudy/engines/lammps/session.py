@@ -121,6 +121,11 @@ class LammpsSession:
             return np.array([self.lmp.extract_fix(fix_id, style, self._lam.LMP_TYPE_SCALAR)])
         return np.array([self.lmp.extract_fix(fix_id, style, kind, i) for i in range(length)])
 
+    def compute_scalar(self, compute_id: str) -> float:
+        """Global scalar of a compute (e.g. ``compute pressure``), identical on every rank."""
+        return float(self.lmp.extract_compute(compute_id, self._lam.LMP_STYLE_GLOBAL,
+                                              self._lam.LMP_TYPE_SCALAR))
+
     def box_lengths(self) -> np.ndarray:
         boxlo, boxhi, *_ = self.lmp.extract_box()
         return np.asarray(boxhi) - np.asarray(boxlo)

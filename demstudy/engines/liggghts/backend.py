@@ -21,6 +21,7 @@ continues the uninterrupted run closely but not bit for bit.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -36,6 +37,7 @@ from ...scene import Scene
 from ...scene.initial import build_initial_state
 from ..backend import BackendBase, Capabilities, Needs, frame_mass
 from ..lammps.deck.output import sample_steps
+from ..peculiar import peculiar_observables
 from .deck import (
     BUMP_MASS_FACTOR,
     DATA_FILE,
@@ -275,13 +277,24 @@ class LiggghtsBackend(BackendBase):
         return self._frame
 
     def observe(self, production: bool) -> dict:
-        frame = self.frame()
+        frame, scene = self.frame(), self.scene
         mass = frame_mass(frame)
-        inertia = self.scene.inertia_k * mass * frame.radius**2
-        return {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
-                "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
-                "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
-                                                        frame.angular_velocity**2))}
+        inertia = scene.inertia_k * mass * frame.radius**2
+        values = {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
+                  "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
+                  "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
+                                                          frame.angular_velocity**2))}
+        if scene.y_periodic:
+            # as the other engines: kinetic part about the mean flow (no Lees–Edwards shear in
+            # LIGGGHTS, so about the drift), contact part from this step's contacts
+            values.update(peculiar_observables(frame.position, frame.velocity, mass))
+            x, _v, _w, r = self._gather()
+            whole = np.array([0.0, scene.box.size[1]])  # one bin: the whole periodic box
+            sums = contact_stress_sums(self.lmp, scene, x, r, self.types, whole)[0]
+            volume, dim = math.prod(scene.box.size), scene.dimension
+            values["pressure"] = (2 * values["peculiar_kinetic_energy"]
+                                  + float(np.trace(sums))) / (dim * volume)
+        return values
 
     def wall_impulse(self) -> dict[str, np.ndarray]:
         return {side: value.copy() for side, value in self.impulse.items()}

@@ -18,6 +18,9 @@ STRESS_COLUMNS = 9
 #: distance and x_i - x_j (p10-p12) of every touching pair, and their atom IDs
 HEALTH_PAIRS, HEALTH_IDS = "health_pairs", "health_ids"
 HEALTH_COLUMNS = 4
+#: y-periodic boxes: the contact part of the pressure, tr(Σ r_ij f_ij)/(dim V), read by the
+#: driver at each sample (the virial is tallied on thermo steps only: it is a thermo column)
+VIRIAL_PRESSURE = "virial_pressure"
 
 
 def sample_steps(scene: Scene, dt: float) -> int:
@@ -49,6 +52,11 @@ def sampling_block(scene: Scene, setup: ContactSetup) -> Block:
     # costs nothing between reads)
     cmds.append(f"compute {HEALTH_PAIRS} all pair/local dist p10 p11 p12 cutoff radius")
     cmds.append(f"compute {HEALTH_IDS} all property/local patom1 patom2 cutoff radius")
+    if scene.y_periodic:
+        # virial only: LAMMPS's kinetic part would count the Lees–Edwards mean flow as heat
+        # (the driver adds the peculiar kinetic part, demstudy.engines.peculiar)
+        cmds.append(f"compute {VIRIAL_PRESSURE} all pressure NULL virial")
+        columns.append(f"c_{VIRIAL_PRESSURE}")
     if scene.shear is not None:
         columns.append("xy")  # the Lees–Edwards tilt
     cmds.append("thermo_style custom " + " ".join(columns))
