@@ -38,10 +38,18 @@ chunks longer than the correlation time of the collision statistics).
 Free paths (:func:`free_flights`, :func:`flight_chunks`, :class:`FreePath`): the reading is
 *every particle's flights, path measured centre to centre*: each particle's consecutive
 logged collisions (pairs as i or j via the ``i``, ``j`` datasets, walls and bumps as i) bound
-a flight of exact duration tau; lambda is the distance its centre travels (the chord through
-the nearest periodic image, Lees–Edwards offset included; the parabola's arc length under
-gravity). The log must hold every collision (``log_every`` = 1). Censored flights (before a
-particle's first and after its last logged collision) are dropped, and only flights starting
+a flight of exact duration tau; lambda is the distance its centre travels *relative to the
+local mean flow* u(y) (the chord through the nearest periodic image, Lees–Edwards offset
+included, less u_f tau with u_f the mean of u along the flight; the parabola's arc length
+under gravity in the frame moving at u_f). Kinetic theory's mean free path <|C|>/omega is
+that of the peculiar velocity C = c - u: in the lab frame a flight in a shear or Poiseuille
+flow also carries the mean-flow drift u tau, which grows with |u| and makes <lambda> and Kn
+depend on the frame (a sheared dilute gas: about twice Enskog's lambda next to the
+Lees–Edwards boundaries). Malik (2008) writes l = sqrt(dx^2 + dy^2 + dz^2) "between
+successive collisions" without naming the frame; the lab-frame value is kept as
+``lab_length`` / ``lab_mean_free_path`` / ``lab_knudsen``. The log must hold every
+collision (``log_every`` = 1). Censored flights (before a particle's first and after its
+last logged collision) are dropped, and only flights starting
 a horizon before the log's end count, longer ones weighted, so that the window's censoring
 does not favour short flights; flights longer than the window are never seen. Malik's
 Kn = <lambda>/W is stored per bin with W; with profiles, Enskog's references
@@ -73,6 +81,7 @@ __all__ = [
     "collision_chunks",
     "flight_chunks",
     "flight_length",
+    "flight_mean_flow",
     "free_flights",
     "savage_jeffrey_projected",
 ]
@@ -269,11 +278,25 @@ def flight_length(delta: ArrayLike, tau: ArrayLike,
     return np.where(t > 0, arc, chord)  # tau = 0: no flight (simultaneous collisions)
 
 
+def flight_mean_flow(mean_flow: Callable[[np.ndarray], np.ndarray], y0: ArrayLike,
+                     dy: ArrayLike, tau: ArrayLike,
+                     gravity: ArrayLike | None = None) -> np.ndarray:
+    """Mean of the mean flow u(y(s)) (M, dim) along each flight from height ``y0`` rising
+    ``dy`` in ``tau``: Simpson's rule on the exact y(s) = y0 + v_y s + g_y s^2/2, whose
+    mid-flight height is y0 + dy/2 - g_y tau^2/8 (exact for u linear in y, which makes
+    u(y(s)) at most quadratic in s)."""
+    y0, dy, t = (np.asarray(a, float) for a in (y0, dy, tau))
+    g_y = float(np.asarray(gravity, float)[1]) if gravity is not None else 0.0
+    mid = y0 + 0.5 * dy - g_y * t**2 / 8
+    return (mean_flow(y0) + 4 * mean_flow(mid) + mean_flow(y0 + dy)) / 6
+
+
 def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
                  gravity: ArrayLike | None = None,
                  shear_offset: Callable[[np.ndarray], np.ndarray] | None = None,
                  x_period: Callable[[np.ndarray], np.ndarray] | None = None,
-                 start: float = 0.0) -> dict[str, Any]:
+                 start: float = 0.0,
+                 mean_flow: Callable[[np.ndarray], np.ndarray] | None = None) -> dict[str, Any]:
     """Every particle's free flights between consecutive logged collisions.
 
     ``log``: the ``/collisions`` datasets with ``i``, ``j`` (every collision: ``log_every`` =
@@ -287,13 +310,19 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
     tau = t2 - t1 exactly, the displacement is the nearest periodic image of c2 - c1 (a y wrap
     under Lees–Edwards also shifts x by the offset at t2; the image of a flight longer than
     half a period along an axis is taken as the shorter one: keep the periods >> lambda) and
-    lambda = :func:`flight_length`. Censored flights (before a particle's first logged
-    collision, after its last) are dropped.
+    ``lab_length`` = :func:`flight_length` of that displacement (the lab frame). The free
+    path proper, ``length``, is measured relative to the local mean flow ``mean_flow(y)``
+    ((M,) y, unwrapped across a Lees–Edwards boundary, -> (M, dim) velocity): the flight's
+    displacement less u_f tau, u_f the mean of u(y(s)) along the flight (Simpson's rule on
+    the exact y(s): exact for a linear profile), i.e. the flight seen from the frame moving
+    with the local mean flow (the arc length there under gravity). Without ``mean_flow`` it
+    is the lab-frame length. Censored flights (before a particle's first logged collision,
+    after its last) are dropped.
 
     Returns ``t0``, ``t1`` (the logged window), ``collisions`` (particle collisions: 2 per
     pair, 1 per wall), ``event_time``, ``event_y`` (every particle collision: time, centre y)
-    and per flight ``particle``, ``start_time``, ``tau``, ``length``, ``start`` (M, dim)
-    starting centre, ``y_wrapped`` (crossed the y period)."""
+    and per flight ``particle``, ``start_time``, ``tau``, ``length``, ``lab_length``,
+    ``start`` (M, dim) starting centre, ``y_wrapped`` (crossed the y period)."""
     if "i" not in log or "j" not in log:
         raise ValueError("the collision log has no particle indices i, j (an older results "
                          "file): free paths need them")
@@ -337,12 +366,17 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
         if per[a] > 0:
             length = x_period(when[nxt + 1]) if a == 0 and x_period is not None else per[a]
             delta[:, a] -= length * np.rint(delta[:, a] / length)
+    lab = flight_length(delta, tau, gravity)
+    length = lab
+    if mean_flow is not None:
+        u_f = flight_mean_flow(mean_flow, where[nxt, 1], delta[:, 1], tau, gravity)
+        length = flight_length(delta - u_f * tau[:, None], tau, gravity)
     y = where[:, 1] if per[1] == 0 else np.mod(where[:, 1], per[1])
     return {"t0": float(t.min()), "t1": float(t.max()),
             "collisions": int(2 * pair.sum() + (~pair).sum()),
             "event_time": when, "event_y": y,
             "particle": who[nxt], "start_time": when[nxt], "tau": tau,
-            "length": flight_length(delta, tau, gravity),
+            "length": length, "lab_length": lab,
             "start": np.column_stack([where[nxt, :1], y[nxt], where[nxt, 2:]]),
             "y_wrapped": wrapped}
 
@@ -376,9 +410,11 @@ def flight_chunks(flights: Mapping[str, Any], n_chunks: int = 64,
     weight = np.where(tau <= h, 1.0, (span - h) / np.maximum(span - tau, np.finfo(float).tiny))
     f_chunk, e_chunk = which(np.asarray(flights["start_time"])), which(flights["event_time"])
     y, ey = np.asarray(flights["start"], float)[:, 1], np.asarray(flights["event_y"], float)
+    length = np.asarray(flights["length"], float)
+    lab = np.asarray(flights.get("lab_length", length), float)
     for c in range(n_chunks):
         sel, ev = f_chunk == c, e_chunk == c
-        yield {"y": y[sel], "length": np.asarray(flights["length"])[sel], "tau": tau[sel],
+        yield {"y": y[sel], "length": length[sel], "lab_length": lab[sel], "tau": tau[sel],
                "weight": weight[sel], "event_y": ey[ev], "duration": (span - h) / n_chunks,
                "horizon": h}
 
@@ -387,13 +423,15 @@ class FreePath(AnalysisBase):
     """Free-path and free-time distributions per y-bin, fed with :func:`flight_chunks`.
 
     Reading: every particle's flights (each particle's consecutive collisions, pairs as i or
-    j and walls), path measured centre to centre (the arc length under gravity), binned by
+    j and walls), path measured centre to centre relative to the local mean flow (the arc
+    length under gravity; chunks may carry ``lab_length``, the lab-frame one), binned by
     the y of the flight's starting centre, starting up to a horizon before the log's end
     (flights longer than it weighted against the window's censoring, :func:`flight_chunks`).
     Per bin: P(lambda), P(tau) (normalised over
     every flight of the bin, so flights beyond ``lambda_max`` / ``tau_max`` leave the area
     short by their fraction), <lambda>, <tau>, the moment ratios <x^2>/<x>^2 (2 for an
-    exponential), Kn = <lambda>/``width`` and the collision rate (particle collisions whose
+    exponential), Kn = <lambda>/``width``, the lab-frame ``lab_mean_free_path`` and
+    ``lab_knudsen``, and the collision rate (particle collisions whose
     centre is in the bin, per unit time); errors by jackknife over blocks of chunks.
 
     Parameters
@@ -403,7 +441,7 @@ class FreePath(AnalysisBase):
     """
 
     _SUMS = ("weight", "weight_length", "weight_length2", "weight_tau", "weight_tau2",
-             "events", "flights")
+             "events", "flights", "weight_lab_length")
 
     def __init__(self, edges: ArrayLike, lambda_max: float, tau_max: float, width: float,
                  n_hist: int = 50, dim: int = 3, max_blocks: int = 64,
@@ -436,13 +474,15 @@ class FreePath(AnalysisBase):
         ok = (ybin >= 0) & (ybin < self.n_bins)
         ybin = ybin[ok]
         lam, tau = np.asarray(chunk["length"], float)[ok], np.asarray(chunk["tau"], float)[ok]
+        lab = np.asarray(chunk.get("lab_length", chunk["length"]), float)[ok]
         w = np.asarray(chunk["weight"], float)[ok]
         ebin = bin_index(self.edges, np.asarray(chunk["event_y"], float))
         ebin = ebin[(ebin >= 0) & (ebin < self.n_bins)]
         nb = self.n_bins
         sums = [np.bincount(ybin, v, minlength=nb) for v in (w, w * lam, w * lam**2, w * tau,
                                                              w * tau**2)]
-        sums += [np.bincount(ebin, minlength=nb), np.bincount(ybin, minlength=nb)]
+        sums += [np.bincount(ebin, minlength=nb), np.bincount(ybin, minlength=nb),
+                 np.bincount(ybin, w * lab, minlength=nb)]
         self._acc.add(np.concatenate([self._hist(ybin, lam, self.lambda_edges, w),
                                       self._hist(ybin, tau, self.tau_edges, w), *sums]))
         self.n_flights += int(ok.sum())
@@ -458,6 +498,9 @@ class FreePath(AnalysisBase):
             "mean_free_path": wl / w, "mean_free_time": wt / w,
             "lambda_ratio": wl2 * w / wl**2, "tau_ratio": wt2 * w / wt**2,
             "knudsen": wl / w / self.width,
+            "lab_mean_free_path": s["weight_lab_length"] / w,
+            "lab_knudsen": s["weight_lab_length"] / w / self.width,
+            "all_lab_mean_free_path": np.asarray(tot["weight_lab_length"] / tot["weight"]),
             "collision_rate": s["events"] / self.duration,
             "all_mean_free_path": np.asarray(tot["weight_length"] / tot["weight"]),
             "all_mean_free_time": np.asarray(tot["weight_tau"] / tot["weight"]),
@@ -490,7 +533,9 @@ class FreePath(AnalysisBase):
             "block_length": self._acc.block_length, "n_blocks": self._acc.n_blocks,
             "knudsen_width": self.width,
             "reading": "every particle's flights between consecutive collisions (pairs as i "
-                       "or j, walls and bumps), centre to centre (arc length under gravity), "
+                       "or j, walls and bumps), centre to centre relative to the local mean "
+                       "flow (displacement less the flight's mean of u(y) times tau; arc "
+                       "length under gravity; lab_*: the lab-frame displacement), "
                        "binned by the starting centre's y; starts up to t1 - horizon, flights "
                        "longer than the horizon weighted (T - horizon)/(T - tau) for the "
                        "window's censoring",

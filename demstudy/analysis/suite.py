@@ -92,6 +92,53 @@ def collision_angle_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> 
     return ana
 
 
+def free_path_mean_flow(scene: Scene, profiles: Any,
+                        along_y: bool) -> tuple[Callable[[np.ndarray], np.ndarray] | None, str]:
+    """The local mean flow u(y) -> (M, dim) the free paths are measured against, and where it
+    comes from. Lees–Edwards: the streaming profile γ̇ y x̂ + c, defined for y beyond the box
+    (the images), c the offset (and drift) fitted to the run's ``/profiles/velocity``
+    (number-weighted mean of u − γ̇ y x̂ over the bins) or, without profiles, −γ̇ L_y/2 x̂
+    (the linear start's). Otherwise the run's own ``/profiles/velocity`` (bins along y),
+    interpolated linearly between bin centres and constant beyond the outer ones (y taken
+    modulo the period in a y-periodic box). None without either: the lab frame."""
+    dim = scene.dimension
+    usable = along_y and bool(profiles) and "velocity" in profiles and "y" in profiles
+    if usable:
+        y_b = np.asarray(profiles["y"], float)
+        u_b = np.asarray(profiles["velocity"], float)[:, :dim]
+        n_b = np.asarray(profiles.get("number_density", np.ones(y_b.size)), float)
+        ok = np.all(np.isfinite(u_b), axis=1) & np.isfinite(n_b) & (n_b > 0)
+        usable = bool(ok.any())
+    if scene.shear is not None and scene.y_periodic:
+        rate, ly = float(scene.shear.rate), float(scene.box.size[1])
+        offset = np.zeros(dim)
+        offset[0] = -rate * ly / 2
+        source = "Lees–Edwards streaming profile γ̇ (y − L_y/2) x̂ (no /profiles/velocity)"
+        if usable:
+            slid = u_b[ok].copy()
+            slid[:, 0] -= rate * y_b[ok]
+            offset = np.average(slid, axis=0, weights=n_b[ok])
+            source = ("Lees–Edwards streaming profile γ̇ y x̂ + c, c fitted to "
+                      "/profiles/velocity")
+
+        def streaming(y: np.ndarray) -> np.ndarray:
+            out = np.tile(offset, (np.size(y), 1))
+            out[:, 0] += rate * np.asarray(y, float)
+            return out
+        return streaming, source
+    if not usable:
+        return None, "none (no /profiles/velocity along y): lab frame"
+    period = float(scene.box.size[1]) if scene.y_periodic else 0.0
+    y_ok, u_ok = y_b[ok], u_b[ok]
+
+    def profile(y: np.ndarray) -> np.ndarray:
+        y = np.asarray(y, float)
+        if period:
+            y = np.mod(y, period)
+        return np.column_stack([np.interp(y, y_ok, u_ok[:, a]) for a in range(dim)])
+    return profile, "/profiles/velocity, linear between bin centres"
+
+
 def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
     """Free paths and times per profile bin from the ``/collisions`` log (every collision
     needed: ``log_every`` = 1), radii from the scene's initial state, Kn with the wall gap
@@ -127,9 +174,11 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
         def x_period(t: np.ndarray) -> np.ndarray:
             return np.interp(t, np.asarray(ts["time"], float), np.asarray(ts["width"], float))
     start = float(res.attrs.get("equilibration_end", 0.0))
-    flights = free_flights(log, radius, periods, scene.gravity_vector, offset, x_period, start)
-    lo, hi, _period = profile_bounds(scene)
     along_y = scene.measure.axis == "y"
+    flow, flow_source = free_path_mean_flow(scene, res.profiles, along_y)
+    flights = free_flights(log, radius, periods, scene.gravity_vector, offset, x_period, start,
+                           mean_flow=flow)
+    lo, hi, _period = profile_bounds(scene)
     if not along_y:  # flights are binned along y whatever the profile axis
         lo, hi = 0.0, scene.box.size[1]
     edges = res.profiles.get("edges") if along_y else None
@@ -153,13 +202,15 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
         "measured_collision_frequency": omega,
         "mean_free_time_over_window": float(tau.mean()) / span,
         "y_wrapped_flights": int(flights["y_wrapped"].sum()),
+        "mean_flow": flow_source,
         "gravity": "arc length of the parabola" if scene.gravity else "none: chord",
         "knudsen_width_is": "flow depth (campbell_depth)" if scene.has_open_top and res.profiles
                             else "wall gap" if not scene.y_periodic else "periodic height",
         "shortest_period": shortest,
         # nearest images: a flight longer than half a period along an axis is aliased; the
         # share of an exponential P(lambda) beyond half the shortest period bounds it
-        "alias_fraction_bound": math.exp(-0.5 * shortest / float(lam.mean())),
+        # (the images alias the lab-frame displacement, mean flow included)
+        "alias_fraction_bound": math.exp(-0.5 * shortest / float(flights["lab_length"].mean())),
     })
     if res.profiles and along_y:
         section = math.prod(s for a, s in enumerate(scene.box.size[:dim]) if a != 1)

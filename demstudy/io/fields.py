@@ -227,11 +227,16 @@ _FREEPATH = {
     "tau": (TIME, "free-time histogram bin centres"),
     "p_lambda": (PER_LENGTH, "P(λ) per y-bin, per unit length"),
     "p_tau": (PER_TIME, "P(τ) per y-bin, per unit time"),
-    "mean_free_path": (LENGTH, "mean free path <λ> per y-bin"),
+    "mean_free_path": (LENGTH, "mean free path <λ> per y-bin, relative to the local mean "
+                               "flow"),
     "mean_free_time": (TIME, "mean free time <τ> per y-bin"),
     "lambda_ratio": (ONE, "<λ²>/<λ>² per y-bin"),
     "tau_ratio": (ONE, "<τ²>/<τ>² per y-bin"),
     "knudsen": (ONE, "Kn = <λ>/W per y-bin (W: attribute knudsen_width)"),
+    "lab_mean_free_path": (LENGTH, "<λ> per y-bin from the lab-frame displacement (mean "
+                                   "flow included)"),
+    "lab_knudsen": (ONE, "lab-frame Kn = lab_mean_free_path/W per y-bin"),
+    "all_lab_mean_free_path": (LENGTH, "lab-frame <λ> pooled over the bins"),
     "collision_rate": (RATE, "particle collisions per unit time with the centre in the bin"),
     "collision_frequency": (RATE, "collisions per particle per unit time"),
     "all_mean_free_path": (LENGTH, "<λ> pooled over the bins"),

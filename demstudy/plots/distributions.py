@@ -210,7 +210,8 @@ def draw_freepath(runs: Sequence[Run], bins: Sequence[int] | None = None) -> Fig
             ax.set_xlabel(xlabel)
             ax.set_ylabel(f"P({sym}) (per unit {'length' if x_key == 'lambda' else 'time'})")
             ax.grid(alpha=0.3, which="both")
-    title = "free paths λ and free times τ per y-bin (centre to centre, starting centre's bin)"
+    title = ("free paths λ and free times τ per y-bin (centre to centre relative to the local "
+             "mean flow, starting centre's bin)")
     if widths:
         title += "\nKn = ⟨λ⟩/W, W = " + ", ".join(dict.fromkeys(widths))
     # below the panels (the distributions reach every corner): the λ panel's entries, then
