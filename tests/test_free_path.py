@@ -192,6 +192,28 @@ def test_lees_edwards_free_path_is_measured_in_the_streaming_frame():
         assert fl["lab_length"][0] == pytest.approx(tau * np.linalg.norm(v), rel=1e-12)
 
 
+def test_a_flight_carried_by_the_flow_over_more_than_half_a_period_is_not_aliased():
+    """x period 10, walls in y, plug flow u = 4 x̂: a particle at u + (0.3, 0.5) flies for
+    τ = 2 (x 1 -> 9.6, drift 8 > L_x/2). The nearest image of the lab displacement would be
+    −1.4 (λ = |(−1.4 − 8, 1)| wrong); taken about the drift, λ = |(0.6, 1)| and the lab
+    chord |(8.6, 1)|. Without the mean flow the lab reading is the aliased one, as before."""
+    lb = LogBuilder([0.5, 0.5, 0.5], [10.0, 0.0])
+    v, tau = np.array([4.3, 0.5]), 2.0
+    a = np.array([1.0, 3.0])
+    b = a + tau * v
+    lb.pair(1.0, 0, 1, a, a + [0.0, 1.0])
+    lb.pair(1.0 + tau, 0, 2, b, b + [0.0, 1.0])
+
+    def plug(y):
+        return np.column_stack([np.full(np.size(y), 4.0), np.zeros(np.size(y))])
+
+    fl = free_flights(lb.log(), np.full(3, 0.5), [10.0, 0.0], mean_flow=plug)
+    assert fl["length"][0] == pytest.approx(np.hypot(0.6, 1.0), rel=1e-12)
+    assert fl["lab_length"][0] == pytest.approx(np.hypot(8.6, 1.0), rel=1e-12)
+    plain = free_flights(lb.log(), np.full(3, 0.5), [10.0, 0.0])
+    assert plain["length"][0] == pytest.approx(np.hypot(1.4, 1.0), rel=1e-12)
+
+
 def test_parabolic_flight_relative_to_a_sheared_mean_flow():
     """3D chute gravity (a y component bends y(s)) and a linear profile u = (0.3 y + 0.1,
     0, 0.05 y): Simpson's mean flow along the flight is exact, and the free path is the arc

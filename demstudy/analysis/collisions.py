@@ -39,10 +39,11 @@ Free paths (:func:`free_flights`, :func:`flight_chunks`, :class:`FreePath`): the
 *every particle's flights, path measured centre to centre*: each particle's consecutive
 logged collisions (pairs as i or j via the ``i``, ``j`` datasets, walls and bumps as i) bound
 a flight of exact duration tau; lambda is the distance its centre travels *relative to the
-local mean flow* u(y) (the chord through the nearest periodic image, Lees–Edwards offset
-included, less u_f tau with u_f the mean of u along the flight; the parabola's arc length
-under gravity in the frame moving at u_f). Kinetic theory's mean free path <|C|>/omega is
-that of the peculiar velocity C = c - u: in the lab frame a flight in a shear or Poiseuille
+local mean flow* u(y) (the chord through the periodic image nearest to the one the mean
+flow and gravity predict, Lees–Edwards offset included, less u_f tau with u_f the mean of u
+along the flight; the parabola's arc length under gravity in the frame moving at u_f).
+Kinetic theory's mean free path <|C|>/omega is that of the peculiar velocity C = c - u: in
+the lab frame a flight in a shear or Poiseuille
 flow also carries the mean-flow drift u tau, which grows with |u| and makes <lambda> and Kn
 depend on the frame (a sheared dilute gas: about twice Enskog's lambda next to the
 Lees–Edwards boundaries). Malik (2008) writes l = sqrt(dx^2 + dy^2 + dz^2) "between
@@ -307,9 +308,11 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
     included) or as j (pairs); its centre is contact - r_i n (i) or that + branch (j: the
     branch points to j's nearest image, which across the y boundary is mapped back to j with
     the offset at t1). A flight runs from one collision of a particle to its next:
-    tau = t2 - t1 exactly, the displacement is the nearest periodic image of c2 - c1 (a y wrap
-    under Lees–Edwards also shifts x by the offset at t2; the image of a flight longer than
-    half a period along an axis is taken as the shorter one: keep the periods >> lambda) and
+    tau = t2 - t1 exactly, the displacement is a periodic image of c2 - c1: the nearest one
+    along y (a y wrap under Lees–Edwards also shifts x by the offset at t2), along x and z
+    the one nearest to the displacement u_f tau + g tau^2/2 the mean flow and gravity
+    predict (a flight whose free path exceeds half a period is aliased: keep the periods
+    >> lambda); and
     ``lab_length`` = :func:`flight_length` of that displacement (the lab frame). The free
     path proper, ``length``, is measured relative to the local mean flow ``mean_flow(y)``
     ((M,) y, unwrapped across a Lees–Edwards boundary, -> (M, dim) velocity): the flight's
@@ -362,15 +365,22 @@ def free_flights(log: Mapping[str, Any], radius: ArrayLike, periods: ArrayLike,
         wrapped = k != 0
         if shear_offset is not None:
             delta[:, 0] += k * shear_offset(when[nxt + 1])
+    # x, z: the image nearest to the displacement the mean flow and gravity predict, so that
+    # a long flight carried along by the flow is not aliased (the mean flow along the flight
+    # needs only delta_y, fixed above)
+    u_f = np.zeros_like(delta)
+    if mean_flow is not None:
+        u_f = flight_mean_flow(mean_flow, where[nxt, 1], delta[:, 1], tau, gravity)
+    expected = u_f * tau[:, None]
+    if gravity is not None:
+        expected += 0.5 * np.asarray(gravity, float)[: delta.shape[1]] * tau[:, None] ** 2
     for a in (0, 2)[: delta.shape[1] - 1]:
         if per[a] > 0:
             length = x_period(when[nxt + 1]) if a == 0 and x_period is not None else per[a]
-            delta[:, a] -= length * np.rint(delta[:, a] / length)
+            delta[:, a] -= length * np.rint((delta[:, a] - expected[:, a]) / length)
     lab = flight_length(delta, tau, gravity)
-    length = lab
-    if mean_flow is not None:
-        u_f = flight_mean_flow(mean_flow, where[nxt, 1], delta[:, 1], tau, gravity)
-        length = flight_length(delta - u_f * tau[:, None], tau, gravity)
+    length = lab if mean_flow is None else flight_length(delta - u_f * tau[:, None], tau,
+                                                         gravity)
     y = where[:, 1] if per[1] == 0 else np.mod(where[:, 1], per[1])
     return {"t0": float(t.min()), "t1": float(t.max()),
             "collisions": int(2 * pair.sum() + (~pair).sum()),

@@ -445,7 +445,8 @@ def friction_coefficient(
 
 def knudsen_enskog(profiles: dict[str, Any], width: float) -> np.ndarray:
     """Kn(y) = lambda_Enskog(nu(y)) / W (Malik's Kn = lambda / W with the theoretical mean
-    free path of the local solid fraction; the measured one needs the collision log)."""
+    free path of the local solid fraction, frame-independent; the measured one, relative to
+    the local mean flow, needs the collision log: ``statistics/freepath``)."""
     dim = _dim(profiles)
     nu = np.asarray(profiles["solid_fraction"], float)
     with np.errstate(divide="ignore", invalid="ignore"):

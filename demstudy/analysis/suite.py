@@ -207,10 +207,10 @@ def free_path_analysis(scene: Scene, results: Any, n_chunks: int = 64) -> Any:
         "knudsen_width_is": "flow depth (campbell_depth)" if scene.has_open_top and res.profiles
                             else "wall gap" if not scene.y_periodic else "periodic height",
         "shortest_period": shortest,
-        # nearest images: a flight longer than half a period along an axis is aliased; the
-        # share of an exponential P(lambda) beyond half the shortest period bounds it
-        # (the images alias the lab-frame displacement, mean flow included)
-        "alias_fraction_bound": math.exp(-0.5 * shortest / float(flights["lab_length"].mean())),
+        # nearest images (about the displacement the mean flow and gravity predict): a flight
+        # whose free path exceeds half a period along an axis is aliased; the share of an
+        # exponential P(lambda) beyond half the shortest period bounds it
+        "alias_fraction_bound": math.exp(-0.5 * shortest / float(lam.mean())),
     })
     if res.profiles and along_y:
         section = math.prod(s for a, s in enumerate(scene.box.size[:dim]) if a != 1)
