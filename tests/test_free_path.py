@@ -458,3 +458,48 @@ def test_sheared_gas_free_path_is_enskogs_in_every_bin(sheared_gas):
     np.testing.assert_allclose(data["knudsen"], data["mean_free_path"] / attrs["knudsen_width"])
     np.testing.assert_allclose(data["lab_knudsen"],
                                data["lab_mean_free_path"] / attrs["knudsen_width"])
+
+
+def test_mean_flow_of_a_walled_channel_is_its_velocity_profile():
+    """Walls in y: u(y) is /profiles/velocity, linear between bin centres (an empty bin
+    skipped), constant beyond the outer centres; no profiles (or profiles along x): none."""
+    from demstudy.analysis.suite import free_path_mean_flow
+
+    scene = validate_scene({
+        "dimension": 2, "box": {"size": [10.0, 8.0]}, "particles": {"count": 4},
+        "contact": {"restitution": 1.0},
+        "walls": [{"side": "lower", "restitution": 1.0}, {"side": "upper", "restitution": 1.0}],
+        "run": {"equilibration": 0.0, "production": 1.0}})
+    y = np.array([1.0, 3.0, 5.0, 7.0])
+    velocity = np.array([[1.0, 0.1], [9.0, 9.0], [3.0, 0.3], [4.0, 0.4]])
+    density = np.array([0.2, 0.0, 0.2, 0.2])  # bin 2 empty: its velocity is not used
+    flow, source = free_path_mean_flow(
+        scene, {"y": y, "velocity": velocity, "number_density": density}, True)
+    assert "profiles/velocity" in source
+    got = flow(np.array([0.0, 2.0, 4.0, 6.0, 8.0]))
+    np.testing.assert_allclose(got[:, 0], [1.0, 1.5, 2.5, 3.5, 4.0])
+    np.testing.assert_allclose(got[:, 1], [0.1, 0.15, 0.25, 0.35, 0.4])
+    assert free_path_mean_flow(scene, {}, True)[0] is None
+    assert free_path_mean_flow(scene, {"y": y, "velocity": velocity}, False)[0] is None
+
+
+def test_lees_edwards_mean_flow_is_the_streaming_profile_with_the_fitted_offset():
+    """γ̇ = 0.5, L_y = 8: without profiles u = γ̇ (y − 4) x̂ (the linear start's); with them the
+    offset (and a drift) is the number-weighted mean of u − γ̇ y x̂; defined beyond the box."""
+    from demstudy.analysis.suite import free_path_mean_flow
+
+    scene = validate_scene({
+        "dimension": 2, "box": {"size": [10.0, 8.0]}, "particles": {"count": 4},
+        "contact": {"restitution": 1.0}, "shear": {"rate": 0.5},
+        "run": {"equilibration": 0.0, "production": 1.0}})
+    flow, source = free_path_mean_flow(scene, {}, True)
+    assert "Lees–Edwards" in source
+    np.testing.assert_allclose(flow(np.array([-2.0, 4.0, 11.0])),
+                               [[-3.0, 0.0], [0.0, 0.0], [3.5, 0.0]])
+    y = np.array([2.0, 6.0])
+    profiles = {"y": y, "velocity": np.array([[-0.5, 0.2], [1.9, 0.2]]),
+                "number_density": np.array([0.1, 0.3])}
+    flow, source = free_path_mean_flow(scene, profiles, True)
+    assert "fitted" in source
+    # u − γ̇ y: (−1.5, 0.2) and (−1.1, 0.2), weights 1:3 -> offset (−1.2, 0.2)
+    np.testing.assert_allclose(flow(np.array([0.0, 10.0])), [[-1.2, 0.2], [3.8, 0.2]])
