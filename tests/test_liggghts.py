@@ -103,6 +103,55 @@ def test_body_inertia_from_an_oblique_wall_impact(tmp_path, dim, K):
     assert 4 * inertia == pytest.approx(K, rel=5e-3)
 
 
+MOVING_WALL = """
+import json, sys
+from demstudy.contact.mapping import make_contact
+from demstudy.engines.lammps.calibrate import impact
+from demstudy.engines.liggghts import calibrate as lig
+lig._WORKDIR = __import__("pathlib").Path(sys.argv[1])
+# the Couette cell's rough wall (inputs/accuracy-cost/couette-rough-nu0.55.toml): e_w = 0.8,
+# contact point sticks (beta = 0), k* = 1e4, 50 steps per contact
+p = make_contact(kn=1e4, e=0.8, m_eff=1.0, K=0.5, beta=0.0, steps_per_contact=50, wall=True)
+
+def sliding_at(V):
+    # the scene's moving wall (shear x V) and the disc's velocity seen from the ground
+    def opener(dim, wall, params, dt, atoms, gravity=None):
+        moved = [(*a[:3], a[3] + V, *a[4:]) for a in atoms]
+        return lig.open_bodies(dim, wall, params, dt, moved, gravity, wall_velocity=V)
+    return opener
+
+out = []
+for angle, spin in ((30.0, 0.0), (60.0, 2.0)):
+    for V in (0.0, 1.0, -2.5):
+        r = impact(2, "wall", p, 0.5, angle, p.timestep(50), spin=spin,
+                   bodies=(sliding_at(V), lig.read_state))
+        out.append({"angle": angle, "spin": spin, "V": V, "beta": r.beta,
+                    "v0": r.before[1][0].tolist(), "v1": r.after[1][0].tolist(),
+                    "w1": r.after[2][0].tolist()})
+print(json.dumps(out))
+"""
+
+
+def test_moving_wall_impact_is_the_still_walls_seen_from_a_moving_frame(tmp_path):
+    """Galilean invariance of the scene's moving wall (``shear x V``): a disc hitting the wall
+    sliding at V with velocity (u + V, −w) and spin ω leaves it as one hitting the still wall
+    with (u, −w) and ω does, to round-off: its velocity less V and its spin (the contact's
+    relative velocity, e_w and the tangential spring's history all follow the wall). The
+    Couette cell's rough wall (β = 0): on the still wall the contact point sticks (|β| <
+    0.01, as in LAMMPS), with a real tangential impulse. V = 1 and −2.5, 30° and 60° (spun)."""
+    out = subprocess.run([sys.executable, "-c", MOVING_WALL, str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    rows = json.loads(out.stdout)
+    for still in (r for r in rows if r["V"] == 0.0):
+        assert abs(still["beta"]) < 0.01
+        assert abs(still["v1"][0] - still["v0"][0]) > 0.05
+        for moving in (r for r in rows if r["angle"] == still["angle"] and r["V"] != 0.0):
+            seen = np.array(moving["v1"]) - [moving["V"], 0.0, 0.0]
+            np.testing.assert_allclose(seen, still["v1"], rtol=0, atol=1e-9)
+            np.testing.assert_allclose(moving["w1"], still["w1"], rtol=0, atol=1e-9)
+
+
 # ---------------------------------------------------------------- runs
 GAS = {
     "dimension": 3, "meta": {"name": "elastic-gas"}, "box": {"size": [8.0, 8.0, 8.0]},

@@ -38,7 +38,7 @@ from ..lammps.deck.base import fmt
 from ..lammps.deck.system import format_rows
 
 __all__ = ["DATA_FILE", "TRANSLATIONS", "LiggghtsDeck", "build_deck", "data_text",
-           "run_commands", "state_rows", "write_deck"]
+           "run_commands", "state_rows", "wall_command", "write_deck"]
 
 DATA_FILE = "initial.data"
 DENSITY = {2: 4 / math.pi, 3: 6 / math.pi}  # m = 1 for d = 1 (per area in 2D)
@@ -221,14 +221,24 @@ def contact_commands(scene: Scene, setup: ContactSetup) -> list[str]:
 
 
 # ---------------------------------------------------------------- effects
+def wall_command(fid: str, group: str, atom_type: int, plane: float, velocity: float = 0.0,
+                 extra: str = "") -> str:
+    """The ``fix wall/gran`` of a flat wall: the plane y = ``plane`` whose contacts take the
+    per-type-pair inputs of ``atom_type``, sliding along x at ``velocity`` (``shear x V``:
+    the plane stays put, its contacts see the wall velocity V x̂; LIGGGHTS's tangential
+    springs integrate the contact point's velocity relative to it, so an impact on the
+    moving wall is the still wall's seen from a frame moving at V; tests/test_liggghts.py)."""
+    motion = f" shear x {velocity!r}" if velocity != 0.0 else ""
+    return (f"fix {fid} {group} wall/gran model hooke/stiffness tangential history primitive "
+            f"type {atom_type} yplane {plane!r}{motion}{extra}")
+
+
 def _walls(scene: Scene, deck: LiggghtsDeck) -> None:
     for wall in scene.walls:
         fid = f"wall_{wall.side}"
-        motion = f" shear x {wall.velocity!r}" if wall.velocity != 0.0 else ""
-        deck.physics.append(
-            f"fix {fid} mobile wall/gran model hooke/stiffness tangential history primitive "
-            f"type {wall_type(scene, wall.side)} yplane {scene.wall_position(wall.side)!r}"
-            f"{motion} store_force yes")
+        deck.physics.append(wall_command(fid, "mobile", wall_type(scene, wall.side),
+                                         scene.wall_position(wall.side), wall.velocity,
+                                         " store_force yes"))
         # the wall's force on the particles, summed (the per-atom store of store_force)
         deck.physics.append(f"compute {fid}_force mobile reduce sum f_force_{fid}[1] "
                             f"f_force_{fid}[2] f_force_{fid}[3]")
