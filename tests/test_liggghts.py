@@ -152,6 +152,61 @@ def test_moving_wall_impact_is_the_still_walls_seen_from_a_moving_frame(tmp_path
             np.testing.assert_allclose(moving["w1"], still["w1"], rtol=0, atol=1e-9)
 
 
+SECOND_COLLISION = """
+import json, sys
+import numpy as np
+from demstudy.contact.mapping import make_contact
+from demstudy.engines.liggghts import calibrate as lig
+lig._WORKDIR = __import__("pathlib").Path(sys.argv[1])
+# the Couette cell's pair contact: e = 0.6, beta = 0 (sticks), k* = 1e4, 50 steps per contact
+p = make_contact(kn=1e4, e=0.6, m_eff=0.5, K=0.5, beta=0.0, steps_per_contact=50)
+dt = p.timestep(50)
+g = 0.5 * np.array([np.sin(np.radians(40.0)), -np.cos(np.radians(40.0)), 0.0])
+atoms = [(0.0, 0.5 + 0.1 * dt, 0.0, *(0.5 * g), 0.0, 1.0, 1.0),
+         (0.0, -0.5 - 0.1 * dt, 0.0, *(-0.5 * g), 0.0, 1.0, 1.0)]
+
+def collide(lmp):
+    touched = False
+    for _ in range(10000):
+        lmp.command("run 1 pre no post no")
+        x = lmp.gather("x", 3)
+        gap = np.linalg.norm(x[0] - x[1]) - 1.0
+        touched = touched or gap < 0.0
+        if touched and gap > 1e-4:
+            return [lmp.gather(k, 3).tolist() for k in ("x", "v", "omega")]
+    raise RuntimeError("no collision")
+
+lmp = lig.open_bodies(2, False, p, dt, atoms)
+x, v, w = collide(lmp)
+lmp.scatter("v", -np.array(v))  # straight back: a second collision, long before a rebuild
+continued = collide(lmp)
+lmp.close()
+lmp = lig.open_bodies(2, False, p, dt, atoms)  # the same second collision in a fresh run
+for name, value in (("x", x), ("v", -np.array(v)), ("omega", w)):
+    lmp.scatter(name, np.array(value))
+lmp.command("run 0")
+fresh = collide(lmp)
+print(json.dumps({"first": v, "continued": continued[1:], "fresh": fresh[1:]}))
+"""
+
+
+def test_a_second_collision_does_not_remember_the_first(tmp_path):
+    """Two discs part after an oblique sticking collision and are sent straight back into
+    each other a few hundred steps later, before any neighbour-list rebuild: the second
+    collision starts its tangential spring at zero, so it ends as the same collision run in
+    a fresh LIGGGHTS (to round-off). LIGGGHTS's default contact_distance_factor (1) kept the
+    first collision's spring until the next rebuild: spin −0.141 instead of +0.074."""
+    out = subprocess.run([sys.executable, "-c", SECOND_COLLISION, str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    s = json.loads(out.stdout)
+    assert abs(s["first"][0][0] - 0.5 * 0.5 * math.sin(math.radians(40.0))) > 0.05  # it stuck
+    (v_c, w_c), (v_f, w_f) = s["continued"], s["fresh"]
+    assert abs(w_f[0][2]) > 0.02  # the second collision turns the discs
+    np.testing.assert_allclose(v_c, v_f, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(w_c, w_f, rtol=0, atol=1e-9)
+
+
 # ---------------------------------------------------------------- runs
 GAS = {
     "dimension": 3, "meta": {"name": "elastic-gas"}, "box": {"size": [8.0, 8.0, 8.0]},

@@ -25,7 +25,7 @@ import numpy as np
 from ...contact.calibration import CollisionRow
 from ...contact.mapping import ContactParameters
 from ...errors import EngineError, UnsupportedByEngine
-from .deck import DENSITY, _coefficients, wall_command
+from .deck import DENSITY, NEIGHBOUR_COMMANDS, _coefficients, wall_command
 from .library import Liggghts, crash_report, require_library
 
 __all__ = ["calibrate_in_child", "open_bodies", "read_state"]
@@ -47,7 +47,7 @@ def open_bodies(dim: int, wall: bool, params: ContactParameters, dt: float,
             f"dimension {dim}", f"boundary p {'f' if wall else 'p'} p", "newton off",
             "communicate single vel yes",
             f"region box block {-half!r} {half!r} {ylo!r} {half!r} {zlo!r} {zhi!r} units box",
-            "create_box 2 box", "neighbor 0.2 bin", "neigh_modify delay 0"]
+            "create_box 2 box", *NEIGHBOUR_COMMANDS]
     for a in atoms:
         xyz = " ".join(repr(float(c)) for c in a[:3])
         cmds.append(f"create_atoms 1 single {xyz} units box")

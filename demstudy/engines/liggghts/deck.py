@@ -37,8 +37,8 @@ from ...scene.initial import InitialState
 from ..lammps.deck.base import fmt
 from ..lammps.deck.system import format_rows
 
-__all__ = ["DATA_FILE", "TRANSLATIONS", "LiggghtsDeck", "build_deck", "data_text",
-           "run_commands", "state_rows", "wall_command", "write_deck"]
+__all__ = ["DATA_FILE", "NEIGHBOUR_COMMANDS", "TRANSLATIONS", "LiggghtsDeck", "build_deck",
+           "data_text", "run_commands", "state_rows", "wall_command", "write_deck"]
 
 DATA_FILE = "initial.data"
 DENSITY = {2: 4 / math.pi, 3: 6 / math.pi}  # m = 1 for d = 1 (per area in 2D)
@@ -49,6 +49,16 @@ WALL_FORCES = "wall_forces"  # fix ave/time of every wall's summed force
 BOUNDARY_MARGIN = 1e-9
 #: room between a wall plane and the box boundary behind it, in d (``y_bounds``)
 WALL_MARGIN = 1.0
+#: LIGGGHTS forgets a pair's tangential spring only where a pair within
+#: ``contact_distance_factor`` × (r_i + r_j) no longer overlaps, or at the next neighbour-list
+#: rebuild; at its default 1 a pair that parts keeps its spring until that rebuild (every
+#: ~skin/2 / v_max, hundreds of steps), so a second collision before it starts with the first
+#: one's spring (a spurious tangential impulse; how often depends on the frame through the
+#: rebuild rate). 1.05: a parted pair is forgotten the step it parts (it would have to move
+#: 0.05 (r_i + r_j) in one step to escape that), as LAMMPS does; tests/test_liggghts.py
+CONTACT_DISTANCE_FACTOR = 1.05
+NEIGHBOUR_COMMANDS = ("neighbor 0.2 bin",
+                      f"neigh_modify delay 0 contact_distance_factor {CONTACT_DISTANCE_FACTOR}")
 
 
 @dataclass
@@ -315,8 +325,7 @@ def build_deck(scene: Scene, setup: ContactSetup, sample_steps: int,
         "newton off",
         "communicate single vel yes",
         f"read_data {data}",
-        "neighbor 0.2 bin",
-        "neigh_modify delay 0",
+        *NEIGHBOUR_COMMANDS,
         "group mobile type 1",
     ]
     deck.physics = contact_commands(scene, setup)
