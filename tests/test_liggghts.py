@@ -194,8 +194,9 @@ def test_a_second_collision_does_not_remember_the_first(tmp_path):
     """Two discs part after an oblique sticking collision and are sent straight back into
     each other a few hundred steps later, before any neighbour-list rebuild: the second
     collision starts its tangential spring at zero, so it ends as the same collision run in
-    a fresh LIGGGHTS (to round-off). LIGGGHTS's default contact_distance_factor (1) kept the
-    first collision's spring until the next rebuild: spin −0.141 instead of +0.074."""
+    a fresh LIGGGHTS (to round-off). With LIGGGHTS's default neighbour rebuilds (once an atom
+    has moved skin/2) the pair kept the first collision's spring until the next rebuild:
+    spin −0.141 instead of +0.074."""
     out = subprocess.run([sys.executable, "-c", SECOND_COLLISION, str(tmp_path)],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]
