@@ -57,10 +57,9 @@ WALL_MARGIN = 1.0
 #: a moving wall's Couette is no longer its mirror image). Rebuilt every step, a parted pair
 #: is forgotten the step it parts, as LAMMPS does (tests/test_liggghts.py); it costs ≈ 2×
 #: the run time of a small 2D cell (the 100-disc Couette: 5.4 → 11.3 s for 300 time units).
-#: ``neigh_modify contact_distance_factor`` > 1 would also forget it (the pair's contact
-#: model then sees the parted pair) and costs nothing, but
-#: with it the contact stress of a resting bed no longer obeys its momentum balance (σ_xy
-#: of a bed at rest up to 2 % of σ_yy): not used.
+#: ``neigh_modify contact_distance_factor`` > 1 also forgets it at no cost (the contact
+#: model then sees the parted pair), but changes which pairs LIGGGHTS's models and computes
+#: treat as neighbours; with it the resting-bed stress test failed (docs/engines.md).
 NEIGHBOUR_COMMANDS = ("neighbor 0.2 bin", "neigh_modify delay 0 every 1 check no")
 
 
