@@ -103,6 +103,177 @@ def test_body_inertia_from_an_oblique_wall_impact(tmp_path, dim, K):
     assert 4 * inertia == pytest.approx(K, rel=5e-3)
 
 
+MOVING_WALL = """
+import json, sys
+from demstudy.contact.mapping import make_contact
+from demstudy.engines.lammps.calibrate import impact
+from demstudy.engines.liggghts import calibrate as lig
+lig._WORKDIR = __import__("pathlib").Path(sys.argv[1])
+# the Couette cell's rough wall (inputs/accuracy-cost/couette-rough-nu0.55.toml): e_w = 0.8,
+# contact point sticks (beta = 0), k* = 1e4, 50 steps per contact
+p = make_contact(kn=1e4, e=0.8, m_eff=1.0, K=0.5, beta=0.0, steps_per_contact=50, wall=True)
+
+def sliding_at(V):
+    # the scene's moving wall (shear x V) and the disc's velocity seen from the ground
+    def opener(dim, wall, params, dt, atoms, gravity=None):
+        moved = [(*a[:3], a[3] + V, *a[4:]) for a in atoms]
+        return lig.open_bodies(dim, wall, params, dt, moved, gravity, wall_velocity=V)
+    return opener
+
+out = []
+for angle, spin in ((30.0, 0.0), (60.0, 2.0)):
+    for V in (0.0, 1.0, -2.5):
+        r = impact(2, "wall", p, 0.5, angle, p.timestep(50), spin=spin,
+                   bodies=(sliding_at(V), lig.read_state))
+        out.append({"angle": angle, "spin": spin, "V": V, "beta": r.beta,
+                    "v0": r.before[1][0].tolist(), "v1": r.after[1][0].tolist(),
+                    "w1": r.after[2][0].tolist()})
+print(json.dumps(out))
+"""
+
+
+def test_moving_wall_impact_is_the_still_walls_seen_from_a_moving_frame(tmp_path):
+    """Galilean invariance of the scene's moving wall (``shear x V``): a disc hitting the wall
+    sliding at V with velocity (u + V, −w) and spin ω leaves it as one hitting the still wall
+    with (u, −w) and ω does, to round-off: its velocity less V and its spin (the contact's
+    relative velocity, e_w and the tangential spring's history all follow the wall). The
+    Couette cell's rough wall (β = 0): on the still wall the contact point sticks (|β| <
+    0.01, as in LAMMPS), with a real tangential impulse. V = 1 and −2.5, 30° and 60° (spun)."""
+    out = subprocess.run([sys.executable, "-c", MOVING_WALL, str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    rows = json.loads(out.stdout)
+    for still in (r for r in rows if r["V"] == 0.0):
+        assert abs(still["beta"]) < 0.01
+        assert abs(still["v1"][0] - still["v0"][0]) > 0.05
+        for moving in (r for r in rows if r["angle"] == still["angle"] and r["V"] != 0.0):
+            seen = np.array(moving["v1"]) - [moving["V"], 0.0, 0.0]
+            np.testing.assert_allclose(seen, still["v1"], rtol=0, atol=1e-9)
+            np.testing.assert_allclose(moving["w1"], still["w1"], rtol=0, atol=1e-9)
+
+
+SECOND_COLLISION = """
+import json, sys
+import numpy as np
+from demstudy.contact.mapping import make_contact
+from demstudy.engines.liggghts import calibrate as lig
+lig._WORKDIR = __import__("pathlib").Path(sys.argv[1])
+# the Couette cell's pair contact: e = 0.6, beta = 0 (sticks), k* = 1e4, 50 steps per contact
+p = make_contact(kn=1e4, e=0.6, m_eff=0.5, K=0.5, beta=0.0, steps_per_contact=50)
+dt = p.timestep(50)
+g = 0.5 * np.array([np.sin(np.radians(40.0)), -np.cos(np.radians(40.0)), 0.0])
+atoms = [(0.0, 0.5 + 0.1 * dt, 0.0, *(0.5 * g), 0.0, 1.0, 1.0),
+         (0.0, -0.5 - 0.1 * dt, 0.0, *(-0.5 * g), 0.0, 1.0, 1.0)]
+
+def collide(lmp):
+    touched = False
+    for _ in range(10000):
+        lmp.command("run 1 pre no post no")
+        x = lmp.gather("x", 3)
+        gap = np.linalg.norm(x[0] - x[1]) - 1.0
+        touched = touched or gap < 0.0
+        if touched and gap > 1e-4:
+            return [lmp.gather(k, 3).tolist() for k in ("x", "v", "omega")]
+    raise RuntimeError("no collision")
+
+lmp = lig.open_bodies(2, False, p, dt, atoms)
+x, v, w = collide(lmp)
+lmp.scatter("v", -np.array(v))  # straight back: a second collision, long before a rebuild
+continued = collide(lmp)
+lmp.close()
+lmp = lig.open_bodies(2, False, p, dt, atoms)  # the same second collision in a fresh run
+for name, value in (("x", x), ("v", -np.array(v)), ("omega", w)):
+    lmp.scatter(name, np.array(value))
+lmp.command("run 0")
+fresh = collide(lmp)
+print(json.dumps({"first": v, "continued": continued[1:], "fresh": fresh[1:]}))
+"""
+
+
+def test_a_second_collision_does_not_remember_the_first(tmp_path):
+    """Two discs part after an oblique sticking collision and are sent straight back into
+    each other a few hundred steps later, before any neighbour-list rebuild: the second
+    collision starts its tangential spring at zero, so it ends as the same collision run in
+    a fresh LIGGGHTS (to round-off). With LIGGGHTS's default neighbour rebuilds (once an atom
+    has moved skin/2) the pair kept the first collision's spring until the next rebuild:
+    spin −0.141 instead of +0.074."""
+    out = subprocess.run([sys.executable, "-c", SECOND_COLLISION, str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    s = json.loads(out.stdout)
+    assert abs(s["first"][0][0] - 0.5 * 0.5 * math.sin(math.radians(40.0))) > 0.05  # it stuck
+    (v_c, w_c), (v_f, w_f) = s["continued"], s["fresh"]
+    assert abs(w_f[0][2]) > 0.02  # the second collision turns the discs
+    np.testing.assert_allclose(v_c, v_f, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(w_c, w_f, rtol=0, atol=1e-9)
+
+
+MIRRORED_COUETTE = """
+import json, sys
+from pathlib import Path
+import numpy as np
+from demstudy.contact.stiffness import contact_setup
+from demstudy.engines.liggghts.deck import build_deck, data_text, initial_atoms, state_rows
+from demstudy.engines.liggghts.library import Liggghts
+from demstudy.scene.initial import build_initial_state
+from demstudy.scene.load import load_scene
+
+scene = load_scene(sys.argv[2])
+scene = scene.model_copy(update={"soft": scene.soft.model_copy(
+    update={"hardness": None, "stiffness": 1e4, "steps_per_contact": 50.0})})
+setup = contact_setup(scene, "liggghts")
+L, H, U = scene.box.size[0], scene.wall_position("upper"), scene.wall("upper").velocity
+work = Path(sys.argv[1])
+
+def run(name, rows, steps):
+    (work / name).mkdir()
+    (work / name / "initial.data").write_text(data_text(scene, *rows))
+    lmp = Liggghts(work / name)
+    for cmd in build_deck(scene, setup, 1000, data=str(work / name / "initial.data")).commands():
+        lmp.command(cmd)
+    lmp.command(f"run {steps}")
+    state = [lmp.gather(k, 3) for k in ("x", "v", "omega")]
+    lmp.close()
+    return state
+
+atoms, velocities = initial_atoms(scene, build_initial_state(scene))
+d, types = atoms[:, 2], atoms[:, 1]
+x, v, w = run("warm", (atoms, velocities), 20000)  # sheared for a while: contacts everywhere
+rows = lambda x, v, w: state_rows(scene, x[:, :2], v[:, :2], w[:, 2:3], d, types)
+steps = 20000
+a = run("a", rows(x, v, w), steps)
+mx = np.column_stack([np.mod(-x[:, 0], L), H - x[:, 1], x[:, 2]])
+mv = np.column_stack([U - v[:, 0], -v[:, 1], v[:, 2]])
+b = run("b", rows(mx, mv, w), steps)
+t = steps * setup.timestep
+back = np.column_stack([np.mod(-a[0][:, 0] + U * t, L), H - a[0][:, 1]])
+dx = back - b[0][:, :2]
+dx[:, 0] -= L * np.round(dx[:, 0] / L)
+print(json.dumps({"time": t, "dx": float(np.abs(dx).max()),
+                  "dv": float(np.abs(np.column_stack([U - a[1][:, 0], -a[1][:, 1]])
+                                     - b[1][:, :2]).max()),
+                  "dw": float(np.abs(a[2][:, 2] - b[2][:, 2]).max()),
+                  "moved": float(np.abs(a[1] - v).max())}))
+"""
+
+
+def test_the_mirrored_couette_cell_runs_as_its_mirror_image(tmp_path):
+    """The Couette cell (rough walls, the upper one sliding at U, k* = 1e4, 50 steps per
+    contact) is symmetric under a half turn about z followed by a boost by U (x → −x,
+    y → H − y, v_x → U − v_x, v_y → −v_y, ω kept): run from a sheared state and from its
+    image, LIGGGHTS ends in images of each other to 1e-6 after 9 time units (round-off grows
+    to ~1e-9). Each wall takes the other's part, a still wall that of the moving one; a stale
+    tangential spring, kept until a neighbour rebuild whose timing depends on the frame,
+    broke it at t ≈ 8.5 (a velocity 1e-2 off)."""
+    scene = Path(__file__).parent.parent / "inputs" / "accuracy-cost" / "couette-rough-nu0.55.toml"
+    out = subprocess.run([sys.executable, "-c", MIRRORED_COUETTE, str(tmp_path), str(scene)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    s = json.loads(out.stdout)
+    assert s["time"] > 8.0 and s["moved"] > 0.05  # long enough, and the flow did change
+    assert max(s["dx"], s["dv"], s["dw"]) < 1e-6
+
+
 # ---------------------------------------------------------------- runs
 GAS = {
     "dimension": 3, "meta": {"name": "elastic-gas"}, "box": {"size": [8.0, 8.0, 8.0]},

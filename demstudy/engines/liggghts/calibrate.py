@@ -25,7 +25,7 @@ import numpy as np
 from ...contact.calibration import CollisionRow
 from ...contact.mapping import ContactParameters
 from ...errors import EngineError, UnsupportedByEngine
-from .deck import DENSITY, _coefficients
+from .deck import DENSITY, NEIGHBOUR_COMMANDS, _coefficients, wall_command
 from .library import Liggghts, crash_report, require_library
 
 __all__ = ["calibrate_in_child", "open_bodies", "read_state"]
@@ -34,9 +34,11 @@ _WORKDIR = Path(tempfile.gettempdir())
 
 
 def open_bodies(dim: int, wall: bool, params: ContactParameters, dt: float,
-                atoms: Sequence[tuple], gravity: tuple[float, float] | None = None) -> Liggghts:
+                atoms: Sequence[tuple], gravity: tuple[float, float] | None = None,
+                wall_velocity: float = 0.0) -> Liggghts:
     """A LIGGGHTS instance holding ``atoms`` (x, y, z, vx, vy, vz, ω_z, d, m) with the
-    contact ``params`` (pair, or the particle's on a ``yplane 0`` wall)."""
+    contact ``params`` (pair, or the particle's on a ``yplane 0`` wall, sliding along x at
+    ``wall_velocity`` as a scene's moving wall does: :func:`.deck.wall_command`)."""
     lmp = Liggghts(_WORKDIR)
     half = 5.0 * max(a[7] for a in atoms)
     zlo, zhi = (-0.5, 0.5) if dim == 2 else (-half, half)
@@ -45,7 +47,7 @@ def open_bodies(dim: int, wall: bool, params: ContactParameters, dt: float,
             f"dimension {dim}", f"boundary p {'f' if wall else 'p'} p", "newton off",
             "communicate single vel yes",
             f"region box block {-half!r} {half!r} {ylo!r} {half!r} {zlo!r} {zhi!r} units box",
-            "create_box 2 box", "neighbor 0.2 bin", "neigh_modify delay 0"]
+            "create_box 2 box", *NEIGHBOUR_COMMANDS]
     for a in atoms:
         xyz = " ".join(repr(float(c)) for c in a[:3])
         cmds.append(f"create_atoms 1 single {xyz} units box")
@@ -54,8 +56,7 @@ def open_bodies(dim: int, wall: bool, params: ContactParameters, dt: float,
                     + " ".join([repr(value)] * 4))
     cmds += ["pair_style gran model hooke/stiffness tangential history", "pair_coeff * *"]
     if wall:
-        cmds.append("fix wall all wall/gran model hooke/stiffness tangential history "
-                    "primitive type 2 yplane 0.0")
+        cmds.append(wall_command("wall", "all", 2, 0.0, wall_velocity))
     if gravity is not None:
         gx, gy = (float(c) for c in gravity)
         cmds.append(f"fix grav all gravity 1.0 vector {gx!r} {gy!r} 0.0")

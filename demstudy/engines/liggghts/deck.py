@@ -37,8 +37,8 @@ from ...scene.initial import InitialState
 from ..lammps.deck.base import fmt
 from ..lammps.deck.system import format_rows
 
-__all__ = ["DATA_FILE", "TRANSLATIONS", "LiggghtsDeck", "build_deck", "data_text",
-           "run_commands", "state_rows", "write_deck"]
+__all__ = ["DATA_FILE", "NEIGHBOUR_COMMANDS", "TRANSLATIONS", "LiggghtsDeck", "build_deck",
+           "data_text", "run_commands", "state_rows", "wall_command", "write_deck"]
 
 DATA_FILE = "initial.data"
 DENSITY = {2: 4 / math.pi, 3: 6 / math.pi}  # m = 1 for d = 1 (per area in 2D)
@@ -49,6 +49,18 @@ WALL_FORCES = "wall_forces"  # fix ave/time of every wall's summed force
 BOUNDARY_MARGIN = 1e-9
 #: room between a wall plane and the box boundary behind it, in d (``y_bounds``)
 WALL_MARGIN = 1.0
+#: The neighbour lists are rebuilt every step: LIGGGHTS forgets a pair's tangential spring only
+#: at a rebuild (a pair that parts keeps it until then; with LIGGGHTS's default, rebuilding
+#: once some atom has moved skin/2, that is hundreds of steps), so a second collision of
+#: the same pair before the rebuild would start with the first one's spring, a spurious
+#: tangential impulse, and how often depends on the frame (through the atoms' displacements:
+#: a moving wall's Couette is no longer its mirror image). Rebuilt every step, a parted pair
+#: is forgotten the step it parts, as LAMMPS does (tests/test_liggghts.py); it costs ≈ 2×
+#: the run time of a small 2D cell (the 100-disc Couette: 5.4 → 11.3 s for 300 time units).
+#: ``neigh_modify contact_distance_factor`` > 1 also forgets it at no cost (the contact
+#: model then sees the parted pair), but changes which pairs LIGGGHTS's models and computes
+#: treat as neighbours; with it the resting-bed stress test failed (docs/engines.md).
+NEIGHBOUR_COMMANDS = ("neighbor 0.2 bin", "neigh_modify delay 0 every 1 check no")
 
 
 @dataclass
@@ -221,14 +233,24 @@ def contact_commands(scene: Scene, setup: ContactSetup) -> list[str]:
 
 
 # ---------------------------------------------------------------- effects
+def wall_command(fid: str, group: str, atom_type: int, plane: float, velocity: float = 0.0,
+                 extra: str = "") -> str:
+    """The ``fix wall/gran`` of a flat wall: the plane y = ``plane`` whose contacts take the
+    per-type-pair inputs of ``atom_type``, sliding along x at ``velocity`` (``shear x V``:
+    the plane stays put, its contacts see the wall velocity V x̂; LIGGGHTS's tangential
+    springs integrate the contact point's velocity relative to it, so an impact on the
+    moving wall is the still wall's seen from a frame moving at V; tests/test_liggghts.py)."""
+    motion = f" shear x {velocity!r}" if velocity != 0.0 else ""
+    return (f"fix {fid} {group} wall/gran model hooke/stiffness tangential history primitive "
+            f"type {atom_type} yplane {plane!r}{motion}{extra}")
+
+
 def _walls(scene: Scene, deck: LiggghtsDeck) -> None:
     for wall in scene.walls:
         fid = f"wall_{wall.side}"
-        motion = f" shear x {wall.velocity!r}" if wall.velocity != 0.0 else ""
-        deck.physics.append(
-            f"fix {fid} mobile wall/gran model hooke/stiffness tangential history primitive "
-            f"type {wall_type(scene, wall.side)} yplane {scene.wall_position(wall.side)!r}"
-            f"{motion} store_force yes")
+        deck.physics.append(wall_command(fid, "mobile", wall_type(scene, wall.side),
+                                         scene.wall_position(wall.side), wall.velocity,
+                                         " store_force yes"))
         # the wall's force on the particles, summed (the per-atom store of store_force)
         deck.physics.append(f"compute {fid}_force mobile reduce sum f_force_{fid}[1] "
                             f"f_force_{fid}[2] f_force_{fid}[3]")
@@ -305,8 +327,7 @@ def build_deck(scene: Scene, setup: ContactSetup, sample_steps: int,
         "newton off",
         "communicate single vel yes",
         f"read_data {data}",
-        "neighbor 0.2 bin",
-        "neigh_modify delay 0",
+        *NEIGHBOUR_COMMANDS,
         "group mobile type 1",
     ]
     deck.physics = contact_commands(scene, setup)
