@@ -63,11 +63,13 @@ class Case:
     def label(self) -> str:
         return f"{self.base}-{self.angle:g}"
 
-    def scene(self):
-        """Campbell's chute at this angle and base; the second half is the production window."""
+    def scene(self, equilibration: float | None = None):
+        """Campbell's chute at this angle and base; the production window is the second half
+        (or what follows ``equilibration``)."""
+        eq = self.duration / 2 if equilibration is None else equilibration
         sections = dict(gravity={"angle": self.angle}, measure={"statistics": []},
-                        run={"equilibration": self.duration / 2,
-                             "production": self.duration / 2, "sample_interval": SAMPLE}
+                        run={"equilibration": eq, "production": self.duration - eq,
+                             "sample_interval": SAMPLE}
                         | ({} if self.seed is None else {"seed": self.seed}))
         if self.base != "flat":
             spacing = float(self.base.split("-")[1])
@@ -273,8 +275,40 @@ def early_panel(ax, flat: list[dict]) -> None:
     ax.legend(fontsize=8, loc="upper left")
 
 
+# -- the base's contacts ------------------------------------------------------------------
+CONTACT_CASES = (Case(24.0, "flat", 200.0), Case(30.0, "flat", 200.0),
+                 Case(30.0, "bumps-1.2", 200.0))
+LOG_EVERY = 200  # every 200th collision: the log's 200 000 records then span 200 √(d/g)
+
+
+def base_contacts(case: Case, out: Path, tc: float, reuse: bool) -> dict:
+    """How the discs meet the base in the dense phase (t = EARLY), from the collision log of a
+    short run: the median speed of a disc's contact point along x relative to its centre's
+    (≈ 0: the disc rolls), wall events per √(d/g), and |ΣJ_x/ΣJ_y| of the logged wall impulses."""
+    path = out / f"contacts-{case.label}.h5"
+    if reuse and path.exists():
+        res = ds.load(path)
+    else:
+        res = ds.run(case.scene(equilibration=0.0), engine="edmd", out=path, progress=False,
+                     tc=tc, log_every=LOG_EVERY)
+    log = res.groups["collisions"]
+    wall = log["kind"] == 1
+    t = log["time"][wall]
+    sel = (t > EARLY[0]) & (t <= EARLY[1])
+    u = np.abs(log["velocity"][wall][sel, 0])
+    slip = np.abs(log["spin_velocity"][wall][sel, 0])
+    impulse = log["impulse"][wall][sel]
+    ts = res.timeseries
+    span = (ts["time"] > EARLY[0]) & (ts["time"] <= EARLY[1])
+    events = np.diff(ts["wall_collisions"][span][[0, -1]])[0] / np.ptp(ts["time"][span])
+    return {"angle": case.angle, "base": case.base, "logged": int(sel.sum()),
+            "median_slip_over_speed": float(np.median(slip / np.maximum(u, 1e-12))),
+            "wall_events_per_time": float(events),
+            "logged_impulse_ratio": float(abs(impulse[:, 0].sum() / impulse[:, 1].sum()))}
+
+
 # -- main -------------------------------------------------------------------------------
-def measure(selected: list[Case], out: Path, tc: float, reuse: bool) -> dict:
+def measure(selected: list[Case], out: Path, tc: float, reuse: bool, quick: bool) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     runs = []
     for case in selected:
@@ -292,8 +326,14 @@ def measure(selected: list[Case], out: Path, tc: float, reuse: bool) -> dict:
               f"late {r['ratio_late']:.3f} (tan α {r['tan_alpha']:.3f})  KE/N late "
               f"{r['ke_late']:8.2f}  trend {r['ke_trend_late']:+.2f}  ν_base {r['nu_base']:.2f}  "
               f"slip {r['slip']:.2f}  TC share {r['tc_share']:.2f}", flush=True)
+    contacts = [] if quick else [base_contacts(c, out, tc, reuse) for c in CONTACT_CASES]
+    for c in contacts:
+        print(f"contacts {c['base']}-{c['angle']:g}: contact point / centre speed "
+              f"{c['median_slip_over_speed']:.1e}, {c['wall_events_per_time']:.3g} wall events "
+              f"per √(d/g), logged |ΣJx/ΣJy| {c['logged_impulse_ratio']:.3f}", flush=True)
     machine = f"{platform.node()}, {platform.processor() or platform.machine()}"
     return {"units": "d = 1, m = 1, g = 1: times in √(d/g), energies in m g d, forces in m g",
+            "base_contacts": contacts,
             "scene": SCENE, "engine": "edmd", "tc": tc,
             "machine": f"machine: {machine}, Python {platform.python_version()}",
             "runs": runs}
@@ -332,7 +372,7 @@ def main(argv: list[str] | None = None) -> int:
         "-some" if args.angles or args.duration else "") + (
         f"-seed{args.seed}" if args.seed is not None else "")
     out = ROOT / "results" / name
-    data = measure(selected, out, args.tc, args.reuse)
+    data = measure(selected, out, args.tc, args.reuse, partial)
     text = json.dumps(data, separators=(",", ":"))
     write_atomically(out / "chute_angles.json", text.encode())
     print(f"figure: {figure(data, out / 'chute_angles.png')}")
