@@ -168,9 +168,12 @@ def fast_impacts(engine: str, quick: bool, folder: Path) -> Outcome:
                 continue
             except EngineError as exc:
                 ok = False
-                lost = "lost" in str(exc).lower()
+                # LAMMPS: "Lost atoms" with its cause; LIGGGHTS: "crossed the lower wall"
+                text = str(exc).lower()
+                lost = "lost" in text or "crossed the" in text
                 undetected |= not (lost and model == "hooke")
-                figures.append(f"{model} {what}: " + ("lost" if lost else "failed"))
+                figures.append(f"{model} {what}: " + ("lost (stopped, named)" if lost
+                                                      else "failed"))
                 notes.append(f"{model} {what}: the run stopped: "
                              f"{str(exc).splitlines()[0][-160:]}")
                 continue
