@@ -210,3 +210,15 @@ class BackendBase:
 def frame_mass(frame: Frame) -> np.ndarray:
     """Particle masses of a frame: m = d^dim (d = 1 has m = 1)."""
     return (2 * np.asarray(frame.radius, float)) ** frame.dim
+
+
+def frame_energies(frame: Frame, inertia_k: float) -> dict[str, Any]:
+    """Total momentum, translational and rotational kinetic energy of a frame's particles
+    (mean flow included: the peculiar parts are :mod:`demstudy.engines.peculiar`'s);
+    ``inertia_k``: I = K m r²."""
+    mass = frame_mass(frame)
+    inertia = inertia_k * mass * frame.radius**2
+    return {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
+            "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
+            "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
+                                                    frame.angular_velocity**2))}

@@ -32,7 +32,7 @@ from ...io.checksum import file_digest, verify_file
 from ...io.frames import Frame
 from ...scene import Scene
 from ...scene.initial import build_initial_state
-from ..backend import BackendBase, Capabilities, Needs, frame_mass
+from ..backend import BackendBase, Capabilities, Needs, frame_energies, frame_mass
 from ..peculiar import peculiar_observables
 from .deck import build_deck, check_scene, write_deck
 from .deck.effects import TRANSLATIONS, wall_fix_id, wall_force_sources
@@ -317,11 +317,7 @@ class LammpsBackend(BackendBase):
                 "omegax omegay omegaz modify sort id append yes format float %.17g")
         scene = self.scene
         mass = frame_mass(frame)
-        inertia = scene.inertia_k * mass * frame.radius**2
-        values = {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
-                  "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
-                  "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
-                                                          frame.angular_velocity**2))}
+        values = frame_energies(frame, scene.inertia_k)
         if scene.y_periodic:
             # the mean flow (Lees–Edwards streaming profile) is no pressure: peculiar part
             # from the velocities, contact part from LAMMPS's virial at this step

@@ -35,7 +35,7 @@ from ...errors import EngineError, UnsupportedByEngine
 from ...io.frames import Frame
 from ...scene import Scene
 from ...scene.initial import build_initial_state
-from ..backend import BackendBase, Capabilities, Needs, frame_mass
+from ..backend import BackendBase, Capabilities, Needs, frame_energies, frame_mass
 from ..lammps.deck.output import sample_steps
 from ..peculiar import peculiar_observables
 from .deck import (
@@ -279,11 +279,7 @@ class LiggghtsBackend(BackendBase):
     def observe(self, production: bool) -> dict:
         frame, scene = self.frame(), self.scene
         mass = frame_mass(frame)
-        inertia = scene.inertia_k * mass * frame.radius**2
-        values = {"momentum": np.sum(mass[:, None] * frame.velocity, axis=0),
-                  "kinetic_energy": 0.5 * float(np.sum(mass[:, None] * frame.velocity**2)),
-                  "rotational_energy": 0.5 * float(np.sum(inertia[:, None] *
-                                                          frame.angular_velocity**2))}
+        values = frame_energies(frame, scene.inertia_k)
         if scene.y_periodic:
             # as the other engines: kinetic part about the mean flow (no Lees–Edwards shear in
             # LIGGGHTS, so about the drift), contact part from this step's contacts
