@@ -529,16 +529,23 @@ def test_contact_stress_of_a_resting_bed_carries_its_weight(tmp_path):
     """40 discs settled on the wall under normal gravity: the contact stress (pairs from
     compute pair/gran/local, the wall's from its stored forces) balances the weight above
     each height: σ_yy(y) equals the momentum balance's τ_yy within 2 % of the bottom value
-    in the bed's interior bins, the wall carries N g / L_x, and σ_xy vanishes."""
+    in the bed's interior bins, the wall carries N g / L_x, and σ_xy vanishes. The bed is
+    not quite still: it rocks on its tangential springs (its net x force swings by ~±1 m g),
+    so a single step's σ_xy is not zero; the scene's 8 samples (every 0.5) aliased that into
+    a mean σ_xy of up to 0.05 (0.6 % of σ_yy) depending on the window and on round-off; 80
+    (every 0.05) average it to ≤ 0.003 (measured after 40, 44 and 48 time units, with either
+    neighbour-list policy of docs/engines.md)."""
     out = tmp_path / "bed.h5"
     res = cli("run", "campbell1982/chute-30", "--engine", "liggghts", "--out", str(out), "-q",
               "--set", "gravity.angle=0", "--set", "run.equilibration=40", "--set",
-              "run.production=4", "--set", 'measure.statistics=["profiles","stress"]')
+              "run.production=4", "--set", "run.sample_interval=0.05",
+              "--set", 'measure.statistics=["profiles","stress"]')
     assert res.returncode == 0, res.stderr
     with h5py.File(out) as f:
         total, balance = f["stress/total"][:], f["stress/balance_tau_yy"][:]
         wall = f["stress/wall_lower"][:]
         assert f["timeseries/kinetic_energy"][-1] < 1e-3  # at rest
+        assert f["stress"].attrs["contact_samples"] >= 80
     assert wall[1] == pytest.approx(40 / 4.8, rel=1e-3)
     inside = slice(1, 7)
     assert np.all(np.abs(total[inside, 1, 1] - balance[inside]) < 0.02 * balance[0])

@@ -49,18 +49,24 @@ WALL_FORCES = "wall_forces"  # fix ave/time of every wall's summed force
 BOUNDARY_MARGIN = 1e-9
 #: room between a wall plane and the box boundary behind it, in d (``y_bounds``)
 WALL_MARGIN = 1.0
-#: The neighbour lists are rebuilt every step: LIGGGHTS forgets a pair's tangential spring only
-#: at a rebuild (a pair that parts keeps it until then; with LIGGGHTS's default, rebuilding
-#: once some atom has moved skin/2, that is hundreds of steps), so a second collision of
-#: the same pair before the rebuild would start with the first one's spring, a spurious
-#: tangential impulse, and how often depends on the frame (through the atoms' displacements:
-#: a moving wall's Couette is no longer its mirror image). Rebuilt every step, a parted pair
-#: is forgotten the step it parts, as LAMMPS does (tests/test_liggghts.py); it costs ≈ 2×
-#: the run time of a small 2D cell (the 100-disc Couette: 5.4 → 11.3 s for 300 time units).
-#: ``neigh_modify contact_distance_factor`` > 1 also forgets it at no cost (the contact
-#: model then sees the parted pair), but changes which pairs LIGGGHTS's models and computes
-#: treat as neighbours; with it the resting-bed stress test failed (docs/engines.md).
-NEIGHBOUR_COMMANDS = ("neighbor 0.2 bin", "neigh_modify delay 0 every 1 check no")
+#: A parted pair must forget its tangential spring the step it parts, as LAMMPS does. LIGGGHTS
+#: zeroes a listed pair's spring only in its contact models' ``surfacesClose`` (called for
+#: a pair closer than ``contact_distance_factor`` × (r_i + r_j) but not touching;
+#: src/pair_gran_base.h) or when a neighbour rebuild drops it. With the default factor 1
+#: ``surfacesClose`` is never called, so a parted pair kept its spring until the next
+#: rebuild (hundreds of steps with the displacement check): a second collision before it
+#: started with the first one's spring, and a mirrored Couette cell left its mirror image
+#: (tests/test_liggghts.py). Factor 1.05 zeroes the spring the step the gap opens, as long
+#: as no pair separates by more than 0.05 (r_i + r_j) in one step (a relative speed of
+#: 0.05 d / dt: 60 in the units of accuracy-cost/couette-rough-nu0.55, whose walls move at
+#: 1, and 350–1500 in the chute, cooling and Poiseuille scenes). It only adds the ring
+#: 1 < r/(r_i + r_j) < 1.05 to the lists: ``compute pair/gran/local`` still reports
+#: touching pairs only (its rows are the overlapping ones), and a wall contact is zeroed
+#: the step it opens either way. Rebuilding every step instead
+#: (the earlier fix) made LIGGGHTS several times slower (docs/benchmarks.md).
+CONTACT_DISTANCE_FACTOR = 1.05
+NEIGHBOUR_COMMANDS = ("neighbor 0.2 bin", "neigh_modify delay 0 every 1 check yes "
+                      f"contact_distance_factor {CONTACT_DISTANCE_FACTOR}")
 
 
 @dataclass
