@@ -59,7 +59,10 @@ WALL_MARGIN = 1.0
 #: (tests/test_liggghts.py). Factor 1.05 zeroes the spring the step the gap opens, as long
 #: as no pair separates by more than 0.05 (r_i + r_j) in one step (a relative speed of
 #: 0.05 d / dt: 60 in the units of accuracy-cost/couette-rough-nu0.55, whose walls move at
-#: 1, and 350–1500 in the chute, cooling and Poiseuille scenes). It only adds the ring
+#: 1, and 350–1500 in the chute, cooling and Poiseuille scenes). A healthy contact keeps
+#: far inside that: a pair parts at about the speed v it met with, and with n ≥ 10 steps per
+#: contact it moves v t_c / n ≈ π δ_max / n ≤ 0.016 d per step for the health limit δ_max =
+#: 0.05 d (Hooke: δ_max = v t_c / π). It only adds the ring
 #: 1 < r/(r_i + r_j) < 1.05 to the lists: ``compute pair/gran/local`` still reports
 #: touching pairs only (its rows are the overlapping ones), and a wall contact is zeroed
 #: the step it opens either way. Rebuilding every step instead
