@@ -135,3 +135,12 @@ def test_cli_compares_comma_separated_replica_groups(tmp_path, capsys):
     assert "coarse.h5" in capsys.readouterr().err
     assert main(["compare", ",", str(files[1]), "-o", "none"]) == 2
     assert "RUN.h5" in capsys.readouterr().err
+
+
+def test_replica_files_are_named_in_shell_brace_form():
+    from demstudy.comparison.core import _brace
+
+    assert _brace(["a-r0.h5", "a-r1.h5"]) == "a-r{0,1}.h5"
+    # the ladder's own run (no suffix) beside its extra seeds: bash's {,-r1} form
+    assert _brace(["s.h5", "s-r1.h5", "s-r2.h5"]) == "s{,-r1,-r2}.h5"
+    assert _brace(["x.h5", "x.h5"]) == "x.h5,x.h5"  # not a set of distinct files

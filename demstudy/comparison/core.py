@@ -142,13 +142,13 @@ def _load(source: Results | str | os.PathLike) -> Results:
 
 
 def _brace(names: Sequence[str]) -> str:
-    """Replica files in shell brace form: ``a-r{0,1,2}.h5`` (the full list when they share
-    nothing)."""
+    """Replica files in shell brace form: ``a-r{0,1,2}.h5``, ``a{,-r1,-r2}.h5`` (the full list
+    when they share nothing)."""
     prefix = os.path.commonprefix(list(names))
     rest = [n[len(prefix):] for n in names]
     suffix = os.path.commonprefix([r[::-1] for r in rest])[::-1]
     middle = [r[:len(r) - len(suffix)] for r in rest]
-    if not (prefix or suffix) or not all(middle):
+    if not (prefix or suffix) or len(set(middle)) < len(middle):
         return ",".join(names)
     return f"{prefix}{{{','.join(middle)}}}{suffix}"
 
