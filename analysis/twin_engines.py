@@ -55,6 +55,21 @@ def energies(path: Path) -> tuple[np.ndarray, np.ndarray]:
         ts["rotational_energy"])
 
 
+def wall_forces(out: Path, variant: str, seed: int, before: float = 5.0) -> None:
+    """Each wall's x force, LIGGGHTS against LAMMPS, in the samples before ``before`` (still
+    the same trajectory) that had a wall contact: a systematic ratio is a wall difference."""
+    runs = [ds.load(out / f"{variant}-{engine}-s{seed}.h5").timeseries for engine in ENGINES]
+    early = np.asarray(runs[0]["time"]) < before
+    for side in ("upper", "lower"):
+        lmp, lig = (np.asarray(ts[f"wall_force_{side}"])[early, 0] for ts in runs)
+        hit = np.abs(lmp) > 1e-3
+        if hit.any():
+            ratio = lig[hit] / lmp[hit] - 1
+            print(f"seed {seed}, {side} wall x force before t = {before:g}: LIGGGHTS/LAMMPS - 1 "
+                  f"= {ratio.mean():+.1e} (range {ratio.min():+.1e} … {ratio.max():+.1e}, "
+                  f"{hit.sum()} samples)")
+
+
 def compare(variant: str, seeds: int, out: Path) -> None:
     """Run ``variant`` in both engines for ``seeds`` seeds and print the energy ratio."""
     curves: dict[str, list[np.ndarray]] = {engine: [] for engine in ENGINES}
@@ -68,6 +83,8 @@ def compare(variant: str, seeds: int, out: Path) -> None:
                 ds.run(scene, engine, path, progress=False)
             time, energy = energies(path)
             curves[engine].append(energy)
+        if variant == "shear":
+            wall_forces(out, variant, seed)
     lmp, lig = (np.array(curves[engine]) for engine in ENGINES)
     print(f"\n{variant}: {seeds} seeds, identical initial states in both engines")
     print("    t/τ      <E> LAMMPS  <E> LIGGGHTS  ratio - 1   ± s.e. (paired over seeds)")
