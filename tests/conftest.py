@@ -7,3 +7,4 @@ import os
 # timings; ~10 s per engine kind): forecasts come from the cache or are skipped
 # (tests/test_forecast.py sets its own costs)
 os.environ.setdefault("DEMSTUDY_MEASURE_RATES", "0")
+

@@ -18,15 +18,18 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from liggghts_required import require_liggghts
 
 from demstudy.contact.mapping import hooke_contact
 from demstudy.engines.liggghts.deck import state_rows
-from demstudy.engines.liggghts.library import LIBRARY_ENV, library_path
+from demstudy.engines.liggghts.library import LIBRARY_ENV
 from demstudy.errors import EngineError, UnsupportedByEngine
 from demstudy.scene import validate_scene
 
-pytestmark = pytest.mark.skipif(library_path() is None,
-                                reason="LIGGGHTS is not installed (make install as root)")
+
+@pytest.fixture(autouse=True)
+def _liggghts_installed():
+    require_liggghts()
 
 KN = 1e5
 
@@ -450,10 +453,8 @@ def test_the_deck_runs_unchanged_in_bare_liggghts(tmp_path):
     """`demstudy deck --engine liggghts` writes deck.in and its data file; `liggghts -in
     deck.in` runs them without demstudy and prints the same kinetic energies, sample by
     sample, as the driven run (to 1e-9)."""
-    import shutil
 
-    if shutil.which("liggghts") is None:
-        pytest.skip("the liggghts executable is not installed")
+    require_liggghts(executable=True)
     scene = write_scene(tmp_path / "gas.toml", GAS | {"run": GAS["run"] | {"production": 0.5}})
     deck = tmp_path / "deck"
     assert cli("deck", str(scene), "--engine", "liggghts", "-o", str(deck)).returncode == 0

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from liggghts_required import require_liggghts
 
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
-from demstudy.engines.liggghts.library import library_path
 from demstudy.engines.peculiar import peculiar_observables, peculiar_velocity
 from demstudy.io.results import read_results
 from demstudy.scene import validate_scene
@@ -122,8 +122,8 @@ def test_periodic_pressure_equals_the_stress_trace(engine, tmp_path):
     equals tr /stress/total / 3 and the ``temperature`` timeseries the profiles' one, to the
     bins' own fluctuation term (measured: 0.828 against 0.827 in LIGGGHTS, 0.827 against
     0.826 in LAMMPS, 0.812 against 0.811 event-driven)."""
-    if engine == "liggghts" and library_path() is None:
-        pytest.skip("LIGGGHTS is not installed")
+    if engine == "liggghts":
+        require_liggghts()
     n, phi = 1000, 0.2
     length = (n * math.pi / 6 / phi) ** (1 / 3)
     scene = validate_scene({
