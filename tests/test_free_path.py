@@ -332,6 +332,18 @@ def dilute_moment_ratios() -> tuple[float, float]:
             2 * avg(lambda c: 1 / rel(c)) * nu)
 
 
+
+def run_and_read_free_paths(folder, name: str):
+    """Run ``folder/name.toml`` event-driven, analyse its free paths, return (datasets,
+    attributes) of /statistics/freepath."""
+    path = folder / f"{name}.h5"
+    assert main(["run", str(folder / f"{name}.toml"), "--engine", "edmd", "--out", str(path),
+                 "--quiet"]) == 0
+    assert main(["analyze", str(path), "--what", "freepath"]) == 0
+    with h5py.File(path) as f:
+        g = f["statistics/freepath"]
+        return {k: g[k][()] for k in g}, dict(g.attrs)
+
 @pytest.fixture(scope="module")
 def gas(tmp_path_factory):
     """A real run: 4000 elastic smooth spheres at phi = 0.05, T = 1, in a periodic cube
@@ -359,13 +371,7 @@ seed = 3
 statistics = ["profiles", "angles"]
 bin_width = 5.0
 """)
-    path = folder / "gas.h5"
-    assert main(["run", str(folder / "gas.toml"), "--engine", "edmd", "--out", str(path),
-                 "--quiet"]) == 0
-    assert main(["analyze", str(path), "--what", "freepath"]) == 0
-    with h5py.File(path) as f:
-        g = f["statistics/freepath"]
-        return {k: g[k][()] for k in g}, dict(g.attrs)
+    return run_and_read_free_paths(folder, "gas")
 
 
 def test_dilute_gas_free_paths_follow_kinetic_theory(gas):
@@ -428,13 +434,7 @@ seed = 5
 statistics = ["profiles", "freepath"]
 bin_width = 15.6625
 """)
-    path = folder / "le.h5"
-    assert main(["run", str(folder / "le.toml"), "--engine", "edmd", "--out", str(path),
-                 "--quiet"]) == 0
-    assert main(["analyze", str(path), "--what", "freepath"]) == 0
-    with h5py.File(path) as f:
-        g = f["statistics/freepath"]
-        return {k: g[k][()] for k in g}, dict(g.attrs)
+    return run_and_read_free_paths(folder, "le")
 
 
 def test_sheared_gas_free_path_is_enskogs_in_every_bin(sheared_gas):
