@@ -1,5 +1,5 @@
 """Command line: ``demstudy validate | deck | run | plot | analyze | compare | forecast |
-calibrate | cost | engine-map | stability``.
+calibrate | cost | engine-map | stability | study``.
 
 All quantities are in dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts
 (otherwise a wall speed or the shear rate sets the time scale).
@@ -306,6 +306,28 @@ def _cmd_cost(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_study(args: argparse.Namespace) -> int:
+    from .accuracy.study import check_dask_address
+    from .studies.runner import publish, run_study
+
+    dask = check_dask_address(args.dask) if args.dask else None
+    result = run_study(args.name, quick=args.quick, out=args.out,
+                       workers=args.workers or os.cpu_count() or 1, dask=dask,
+                       dry_run=args.dry_run, analyse_only=args.analyse_only,
+                       engines=[e.strip() for e in ",".join(args.engine).split(",")
+                                if e.strip()] if args.engine else None,
+                       only=args.only)
+    if args.dry_run:
+        return 0
+    if args.docs:
+        if args.quick:
+            print("--docs publishes the full study only; the quick report stays in "
+                  f"{result.out}/", file=sys.stderr)
+        else:
+            print(f"published: {publish(result, Path(args.docs))}")
+    return 1 if result.failed else 0
+
+
 def _cmd_engine_map(args: argparse.Namespace) -> int:
     from .accuracy.engine_map import QUICK, RESTITUTIONS, MapSettings, engine_map
 
@@ -548,6 +570,29 @@ def build_parser() -> argparse.ArgumentParser:
                    help="print every planned run with its forecast and the total on the "
                         "workers; run nothing, write nothing")
     p.set_defaults(func=_cmd_cost)
+
+    p = sub.add_parser("study", help="a seed study end to end: runs, analysis, figures in the "
+                       "thesis's forms and a report checking its statements (docs/studies/)")
+    p.add_argument("name", help="campbell1982 or malik2008")
+    p.add_argument("--quick", action="store_true",
+                   help="a reduced study in minutes (short runs, fewer cases) into "
+                        "results/studies/NAME-quick/")
+    p.add_argument("--workers", type=int, help="local processes (default: the cores)")
+    p.add_argument("--dask", metavar="ADDRESS",
+                   help="run on this Dask scheduler instead (tcp://host:port or host:port)")
+    p.add_argument("--out", help="study folder (default results/studies/NAME[-quick]/)")
+    p.add_argument("--engine", action="append", metavar="edmd,lammps",
+                   help="only the cases of these engines")
+    p.add_argument("--only", action="append", metavar="TEXT",
+                   help="only the cases whose name contains TEXT (repeatable)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the runs to make and the forecast; run nothing")
+    p.add_argument("--analyse-only", action="store_true",
+                   help="no runs: analyse the results files already made")
+    p.add_argument("--docs", metavar="DOCS",
+                   help="also publish the report and figures under DOCS (docs/studies/NAME.md,"
+                        " docs/figures/studies/NAME/)")
+    p.set_defaults(func=_cmd_study)
 
     p = sub.add_parser("engine-map",
                        help="which engine is cheaper at 2 %% accuracy, over solid fraction "

@@ -1,0 +1,135 @@
+"""What a seed study is made of: the runs it needs (``Case``), the statements of the thesis it
+checks (``Check``) and the study itself (``Study``: cases, then an analysis that turns the
+results files into figures and checks).
+
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed or
+the shear rate sets the time unit). Every figure and report a study writes says so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+#: the verdicts a check can reach (the report's last columns say why for every other than
+#: the first)
+REPRODUCED = "reproduced"
+NOT_REPRODUCED = "not reproduced"
+PARTLY = "partly"
+NOT_RUN = "not run"  # the case was not in this (quick) run of the study
+VERDICTS = (REPRODUCED, PARTLY, NOT_REPRODUCED, NOT_RUN)
+
+UNITS_NOTE = ("Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise "
+              "a wall speed sets the time unit).")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run of a study: the scene (a preset name or file), typed section overrides merged
+    into it (``load_scene(scene, **sections)``), the engine and its options. ``name`` is the
+    results file's stem, unique in the study; ``quick``: also part of ``--quick``, with
+    ``quick_sections`` merged on top (shorter runs); ``group`` tags cases an analysis
+    treats together."""
+
+    name: str
+    scene: str
+    engine: str = "edmd"
+    sections: Mapping[str, Any] = field(default_factory=dict)
+    options: Mapping[str, Any] = field(default_factory=dict)
+    quick: bool = False
+    quick_sections: Mapping[str, Any] = field(default_factory=dict)
+    group: str = ""
+
+    def load(self, quick: bool = False):
+        """The case's validated scene."""
+        from ..scene import load_scene
+
+        sections = merge(self.sections, self.quick_sections) if quick else dict(self.sections)
+        return load_scene(self.scene, **sections)
+
+
+def merge(base: Mapping[str, Any], top: Mapping[str, Any]) -> dict[str, Any]:
+    """``base`` with ``top`` merged into it, tables recursively (``top`` wins)."""
+    out = dict(base)
+    for key, value in top.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+@dataclass
+class Check:
+    """One statement or figure of the thesis and what demstudy measured of it.
+
+    ``ref``: where the thesis says it (figure, line numbers of the digest); ``statement``:
+    what it says, in words; ``thesis``: its value where it gives one; ``measured``:
+    demstudy's value with its statistical error (text), per engine where meaningful;
+    ``verdict``: one of ``VERDICTS``; ``reason``: for every verdict other than
+    "reproduced", the cause found (or what is still open)."""
+
+    ref: str
+    statement: str
+    thesis: str
+    measured: str
+    verdict: str
+    reason: str = ""
+
+    def __post_init__(self) -> None:
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"verdict {self.verdict!r}: allowed are {', '.join(VERDICTS)}")
+
+
+@dataclass
+class Figure:
+    """A figure the study wrote: its file and a one-line caption."""
+
+    path: Path
+    caption: str
+
+
+@dataclass
+class Analysis:
+    """What a study's analysis returns: the checks, the figures and free-form sections of
+    the report (markdown, in order)."""
+
+    checks: list[Check] = field(default_factory=list)
+    figures: list[Figure] = field(default_factory=list)
+    sections: list[tuple[str, str]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Study:
+    """A seed study: ``cases(quick)`` lists its runs; ``analyse(runs, out, quick)`` reads
+    them (``runs``: case name → results file path, only the cases of this run of the
+    study) and writes its figures into ``out``."""
+
+    name: str
+    title: str
+    reference: str
+    summary: str
+    cases: Callable[[bool], Sequence[Case]]
+    analyse: Callable[[Mapping[str, Path], Path, bool], Analysis]
+
+
+def pm(value: float, err: float | None = None, digits: int = 2) -> str:
+    """``value ± err`` with the error to ``digits`` significant figures and the value to the
+    same decimal place (``err`` None or not finite: the value alone, 3 significant)."""
+    if value is None or not math.isfinite(value):
+        return "n/a"
+    if err is None or not math.isfinite(err) or err <= 0:
+        return f"{value:.3g}"
+    place = digits - 1 - math.floor(math.log10(err))
+    place = max(place, 0)
+    return f"{value:.{place}f} ± {err:.{place}f}"
+
+
+def within(value: float, err: float, target: float, sigmas: float = 2.0,
+           tolerance: float = 0.0) -> bool:
+    """Whether ``value`` agrees with ``target`` within ``sigmas`` errors plus an absolute
+    ``tolerance`` (the thesis's own precision, e.g. a value read off a figure)."""
+    return abs(value - target) <= sigmas * abs(err) + tolerance

@@ -1,0 +1,31 @@
+"""A study made of parts (chutes, Couette cells, ...): each part module has ``cases(quick)``
+and ``analyse(runs, out, quick)``; the study's cases and analysis are theirs, in order.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from types import ModuleType
+
+from .base import Analysis, Case
+
+
+def combined_cases(parts: Sequence[ModuleType]):
+    def cases(quick: bool) -> list[Case]:
+        return [case for part in parts for case in part.cases(quick)]
+    return cases
+
+
+def combined_analysis(parts: Sequence[ModuleType]):
+    def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
+        total = Analysis()
+        for part in parts:
+            names = {c.name for c in part.cases(quick)}
+            ana = part.analyse({n: p for n, p in runs.items() if n in names}, out, quick)
+            total.checks += ana.checks
+            total.figures += ana.figures
+            total.sections += ana.sections
+        return total
+    return analyse

@@ -1,0 +1,71 @@
+"""The study report (markdown): what was run, the checks table (one row per statement of the
+thesis, with demstudy's value, its error and the verdict, and the reason for every verdict
+other than "reproduced"), the figures and the analysis's own sections.
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+from collections import Counter
+from typing import TYPE_CHECKING
+
+from .base import REPRODUCED, UNITS_NOTE, VERDICTS
+
+if TYPE_CHECKING:
+    from .runner import StudyRun
+
+
+def _cell(text: str) -> str:
+    return " ".join(str(text).split()).replace("|", "\\|")
+
+
+def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "") -> str:
+    study, ana = result.study, result.analysis
+    checks = ana.checks if ana else []
+    count = Counter(c.verdict for c in checks)
+    tally = ", ".join(f"{count[v]} {v}" for v in VERDICTS if count[v])
+    quick_text = (" This is the **quick** version (short runs, fewer cases): its verdicts "
+                  "are indicative only; the full study is `demstudy study "
+                  f"{study.name}`." if quick else "")
+    lines = [
+        f"# {study.title}",
+        "",
+        f"{study.summary}{quick_text}",
+        "",
+        f"Reference: {study.reference}. {UNITS_NOTE}",
+        "",
+        "```bash",
+        f"demstudy study {study.name}{' --quick' if quick else ''}    # rerun: finished runs "
+        "are reused",
+        "```",
+        "",
+        f"Generated {_dt.date.today().isoformat()} on {machine}: {len(result.made)} runs made, "
+        f"{len(result.reused)} reused, {len(result.failed)} failed"
+        + (f" ({', '.join(result.failed)})" if result.failed else "")
+        + f"; {result.wall_seconds / 60:.1f} min in all"
+        + (f" (forecast {result.forecast_seconds / 60:.1f} min)"
+           if result.forecast_seconds else "") + ".",
+        "",
+        f"## Statements of the thesis checked ({tally or 'none'})",
+        "",
+        "Verdict: *reproduced* when demstudy's value agrees with the thesis's within the "
+        "statistical errors (2σ) plus the precision of the thesis's own statement (a value "
+        "read off a figure, a qualitative trend); otherwise the reason found is given.",
+        "",
+        "| # | thesis | statement | thesis value | demstudy | verdict | reason |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for i, c in enumerate(checks, 1):
+        verdict = f"**{c.verdict}**" if c.verdict != REPRODUCED else c.verdict
+        lines.append(f"| {i} | {_cell(c.ref)} | {_cell(c.statement)} | {_cell(c.thesis)} | "
+                     f"{_cell(c.measured)} | {verdict} | {_cell(c.reason)} |")
+    lines.append("")
+    if ana and ana.figures:
+        lines += ["## Figures", ""]
+        for fig in ana.figures:
+            lines += [f"![{_cell(fig.caption)}]({figure_prefix}{fig.path.name})", "",
+                      f"*{fig.caption}*", ""]
+    for title, text in (ana.sections if ana else []):
+        lines += [f"## {title}", "", text.strip(), ""]
+    return "\n".join(lines).rstrip() + "\n"

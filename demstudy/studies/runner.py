@@ -1,0 +1,240 @@
+"""``run_study``: a seed study end to end: the forecast of its runs, the runs (a local process
+pool or a Dask cluster, each run one results file, reused on a rerun: an interrupted study
+resumes), the analysis, the report.
+
+Runs go to ``<out>/runs/<case>.h5`` (``out`` default ``results/studies/<name>`` and
+``results/studies/<name>-quick`` for ``--quick``); figures and the report ``<name>.md`` to
+``out``; ``publish`` copies report and figures into the docs (``--docs``).
+Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+import shutil
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..errors import BadOption, EngineError
+from .base import Analysis, Case, Study
+
+
+@dataclass(frozen=True)
+class _Spec:
+    """What ``demstudy.accuracy.execute`` needs of a run's settings (duck-typed RunSpec)."""
+
+    name: str
+    engine: str
+    engine_options: tuple[tuple[str, Any], ...] = ()
+    relative_cost: float = 1.0
+
+    def options(self) -> dict:
+        return dict(self.engine_options)
+
+
+@dataclass(frozen=True)
+class StudyTask:
+    """A case ready to run: duck-types ``demstudy.accuracy.execute.Task``."""
+
+    case: Case
+    quick: bool
+    path: Path
+    spec: _Spec
+    scene_toml: str = ""
+
+    def scene(self):
+        return self.case.load(self.quick)
+
+
+@dataclass
+class StudyRun:
+    """What ``run_study`` did: the analysis, the report, per-case wall seconds, the
+    forecast (seconds on the workers, None when unknown) and failed cases."""
+
+    study: Study
+    out: Path
+    report: Path | None = None
+    analysis: Analysis | None = None
+    forecast_seconds: float | None = None
+    made: list[str] = field(default_factory=list)
+    reused: list[str] = field(default_factory=list)
+    failed: list[str] = field(default_factory=list)
+    wall_seconds: float = 0.0
+
+
+def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None = None,
+             only: Sequence[str] | None = None) -> list[StudyTask]:
+    """The study's cases as tasks (``engines``: keep cases of these engines; ``only``: keep
+    cases whose name contains one of these strings)."""
+    from ..scene import scene_to_toml
+
+    cases = list(study.cases(quick))
+    names = [c.name for c in cases]
+    if len(set(names)) != len(names):
+        raise ValueError(f"study {study.name}: case names repeat")
+    if engines:
+        cases = [c for c in cases if c.engine in engines]
+    if only:
+        cases = [c for c in cases if any(s in c.name for s in only)]
+    tasks = []
+    for case in cases:
+        scene = case.load(quick)
+        tasks.append(StudyTask(case, quick, out / "runs" / f"{case.name}.h5",
+                               _Spec(case.name, case.engine,
+                                     tuple(sorted(case.options.items()))),
+                               scene_to_toml(scene)))
+    return tasks
+
+
+def forecast(tasks: Sequence[StudyTask], workers: int) -> tuple[float | None, list[str]]:
+    """The wall time of ``tasks`` on ``workers`` (each run's ``--dry-run`` forecast,
+    scheduled longest first) and one line per run; None when a run has no forecast."""
+    from ..accuracy.forecast import makespan
+    from ..api import run
+
+    seconds, lines, unknown = [], [], False
+    for task in tasks:
+        plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
+                   progress=False, **task.case.options)
+        s = plan.get("forecast_seconds")
+        if s is None or not math.isfinite(s):
+            unknown = True
+            lines.append(f"  {task.case.name} ({task.case.engine}): no forecast "
+                         f"({plan.get('forecast', 'not measured')})")
+            continue
+        seconds.append(float(s))
+        lines.append(f"  {task.case.name} ({task.case.engine}): {_duration(s)}")
+    total = makespan(seconds, workers) if seconds else 0.0
+    return (None if unknown else total), lines
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
+              workers: int = 1, dask: Any = None, dry_run: bool = False,
+              engines: Sequence[str] | None = None, only: Sequence[str] | None = None,
+              analyse_only: bool = False, echo=print) -> StudyRun:
+    """Run study ``name`` (module doc). ``dry_run``: the forecast only. ``analyse_only``:
+    no runs, analyse the results files already there. A failed run does not stop the
+    others nor the analysis: its checks say "not run" and ``failed`` lists it."""
+    from ..accuracy.execute import execute, is_done
+    from . import get_study
+
+    study = get_study(name)
+    if workers < 1:
+        raise BadOption("--workers", workers, "a whole number >= 1 is allowed")
+    out = Path(out) if out is not None else Path("results") / "studies" / (
+        study.name + ("-quick" if quick else ""))
+    started = time.perf_counter()
+    tasks = tasks_of(study, quick, out, engines, only)
+    result = StudyRun(study, out)
+    todo, done = [], []
+    for task in tasks:
+        (done if is_done(task.path, task.scene_toml) else todo).append(task)
+    result.reused = [t.case.name for t in done]
+    echo(f"study {study.name}{' (quick)' if quick else ''}: {len(tasks)} runs, "
+         f"{len(done)} already made, {len(todo)} to make; results in {out}/")
+    if todo and not analyse_only:
+        seconds, lines = forecast(todo, 1 if dask is not None else workers)
+        result.forecast_seconds = seconds
+        where = "a Dask cluster" if dask is not None else f"{workers} worker(s)"
+        head = (f"forecast: {_duration(seconds)} on {where}" if seconds is not None
+                else "forecast: unknown for some runs (listed)")
+        echo(head + (" (measured speed of this machine; docs/forecast.md)"))
+        for line in lines:
+            echo(line)
+        if dry_run:
+            return result
+        todo = [StudyTask(t.case, t.quick, t.path,
+                          _Spec(t.spec.name, t.spec.engine, t.spec.engine_options,
+                                _cost_of(lines, t)), t.scene_toml) for t in todo]
+
+        def finished(record: dict) -> None:
+            result.made.append(record["name"])
+            echo(f"  done {record['name']}: {record['task_seconds']:.1f} s")
+
+        try:
+            execute(todo, workers=workers, dask=dask, on_done=finished)
+        except EngineError as exc:
+            result.failed = [t.case.name for t in todo if t.case.name not in result.made]
+            echo(f"warning: {exc}")
+    elif dry_run:
+        return result
+    runs = {t.case.name: t.path for t in tasks if t.path.is_file()}
+    out.mkdir(parents=True, exist_ok=True)
+    result.analysis = study.analyse(runs, out, quick)
+    result.wall_seconds = time.perf_counter() - started
+    result.report = write_report(result, quick)
+    echo(f"report: {result.report}")
+    return result
+
+
+def _cost_of(lines: list[str], task: StudyTask) -> float:
+    """The forecast seconds of ``task`` from its forecast line (for longest-first order)."""
+    for line in lines:
+        if line.startswith(f"  {task.case.name} ("):
+            text = line.rsplit(": ", 1)[-1]
+            try:
+                value, unit = text.split()[:2]
+                return float(value) * {"s": 1, "min": 60, "h": 3600}.get(unit, 1)
+            except ValueError:
+                return 1.0
+    return 1.0
+
+
+def _machine() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import os
+
+    return f"{cpu}, {os.cpu_count()} logical CPUs, Python {platform.python_version()}"
+
+
+def write_report(result: StudyRun, quick: bool) -> Path:
+    """``<out>/<name>.md``: the checks table, the figures and the analysis's sections."""
+    from ..io.results import write_atomically
+    from .report import render
+
+    path = result.out / f"{result.study.name}.md"
+    text = render(result, quick, _machine())
+    write_atomically(path, text.encode())
+    return path
+
+
+def publish(result: StudyRun, docs: Path) -> Path:
+    """Copy the report to ``docs/studies/<name>.md`` and its figures to
+    ``docs/figures/studies/<name>/``, links rewritten; returns the report's new path."""
+    from ..io.results import write_atomically
+    from .report import render
+
+    fig_dir = docs / "figures" / "studies" / result.study.name
+    fig_dir.mkdir(parents=True, exist_ok=True)
+    for figure in result.analysis.figures if result.analysis else []:
+        shutil.copy2(figure.path, fig_dir / figure.path.name)
+    path = docs / "studies" / f"{result.study.name}.md"
+    text = render(result, False, _machine(),
+                  figure_prefix=f"../figures/studies/{result.study.name}/")
+    write_atomically(path, text.encode())
+    return path
+
+
+def runs_by_group(runs: Mapping[str, Path], cases: Sequence[Case], group: str) -> dict[str, Path]:
+    """The runs of the cases tagged ``group``."""
+    names = {c.name for c in cases if c.group == group}
+    return {n: p for n, p in runs.items() if n in names}
