@@ -90,16 +90,24 @@ def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None
     return tasks
 
 
-def forecast(tasks: Sequence[StudyTask], workers: int) -> tuple[float | None, list[str]]:
+def forecast(tasks: Sequence[StudyTask], workers: int
+             ) -> tuple[float | None, list[str], dict[str, str]]:
     """The wall time of ``tasks`` on ``workers`` (each run's ``--dry-run`` forecast,
-    scheduled longest first) and one line per run; None when a run has no forecast."""
+    scheduled longest first; None when a run has no forecast), one line per run, and the
+    runs the engine refuses (name → why: they are not run)."""
     from ..accuracy.forecast import makespan
     from ..api import run
+    from ..errors import UnsupportedByEngine
 
-    seconds, lines, unknown = [], [], False
+    seconds, lines, unknown, refused = [], [], False, {}
     for task in tasks:
-        plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
-                   progress=False, **task.case.options)
+        try:
+            plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
+                       progress=False, **task.case.options)
+        except (UnsupportedByEngine, BadOption) as exc:
+            refused[task.case.name] = str(exc)
+            lines.append(f"  {task.case.name} ({task.case.engine}): refused: {exc}")
+            continue
         s = plan.get("forecast_seconds")
         if s is None or not math.isfinite(s):
             unknown = True
@@ -109,7 +117,7 @@ def forecast(tasks: Sequence[StudyTask], workers: int) -> tuple[float | None, li
         seconds.append(float(s))
         lines.append(f"  {task.case.name} ({task.case.engine}): {_duration(s)}")
     total = makespan(seconds, workers) if seconds else 0.0
-    return (None if unknown else total), lines
+    return (None if unknown else total), lines, refused
 
 
 def _duration(seconds: float) -> str:
@@ -145,8 +153,10 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     echo(f"study {study.name}{' (quick)' if quick else ''}: {len(tasks)} runs, "
          f"{len(done)} already made, {len(todo)} to make; results in {out}/")
     if todo and not analyse_only:
-        seconds, lines = forecast(todo, 1 if dask is not None else workers)
+        seconds, lines, refused = forecast(todo, 1 if dask is not None else workers)
         result.forecast_seconds = seconds
+        result.failed = list(refused)
+        todo = [t for t in todo if t.case.name not in refused]
         where = "a Dask cluster" if dask is not None else f"{workers} worker(s)"
         head = (f"forecast: {_duration(seconds)} on {where}" if seconds is not None
                 else "forecast: unknown for some runs (listed)")
@@ -166,7 +176,7 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         try:
             execute(todo, workers=workers, dask=dask, on_done=finished)
         except EngineError as exc:
-            result.failed = [t.case.name for t in todo if t.case.name not in result.made]
+            result.failed += [t.case.name for t in todo if t.case.name not in result.made]
             echo(f"warning: {exc}")
     elif dry_run:
         return result
@@ -228,6 +238,7 @@ def publish(result: StudyRun, docs: Path) -> Path:
     for figure in result.analysis.figures if result.analysis else []:
         shutil.copy2(figure.path, fig_dir / figure.path.name)
     path = docs / "studies" / f"{result.study.name}.md"
+    path.parent.mkdir(parents=True, exist_ok=True)
     text = render(result, False, _machine(),
                   figure_prefix=f"../figures/studies/{result.study.name}/")
     write_atomically(path, text.encode())

@@ -1,0 +1,160 @@
+"""The study framework (``demstudy study``): cases run once into the study folder and are
+reused on a rerun, a changed case is redone, the forecast is printed before anything runs, a
+failed case leaves the others and the analysis standing, the report lists every check with its
+verdict, ``--docs`` publishes it with working figure links, bad input exits 2.
+
+Dimensionless particle units: d = 1, m = 1; the wall speed U_T = 1 sets the time unit.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pytest  # noqa: E402
+
+import demstudy as ds  # noqa: E402
+from demstudy import studies  # noqa: E402
+from demstudy.studies import Analysis, Case, Check, Figure, Study, pm, within  # noqa: E402
+from demstudy.studies.base import NOT_RUN, REPRODUCED, merge  # noqa: E402
+from demstudy.studies.runner import publish, run_study  # noqa: E402
+
+SHORT = {"run": {"equilibration": 5.0, "production": 10.0}}
+
+
+def _toy_cases(quick: bool) -> list[Case]:
+    cases = [Case("cell-a", "campbell1982/couette-rough", sections=SHORT, quick=True),
+             Case("cell-b", "campbell1982/couette-rough",
+                  sections=merge(SHORT, {"contact": {"restitution": 0.9}}))]
+    return [c for c in cases if c.quick or not quick]
+
+
+def _toy_analysis(runs, out: Path, quick: bool) -> Analysis:
+    """One check per case: the mean solid fraction of the cell equals N (π/4) / area at the
+    start (mass is conserved: the profile's ν integrates back to the number of discs)."""
+    ana = Analysis()
+    for case in _toy_cases(quick):
+        if case.name not in runs:
+            ana.checks.append(Check("toy", f"{case.name} ran", "-", "-", NOT_RUN,
+                                    "the run is missing"))
+            continue
+        res = ds.load(runs[case.name])
+        nu = res.profiles["solid_fraction"]
+        ana.checks.append(Check("toy", f"{case.name}: discs in the profile", "40",
+                                f"{nu.mean():.3f}", REPRODUCED))
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    path = out / "toy.png"
+    fig.savefig(path)
+    plt.close(fig)
+    ana.figures.append(Figure(path, "a toy figure"))
+    ana.sections.append(("Notes", "toy notes"))
+    return ana
+
+
+TOY = Study("toy", "A toy study", "nobody (2026)", "Two tiny Couette cells.",
+            _toy_cases, _toy_analysis)
+
+
+@pytest.fixture
+def toy(monkeypatch):
+    module = types.ModuleType("demstudy_toy_study")
+    module.STUDY = TOY
+    monkeypatch.setitem(sys.modules, "demstudy_toy_study", module)
+    monkeypatch.setitem(studies._MODULES, "toy", "demstudy_toy_study")
+    return TOY
+
+
+def test_runs_are_made_once_then_reused_and_a_changed_case_is_redone(toy, tmp_path, monkeypatch):
+    lines: list[str] = []
+    first = run_study("toy", out=tmp_path, echo=lines.append)
+    assert sorted(first.made) == ["cell-a", "cell-b"] and not first.reused
+    assert any(line.startswith("forecast:") for line in lines), lines
+    # the forecast comes before any run finished
+    assert [i for i, s in enumerate(lines) if s.startswith("forecast:")][0] < \
+        [i for i, s in enumerate(lines) if s.startswith("  done")][0]
+    report = first.report.read_text()
+    assert "| 1 | toy | cell-a: discs in the profile |" in report
+    assert "2 reproduced" in report and "![a toy figure](toy.png)" in report
+    assert "Dimensionless particle units" in report
+
+    second = run_study("toy", out=tmp_path, echo=lines.append)
+    assert second.made == [] and sorted(second.reused) == ["cell-a", "cell-b"]
+
+    changed = Study("toy", TOY.title, TOY.reference, TOY.summary,
+                    lambda q: [Case("cell-a", "campbell1982/couette-rough",
+                                    sections=merge(SHORT, {"run": {"production": 12.0}}))],
+                    _toy_analysis)
+    monkeypatch.setattr(sys.modules["demstudy_toy_study"], "STUDY", changed)
+    third = run_study("toy", out=tmp_path, echo=lines.append)
+    assert third.made == ["cell-a"], "a case whose scene changed must be run again"
+
+
+def test_quick_runs_only_the_quick_cases_and_missing_runs_say_not_run(toy, tmp_path):
+    res = run_study("toy", quick=True, out=tmp_path, echo=lambda s: None)
+    assert res.made == ["cell-a"]
+    verdicts = [c.verdict for c in res.analysis.checks]
+    assert verdicts == [REPRODUCED]
+    assert "quick" in res.report.read_text()
+    # --analyse-only on the full study: cell-b was never made → its check says "not run"
+    full = run_study("toy", out=tmp_path, analyse_only=True, echo=lambda s: None)
+    assert full.made == [] and [c.verdict for c in full.analysis.checks] == [REPRODUCED,
+                                                                           NOT_RUN]
+
+
+def test_dry_run_forecasts_and_writes_nothing(toy, tmp_path):
+    lines: list[str] = []
+    res = run_study("toy", out=tmp_path, dry_run=True, echo=lines.append)
+    assert res.made == [] and res.report is None
+    assert not (tmp_path / "runs").exists()
+    assert any("cell-b (edmd):" in s for s in lines)
+
+
+def test_a_failed_case_does_not_stop_the_others_nor_the_analysis(toy, tmp_path, monkeypatch):
+    bad = Study("toy", TOY.title, TOY.reference, TOY.summary,
+                lambda q: [Case("cell-a", "campbell1982/couette-rough", sections=SHORT),
+                           Case("cell-b", "campbell1982/couette-rough", engine="liggghts",
+                                sections=SHORT)],  # LIGGGHTS refuses the servo
+                _toy_analysis)
+    monkeypatch.setattr(sys.modules["demstudy_toy_study"], "STUDY", bad)
+    res = run_study("toy", out=tmp_path, echo=lambda s: None, workers=1)
+    assert res.made == ["cell-a"] and res.failed == ["cell-b"]
+    assert [c.verdict for c in res.analysis.checks] == [REPRODUCED, NOT_RUN]
+    assert "1 failed (cell-b)" in res.report.read_text()
+
+
+def test_publish_copies_the_figures_and_rewrites_their_links(toy, tmp_path):
+    res = run_study("toy", quick=True, out=tmp_path / "study", echo=lambda s: None)
+    docs = tmp_path / "docs"
+    page = publish(res, docs)
+    text = page.read_text()
+    assert page == docs / "studies" / "toy.md"
+    assert "](../figures/studies/toy/toy.png)" in text
+    assert (page.parent / "../figures/studies/toy/toy.png").resolve().is_file()
+
+
+def test_check_verdicts_and_number_formatting():
+    with pytest.raises(ValueError, match="allowed are"):
+        Check("x", "y", "z", "w", "roughly")
+    assert pm(0.57612, 0.0041) == "0.5761 ± 0.0041"
+    assert pm(12.3, 4.0) == "12.3 ± 4.0"
+    assert pm(float("nan")) == "n/a" and pm(3.14159) == "3.14"
+    assert within(1.0, 0.1, 1.15) and not within(1.0, 0.05, 1.15)
+    assert within(1.0, 0.0, 1.1, tolerance=0.11) and not within(1.0, 0.0, 1.2, tolerance=0.11)
+
+
+def test_cli_refuses_an_unknown_study_and_bad_workers_with_exit_2():
+    for args in (["nope"], ["campbell1982", "--workers", "0"]):
+        proc = subprocess.run([sys.executable, "-m", "demstudy", "study", *args],
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2, proc.stderr
+        assert "Traceback" not in proc.stderr
+    assert "campbell1982, malik2008" in subprocess.run(
+        [sys.executable, "-m", "demstudy", "study", "nope"], capture_output=True,
+        text=True, timeout=120).stderr
