@@ -151,10 +151,10 @@ def test_check_verdicts_and_number_formatting():
 
 def test_cli_refuses_an_unknown_study_and_bad_workers_with_exit_2():
     for args in (["nope"], ["campbell1982", "--workers", "0"]):
-        proc = subprocess.run([sys.executable, "-m", "demstudy", "study", *args],
+        proc = subprocess.run([sys.executable, "-m", "demstudy.cli", "study", *args],
                               capture_output=True, text=True, timeout=120)
         assert proc.returncode == 2, proc.stderr
         assert "Traceback" not in proc.stderr
     assert "campbell1982, malik2008" in subprocess.run(
-        [sys.executable, "-m", "demstudy", "study", "nope"], capture_output=True,
+        [sys.executable, "-m", "demstudy.cli", "study", "nope"], capture_output=True,
         text=True, timeout=120).stderr
