@@ -312,7 +312,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
     dask = check_dask_address(args.dask) if args.dask else None
     result = run_study(args.name, quick=args.quick, out=args.out,
-                       workers=args.workers or os.cpu_count() or 1, dask=dask,
+                       workers=args.workers if args.workers is not None else (os.cpu_count() or 1),
+                       dask=dask,
                        dry_run=args.dry_run, analyse_only=args.analyse_only,
                        engines=[e.strip() for e in ",".join(args.engine).split(",")
                                 if e.strip()] if args.engine else None,
