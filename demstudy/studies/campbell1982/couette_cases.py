@@ -50,12 +50,14 @@ def spacing_for(nu: float) -> float:
     return math.sqrt(math.pi / (4.0 * nu))
 
 
-def _run(gap: float, speed: float, eq: float, prod: float) -> dict[str, Any]:
-    """Run section for ``eq``/``prod`` strain units at γ̇ = speed/gap, sampled every 1/12
-    strain unit (the scenes' interval)."""
+def _run(gap: float, speed: float, eq: float, prod: float,
+         per_strain: float = 4.0) -> dict[str, Any]:
+    """Run section for ``eq``/``prod`` strain units at γ̇ = speed/gap, sampled
+    ``per_strain`` times per strain unit (frames are kept: 4 keeps a full run's file small;
+    the quick runs take the scenes' 12)."""
     rate = speed / gap
     return {"equilibration": eq / rate, "production": prod / rate,
-            "sample_interval": 1.0 / (12.0 * rate)}
+            "sample_interval": 1.0 / (per_strain * rate)}
 
 
 def _walls(model: str, eps_w: float, speed: float, servo: dict | None) -> list[dict]:
@@ -84,7 +86,8 @@ def servo_case(name: str, wall: str, factor: float = 1.0, rate: float = 1 / 12,
         "measure": {"statistics": STATISTICS},
     }
     return Case(name, ROUGH if wall == "rough" else NOSLIP, sections=sections, quick=quick,
-                quick_sections={"run": _run(12.0, speed, QUICK_EQ_STRAIN, QUICK_PROD_STRAIN)},
+                quick_sections={"run": _run(12.0, speed, QUICK_EQ_STRAIN, QUICK_PROD_STRAIN,
+                                                    12.0)},
                 group=group, **extra)
 
 
@@ -105,7 +108,7 @@ def fixed_case(name: str, nu: float, wall: str = "noslip", eps: tuple[float, flo
         "measure": {"statistics": STATISTICS},
     }
     return Case(name, NOSLIP, sections=sections, quick=quick,
-                quick_sections={"run": _run(gap, 1.0, QUICK_EQ_STRAIN, QUICK_PROD_STRAIN)},
+                quick_sections={"run": _run(gap, 1.0, QUICK_EQ_STRAIN, QUICK_PROD_STRAIN, 12.0)},
                 group=group, options=options or {})
 
 

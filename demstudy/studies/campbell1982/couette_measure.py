@@ -55,7 +55,9 @@ def block_mean(x: np.ndarray, blocks: int = 10) -> tuple[float, float]:
     if x.size < blocks:
         return (float(x.mean()) if x.size else math.nan), math.nan
     means = np.array([b.mean() for b in np.array_split(x, blocks)])
-    return float(means.mean()), float(means.std(ddof=1) / math.sqrt(blocks))
+    err = float(means.std(ddof=1) / math.sqrt(blocks))
+    # a constant series (fixed gap) leaves round-off only: no error
+    return float(means.mean()), (err if err > 1e-12 * abs(means.mean()) else 0.0)
 
 
 def centre_mean(values: np.ndarray, errors: np.ndarray, mask: np.ndarray) -> tuple[float, float]:
