@@ -33,6 +33,10 @@ PARTITION_NU = (0.45, 0.55, 0.65, 0.75)
 PARTITION = [f"couette-fixed-nu{nu_tag(n)}" for n in PARTITION_NU]
 K6 = ["couette-k6-nu45-elastic", "couette-fixed-nu35"]
 LAMMPS = "couette-k1-rough-servo-s1-lammps"
+#: the candidate-cause cells of the fixed-gap series (larger lattices, rough walls)
+LARGER = "couette-cause-20x8-nu75"
+CAUSE_FIXED = ["couette-cause-20x8-nu55", "couette-cause-20x8-nu75"]
+CAUSE_ROUGH = ["couette-cause-rough-nu55", "couette-cause-rough-nu75"]
 
 
 def cases(quick: bool) -> list[Case]:
@@ -66,7 +70,7 @@ def checks(s: dict[str, RunSummary]) -> list:
         *ck.shear_rate_independence(s, K3, SHEAR_RATES),
         ck.s_order_one(s, trend_names, trend_nu),
         ck.s_trend(s, trend_names, trend_nu),
-        *ck.bagnold_steep(s, trend_names, trend_nu),
+        *ck.bagnold_steep(s, trend_names, trend_nu, LARGER),
         ck.chi_check(s, trend_names, trend_nu),
         ck.rotational_share(s, part_names, part_nu),
         ck.vdf_maxwellian(s, trend_names, trend_nu),
@@ -85,21 +89,27 @@ def _present(s: dict[str, RunSummary], names: list[str], labels: list[str]):
 
 def figures(s: dict[str, RunSummary], out: Path) -> list:
     made = []
-    servo = _present(s, K1, [f"rough, σ_n×{f:g}" for f in SERVO_FACTORS]) + _present(
-        s, K2, [f"no-slip, σ_n×{f:g}" for f in SERVO_FACTORS])
+    k1 = _present(s, K1, [f"rough, σ_n×{f:g}" for f in SERVO_FACTORS])
     if LAMMPS in s:
-        servo.append(("rough, σ_n×1, LAMMPS", s[LAMMPS]))
-    if servo:
-        made.append(figs.profiles(servo, out, "couette-profiles-servo.png",
-                                  "Servo cells: rough walls (K1, Fig 3.15) and no-slip walls "
-                                  "(K2, Fig 3.16) at three normal stresses"))
+        k1.append(("rough, σ_n×1, LAMMPS (soft)", s[LAMMPS]))
+    if k1:
+        made.append(figs.profiles(k1, out, "couette-profiles-k1.png",
+                                  "Servo cells with rough walls at three normal stresses "
+                                  "(K1, Fig 3.15)"))
+    k2 = _present(s, K2, [f"no-slip, σ_n×{f:g}" for f in SERVO_FACTORS])
+    if k2:
+        made.append(figs.profiles(k2, out, "couette-profiles-k2.png",
+                                  "Servo cells with no-slip walls at three normal stresses "
+                                  "(K2, Fig 3.16)"))
     fixed = _present(s, FIXED, [f"ν = {n:g}" for n in FIXED_NU])
     if fixed:
         made.append(figs.profiles(fixed, out, "couette-profiles-fixed.png",
                                   "Fixed-gap cells, no-slip walls, ν = 0.35 … 0.75"))
     groups = {"fixed gap, no-slip": [r for _, r in fixed],
               "servo, rough (K1)": [s[n] for n in K1 if n in s],
-              "servo, no-slip (K2)": [s[n] for n in K2 if n in s]}
+              "servo, no-slip (K2)": [s[n] for n in K2 if n in s],
+              "fixed gap, 20 × 8 (cause)": [s[n] for n in CAUSE_FIXED if n in s],
+              "fixed gap, rough walls (cause)": [s[n] for n in CAUSE_ROUGH if n in s]}
     groups = {k: v for k, v in groups.items() if v}
     if groups:
         made.append(figs.s_of_nu(groups, out))
@@ -150,7 +160,31 @@ def sections(s: dict[str, RunSummary], quick: bool) -> list[tuple[str, str]]:
             "elastic. Dimensionless particle units (d = 1, m = 1, U_T = 1).\n\n" + table)
     out = [("Couette cells: the numbers", text)]
     out.append(("Couette cells: candidate causes", causes(s)))
+    out.append(("Couette cells: the servo in practice", servo_notes(s)))
     return out
+
+
+def servo_notes(s: dict[str, RunSummary]) -> str:
+    """How the servo walls behaved: gap, width/gap (Campbell holds it at its start value,
+    0.4), the lower wall's wander during production."""
+    rows = []
+    for name, r in s.items():
+        if "wall_wander" not in r.values:
+            continue
+        ratio = r.v("width") / r.v("gap")
+        rows.append(f"| {name} | {pm(*r.values['gap'])} | {pm(*r.values['width'])} | "
+                    f"{ratio:.3f} | {r.v('wall_wander'):.2f} |")
+    if not rows:
+        return "No servo run in this run of the study."
+    return "\n".join([
+        "Campbell keeps width/gap at its start value (0.4, L867-869). The event-driven engine "
+        "rescales the width affinely at each servo update but never so far that touching "
+        "discs would overlap (edmd scale_width), so a dense cell that compresses keeps its "
+        "width: width/gap then exceeds 0.4. The lower wall wanders by the amount in the last "
+        "column during production; the profiles of servo cells are therefore taken in "
+        "wall-relative strips (module couette_measure).", "",
+        "| run | gap H | width | width/H | lower-wall wander (max−min) |",
+        "|---|---|---|---|---|", *rows])
 
 
 def causes(s: dict[str, RunSummary]) -> str:
@@ -162,8 +196,10 @@ def causes(s: dict[str, RunSummary]) -> str:
         base = f"couette-fixed-nu{tag}"
         for name, what in ((base, "baseline: no-slip, 10 × 4, t_c = 1e-5"),
                            (f"couette-cause-rough-nu{tag}", "rough walls"),
-                           (f"couette-cause-10x8-nu{tag}", "10 × 8 discs"),
-                           (f"couette-cause-20x8-nu{tag}", "20 × 8 discs"),
+                           (f"couette-cause-10x8-nu{tag}", "10 × 8 discs"
+                            + (", t_c = 1e-4" if nu > 0.7 else "")),
+                           (f"couette-cause-20x8-nu{tag}", "20 × 8 discs"
+                            + (", t_c = 1e-4" if nu > 0.7 else "")),
                            (f"couette-cause-tc0.0001-nu{tag}", "t_c = 1e-4"),
                            (f"couette-cause-tc1e-06-nu{tag}", "t_c = 1e-6")):
             if name in s:
@@ -172,6 +208,16 @@ def causes(s: dict[str, RunSummary]) -> str:
                             f"{pm(*r.values['S_text'])} | {pm(*r.values['f_s'])} | "
                             f"{pm(*r.values['T_mean'])} | {pm(*r.values['layering'])} | "
                             f"{100 * r.attrs['tc_elastic_fraction']:.2f} % |")
+    for name, what in ((K1[1], "baseline: rough walls, servo σ_n×1, t_c = 1e-5"),
+                       ("couette-cause-tc0.0001-rough-servo-s1", "rough servo, t_c = 1e-4"),
+                       ("couette-cause-tc1e-06-rough-servo-s1", "rough servo, t_c = 1e-6")):
+        if name in s:
+            r = s[name]
+            rows.append(f"| servo | {what} | {pm(*r.values['nu'])} (cell "
+                        f"{pm(*r.values['nu_cell'])}) | {pm(*r.values['S_text'])} | "
+                        f"{pm(*r.values['f_s'])} | {pm(*r.values['T_mean'])} | "
+                        f"{pm(*r.values['layering'])} | "
+                        f"{100 * r.attrs['tc_elastic_fraction']:.2f} % |")
     servo = [(n, s[n]) for n in K2 if n in s]
     if not rows and not servo:
         return "The cause runs are not in this run of the study (full study only)."

@@ -136,17 +136,25 @@ def s_order_one(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> Check
 
 def s_trend(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> Check:
     ref, statement = ("Fig 3.40, L1337",
-                      "S(ν): S acts as an order parameter, larger in the denser, more ordered "
-                      "flows (trend with ν)")
+                      "S(ν): S read as an order parameter, rising with ν (the trend of Fig "
+                      "3.40; its values are not in the digest)")
     def body(rs: list[RunSummary]) -> Check:
         pts = [r.values["S_text"] for r in rs]
         verdict, why = trend_verdict(pts)
-        return Check(ref, statement, "trend only (digest gives no values)",
+        if verdict != REPRODUCED:
+            why = (f"{why}: S stays within {pm(min(v for v, _ in pts[:-1]))}-"
+                   f"{pm(max(v for v, _ in pts[:-1]))} up to ν = {nus[-2]:g} and jumps only "
+                   f"in the layered ν = {nus[-1]:g} cell (structure check); the thesis's "
+                   "own trend is inferred from its wording, so this verdict is tentative")
+        return Check(ref, statement, "rising (inferred; no values in the digest)",
                      fmt(pts, [f"ν={n:g}" for n in nus]), verdict, why)
     return guarded(ref, statement, "", runs, names, body)
 
 
-def bagnold_steep(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> list[Check]:
+def bagnold_steep(runs: Runs, names: Sequence[str], nus: Sequence[float],
+                  larger: str | None = None) -> list[Check]:
+    """f_s, f_N rising steeply with ν; ``larger``: a bigger cell at the densest ν (a
+    candidate cause: the 10 × 4 cell there keeps its square start lattice)."""
     out = []
     for key, label in (("f_s", "f_s"), ("f_N", "f_N")):
         ref = "Figs 3.21-3.24, L1155, L1203-1213"
@@ -157,21 +165,28 @@ def bagnold_steep(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> lis
             lst = [r.values[f"{key}_listing"] for r in rs]
             up, sig = increasing(pts)
             steep = pts[-1][0] / pts[0][0]
-            nu_ratio = nus[-1] / nus[0]
             measured = (f"with π (thesis): {fmt(pts, [f'ν={n:g}' for n in nus])}; without π "
                         f"(listing FNU): {fmt(lst, [f'{n:g}' for n in nus])}; "
                         f"f({nus[-1]:g})/f({nus[0]:g}) = {steep:.2g}")
             if sig and steep > 10:
                 return Check(ref, statement, "steep rise (log axis)", measured, REPRODUCED)
-            if up and steep > nu_ratio ** 2:
-                return Check(ref, statement, "steep rise (log axis)", measured, PARTLY,
-                             f"rises by only ×{steep:.2g} over the range; the dense cells "
-                             "order into sliding layers (see the structure check and the "
-                             "causes section)")
-            return Check(ref, statement, "steep rise (log axis)", measured, NOT_REPRODUCED,
-                         f"rises by ×{steep:.2g} only{'' if up else ', not monotonic'}: the "
-                         "dense cells order into sliding layers (structure check; causes "
-                         "section)")
+            if larger in runs and len(pts) > 2:
+                big = runs[larger].values[key]
+                alt = [*pts[:-1], big]
+                _, alt_sig = increasing(alt)
+                alt_steep = big[0] / pts[0][0]
+                measured += (f"; 20 × 8 cell at ν = {nus[-1]:g}: {pm(*big)} "
+                             f"(×{alt_steep:.2g} over the range)")
+                if alt_sig and alt_steep > 10:
+                    return Check(ref, statement, "steep rise (log axis)", measured, PARTLY,
+                                 f"Campbell's 10 × 4 cell at ν = {nus[-1]:g} keeps its square "
+                                 "start lattice, whose rows slide (layering check; ν_s = π/4, "
+                                 "L1093-1097): f drops; a 20 × 8 cell melts and gives the "
+                                 "steep rise (causes section; it needed t_c = 1e-4)")
+            return Check(ref, statement, "steep rise (log axis)", measured,
+                         PARTLY if up else NOT_REPRODUCED,
+                         f"rises by ×{steep:.2g}{'' if up else ', not monotonic'}: the dense "
+                         "10 × 4 cell slides in layers (structure check; causes section)")
         out.append(guarded(ref, statement, "steep rise", runs, names, body))
     return out
 
@@ -314,9 +329,12 @@ def lammps_cross_check(runs: Runs, edmd: str, lammps: str) -> Check:
             good = abs(a[0] - b[0]) <= 2 * math.hypot(a[1], b[1]) + 0.05 * abs(a[0])
             ok &= good
             rows.append(f"{label}: edmd {pm(*a)}, lammps {pm(*b)}")
+        ratios = (h.v("width") / h.v("gap"), s.v("width") / s.v("gap"))
         return Check(ref, statement, "(not in the thesis: a soft-contact check)",
                      "; ".join(rows), REPRODUCED if ok else PARTLY,
-                     "" if ok else "beyond 2σ + 5 %: soft contacts (k_n, Coulomb-capped "
-                     "tangential spring) and the servo's time interval differ from hard "
-                     "rough discs")
+                     "" if ok else "beyond 2σ + 5 %. Candidate causes: width/gap is "
+                     f"{ratios[0]:.2f} in edmd (its width cannot shrink past touching discs) "
+                     f"against {ratios[1]:.2f} in LAMMPS (Campbell: 0.40); edmd's T depends "
+                     "on t_c here (13 % of collisions elastic; causes section); soft contacts "
+                     "(k_n, Coulomb-capped tangential spring) and the servo's time interval")
     return guarded(ref, statement, "", runs, [edmd, lammps], body)

@@ -29,9 +29,9 @@ COLOURS = plt.get_cmap("tab10").colors
 WHICH_S = {"S_text": "S text", "S_listing": "S listing", "S_text_C": "S′"}
 
 
-def _save(fig: plt.Figure, out: Path, name: str, caption: str) -> Figure:
+def _save(fig: plt.Figure, out: Path, name: str, caption: str, bottom: float = 0.05) -> Figure:
     fig.text(0.01, 0.005, FOOTER, fontsize=6.5, wrap=True, va="bottom")
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     path = out / name
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -40,8 +40,9 @@ def _save(fig: plt.Figure, out: Path, name: str, caption: str) -> Figure:
 
 def profiles(runs: Sequence[tuple[str, RunSummary]], out: Path, name: str,
              title: str) -> Figure:
-    """u/U_T and ν against y/H (y/H vertical, Campbell's Figs 3.15-3.16)."""
-    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 4.6), sharey=True)
+    """u/U_T and ν against y/H (y/H vertical, Campbell's Figs 3.15-3.16); the legend sits
+    below the axes, off the data."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 5.4), sharey=True)
     for k, (label, r) in enumerate(runs):
         c = COLOURS[k % 10]
         yh = r.arrays["y_over_h"]
@@ -50,17 +51,24 @@ def profiles(runs: Sequence[tuple[str, RunSummary]], out: Path, name: str,
         b.errorbar(r.arrays["nu"], yh, xerr=2 * r.arrays["nu_err"], fmt="o-", ms=3, color=c)
     a.plot([0, 1], [0, 1], "k:", lw=0.8, label="no slip, uniform shear")
     a.set_xlabel("u / U_T")
-    a.set_ylabel("y / H (H: wall gap)")
+    a.set_ylabel("y / H (H: wall gap; servo cells: strips follow the walls)")
     b.set_xlabel("solid fraction ν")
     a.set_ylim(0, 1)
-    a.legend(fontsize=7, loc="upper left")
-    fig.suptitle(title, fontsize=10)
-    return _save(fig, out, name, title)
+    a.set_xlim(0, 1)
+    fig.legend(*a.get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=7.5,
+               bbox_to_anchor=(0.5, 0.05))
+    fig.suptitle(title + " (±2σ)", fontsize=10)
+    fig.text(0.01, 0.005, FOOTER, fontsize=6.5, wrap=True, va="bottom")
+    fig.tight_layout(rect=(0, 0.17, 1, 1))
+    path = out / name
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Figure(path, title)
 
 
 def s_of_nu(points: dict[str, list[RunSummary]], out: Path) -> Figure:
     """S(ν), both S definitions and the corrected S' (Fig 3.40)."""
-    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 4.2))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(9, 5.6))
     for k, (label, rs) in enumerate(points.items()):
         nu = [r.v("nu") for r in rs]
         for ax, key, mk in ((a, "S_text", "o"), (a, "S_listing", "s"), (b, "S_text_C", "o")):
@@ -72,32 +80,40 @@ def s_of_nu(points: dict[str, list[RunSummary]], out: Path) -> Figure:
     b.set_ylabel("S′ = S (π/ν)^½ (length scale C)")
     for ax in (a, b):
         ax.set_xlabel("solid fraction ν (centre strips)")
-        ax.legend(fontsize=6.5, loc="upper left")
         ax.set_ylim(bottom=0)
-    fig.suptitle("S(ν), Campbell Fig 3.40 (centre strips, ±2σ)", fontsize=10)
+    handles, labels = a.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7,
+               bbox_to_anchor=(0.5, 0.05))
+    fig.suptitle("S(ν), Campbell Fig 3.40 (centre strips, ±2σ; right: S′ of the same runs)",
+                 fontsize=10)
     return _save(fig, out, "couette-S-nu.png", "S(ν) (Fig 3.40): text and listing S, and "
-                 "S′ with the mean spacing as length scale")
+                 "S′ with the mean spacing as length scale", bottom=0.25)
 
 
 def bagnold(points: dict[str, list[RunSummary]], out: Path) -> Figure:
     """f_s, f_N against ν, log axis (Figs 3.21-3.24)."""
-    fig, axes = plt.subplots(1, 2, figsize=(9, 4.2), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(9, 5.6), sharey=True)
     for ax, key in zip(axes, ("f_s", "f_N"), strict=False):
         for k, (label, rs) in enumerate(points.items()):
             nu = [r.v("nu") for r in rs]
             for suffix, mk, fill in (("", "o", True), ("_listing", "s", False)):
-                ax.errorbar(nu, [r.v(key + suffix) for r in rs],
-                            yerr=[2 * r.e(key + suffix) for r in rs], fmt=mk,
+                val = np.array([r.v(key + suffix) for r in rs])
+                err = np.array([2 * r.e(key + suffix) for r in rs])
+                # a log axis cannot show a bar below zero: the lower bar stops at 5 %
+                ax.errorbar(nu, val, yerr=[np.minimum(err, 0.95 * val), err], fmt=mk,
                             color=COLOURS[k], mfc=COLOURS[k] if fill else "none",
                             label=f"{label}{'' if fill else ' (÷π, listing)'}")
         ax.set_yscale("log")
         ax.set_xlabel("solid fraction ν (centre strips)")
         ax.set_title(f"{key}: τ = ρ_p {key} R² (du/dy)²", fontsize=9)
     axes[0].set_ylabel("f (thesis definition; open: listing FNU = f/π)")
-    axes[0].legend(fontsize=6.5, loc="upper left")
-    fig.suptitle("Bagnold coefficients f_s(ν), f_N(ν), Campbell Figs 3.21-3.24", fontsize=10)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=3,
+               fontsize=7, bbox_to_anchor=(0.5, 0.05))
+    fig.suptitle("Bagnold coefficients f_s(ν), f_N(ν), Campbell Figs 3.21-3.24 (±2σ; lower "
+                 "bars stop at 5 % of the value)", fontsize=10)
     return _save(fig, out, "couette-f-nu.png", "f_s(ν) and f_N(ν) on a log axis, with and "
-                 "without the π factor (cubic-spline du/dy, collisional + kinetic stress)")
+                 "without the π factor (cubic-spline du/dy; fixed gap: the engine's "
+                 "collisional + kinetic strip stress; servo: the walls' stress)", bottom=0.22)
 
 
 def partition(rs: Sequence[RunSummary], nus: Sequence[float], out: Path) -> Figure:
@@ -197,7 +213,7 @@ def structure(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:
 
 def shear_rates(rs: Sequence[RunSummary], rates: Sequence[float], out: Path) -> Figure:
     """ν and T(H/U_T)² against Campbell's R/H (Fig 3.17)."""
-    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 3.8))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 4.0))
     rh = [g / 2 for g in rates]
     a.errorbar(rh, [r.v("nu_cell") for r in rs], yerr=[2 * r.e("nu_cell") for r in rs],
                fmt="o-")
@@ -207,7 +223,10 @@ def shear_rates(rs: Sequence[RunSummary], rates: Sequence[float], out: Path) -> 
     b.set_ylabel("T (H/U_T)² = QFL/3, lengths in R")
     for ax in (a, b):
         ax.set_xscale("log")
-        ax.set_xlabel("R/H (Campbell's dimensionless shear rate, U_T = 1)")
+        ax.set_xticks(rh, [f"1/{round(1 / x):d}" for x in rh])
+        ax.minorticks_off()
+        ax.set_xlim(min(rh) / 1.5, max(rh) * 1.5)
+        ax.set_xlabel("R/H: Campbell's shear rate (his units)")
     fig.suptitle("Shear-rate scaling at σ_n = 0.567 (R/H)², no-slip walls, Fig 3.17",
                  fontsize=10)
     return _save(fig, out, "couette-shear-rate.png", "ν and T(H/U_T)² against the shear "

@@ -10,18 +10,28 @@ Everything comes from the package's analyses stored in the results file (``/prof
 ``WALL_SKIP`` diameters from both walls (the wall layers are Campbell's boundary effect);
 their error is the bins' errors propagated as independent, or the scatter of the bins about
 their mean divided by √n when that is larger.
+
+Servo cells: the package's profiles use strips fixed where the walls stood when production
+started, but the servo walls wander by 1-2 d during production, which smears the wall strips
+(an empty strip behind a wall half the time). As Campbell did (strips referred to the lower
+wall and rescaled with the gap, ST = HGT/FND, L3689-3690, L3950), the profiles of servo runs
+are recomputed here from the stored frames in wall-relative coordinates
+y' = (y − y_lower(t)) H̄ / H(t) (:func:`wall_relative_profiles`); their f_s, f_N and χ then
+use the walls' measured stresses (Campbell's Couette stress, integrated from the lower wall's:
+uniform without gravity, L4337-4348), not the engine's strips.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ...analysis import derived as dv
+from ...analysis.profiles import ProfileAnalysis
 from ...io.results import read_results
 
 #: bins closer than this (d) to a wall are left out of the centre averages
@@ -86,23 +96,35 @@ def _production(ts: dict[str, np.ndarray], start: float) -> np.ndarray:
 
 
 def summarise(name: str, path: Path) -> RunSummary:
-    """Read one Couette results file (not its frames nor its collision log)."""
-    res = read_results(path, skip=("frames", "collisions"))
+    """Read one Couette results file (frames only for servo cells)."""
+    res = read_results(path, skip=("collisions",))
     scene = res.scene
+    servo = any(w.servo is not None for w in scene.walls)
     out = RunSummary(name, attrs=dict(res.attrs))
-    ts, prof = res.timeseries, dict(res.profiles)
-    keep = _production(ts, float(res.attrs.get("equilibration_end", 0.0)))
+    ts = res.timeseries
+    start = float(res.attrs.get("equilibration_end", 0.0))
+    keep = _production(ts, start)
     n = _count(res)
     gap = ts.get("gap", np.full(keep.shape, scene.wall_position("upper")))[keep]
     width = ts.get("width", np.full(keep.shape, scene.box.size[0]))[keep]
     speed = ts.get("wall_velocity_upper", np.full(keep.shape, scene.wall("upper").velocity))
     speed = np.asarray(speed, float)[keep]
     out.values["gap"] = block_mean(gap)
+    out.values["width"] = block_mean(width)
     out.values["U_T"] = block_mean(speed)
     out.values["nu_cell"] = block_mean(n * math.pi / 4 / (gap * width))
+    if servo and "wall_position_lower" in ts:
+        out.values["wall_wander"] = (float(np.ptp(ts["wall_position_lower"][keep])), 0.0)
     h, u_t = out.v("gap"), out.v("U_T")
     rate = u_t / h
     out.values["shear_rate_nominal"] = (rate, 0.0)
+    if servo and res.frames:
+        prof, der = _servo_derived(res, scene, start, h, u_t)
+        out.attrs["profiles_from"] = "wall-relative strips from the frames; wall stresses"
+    else:
+        prof = dict(res.profiles)
+        der = res.groups.get("statistics/derived", {})
+        out.attrs["profiles_from"] = "the run's strips; the engine's strip stresses"
     edges = np.asarray(prof["edges"], float)
     y = np.asarray(prof["y"], float)
     lo, hi = edges[0], edges[-1]
@@ -112,7 +134,6 @@ def summarise(name: str, path: Path) -> RunSummary:
                       u_over_ut=np.asarray(prof["velocity"])[:, 0] / u_t,
                       u_err=np.asarray(prof["velocity_err"])[:, 0] / u_t, centre=centre)
     out.values["nu"] = centre_mean(prof["solid_fraction"], prof["solid_fraction_err"], centre)
-    der = res.groups.get("statistics/derived", {})
     for key in ("S_text", "S_listing", "f_s", "f_N", "chi", "chi_theory", "shear_rate",
                 "friction"):
         if key in der:
@@ -132,13 +153,69 @@ def summarise(name: str, path: Path) -> RunSummary:
         if key in der:
             out.values[key] = (float(der[key]) / u_t, float(der[f"{key}_err"]) / u_t)
     _temperatures(out, prof, centre, rate)
-    _distributions(out, res, centre)
+    _distributions(out, res, (float(edges[0]), float(edges[-1])) if not servo else
+                   (float(res.profiles["edges"][0]), float(res.profiles["edges"][-1])))
     out.attrs["tc_elastic_fraction"] = float(res.attrs.get("tc_elastic_fraction", math.nan))
     out.attrs["engine"] = res.attrs.get("engine", "?")
     out.attrs["rows_columns"] = (scene.initial.rows, scene.initial.columns)
     out.attrs["eps"] = (scene.walls[0].restitution, scene.contact.restitution)
     out.attrs["wall_model"] = scene.walls[0].tangential.model
     return out
+
+
+def wall_relative_profiles(res: Any, scene: Any, start: float, gap: float) -> dict:
+    """Profiles over the production frames with y' = (y − y_lower(t)) gap / H(t): strips
+    that follow the servo walls (Campbell's ST = HGT/FND), on [0, gap]."""
+    ts = res.timeseries
+    t = np.asarray(ts["time"], float)
+    lower = np.asarray(ts["wall_position_lower"], float)
+    upper = np.asarray(ts["wall_position_upper"], float)
+    ana = ProfileAnalysis(axis="y", bin_width=scene.measure.bin_width, lo=0.0, hi=gap, dim=2,
+                          inertia_factor=scene.inertia_k)
+    for frame in res.iter_frames(start + 1e-9):
+        lo, hi = np.interp(frame.time, t, lower), np.interp(frame.time, t, upper)
+        pos = np.array(frame.position, float)
+        pos[:, 1] = (pos[:, 1] - lo) * gap / (hi - lo)
+        box_lo, box_hi = np.array(frame.box_lo, float), np.array(frame.box_hi, float)
+        box_lo[1], box_hi[1] = 0.0, gap
+        ana.feed(replace(frame, position=pos, box_lo=box_lo, box_hi=box_hi))
+    ana.finish()
+    return dict(ana.results)
+
+
+def _servo_derived(res: Any, scene: Any, start: float, gap: float,
+                   u_t: float) -> tuple[dict, dict]:
+    """Wall-relative profiles and what derives from them: S, wall slip, and f_s, f_N, χ
+    with the walls' mean stress (τ_xy = −P_xy, τ_yy = P_yy at the walls, averaged)."""
+    prof = wall_relative_profiles(res, scene, start, gap)
+    der: dict[str, Any] = {}
+    rate = dv.shear_rate(prof)
+    der["shear_rate"], der["shear_rate_err"] = rate
+    for variant in ("text", "listing"):
+        der[f"S_{variant}"], der[f"S_{variant}_err"] = dv.s_parameter(prof, variant, rate=rate)
+    stress = res.groups.get("stress", {})
+    walls = [(np.asarray(stress[f"wall_{s}"], float), np.asarray(stress[f"wall_{s}_err"], float))
+             for s in ("lower", "upper") if f"wall_{s}" in stress]
+    if walls:
+        col = np.mean([w[0] for w in walls], axis=0)
+        col_err = np.sqrt(np.sum([w[1] ** 2 for w in walls], axis=0)) / len(walls)
+        txy, tyy = (-col[0], col_err[0]), (col[1], col_err[1])
+        n = prof["y"].size
+        for key, (tau, err) in (("f_s", txy), ("f_N", tyy)):
+            der[key], der[f"{key}_err"] = dv.bagnold_coefficients(
+                np.full(n, tau), rate[0], 2, "campbell", np.full(n, err), rate[1])
+        der["chi"], der["chi_err"] = dv.equation_of_state(prof, np.full(n, tyy[0]),
+                                                          np.full(n, tyy[1]))
+        der["friction"], der["friction_err"] = (np.full(n, txy[0] / tyy[0]),
+                                                np.full(n, 0.0))
+    from demstudy.theory import campbell_chi  # noqa: PLC0415
+
+    nu = np.nan_to_num(np.asarray(prof["solid_fraction"], float))
+    der["chi_theory"] = np.asarray(campbell_chi(nu, 2, scene.contact.restitution), float)
+    for side, wall, speed in (("lower", 0.0, 0.0), ("upper", gap, u_t)):
+        der[f"slip_{side}"], der[f"slip_{side}_err"] = dv.wall_slip(prof, wall, side, speed,
+                                                                    "extrapolate", 2)
+    return prof, der
 
 
 def _count(res: Any) -> int:
@@ -167,11 +244,19 @@ def _temperatures(out: RunSummary, prof: dict, centre: np.ndarray, rate: float) 
     out.values["T_mean"] = (total / 3, total_err / 3)
 
 
-def _distributions(out: RunSummary, res: Any, centre: np.ndarray) -> None:
+def _centre_of(group: dict, walls: tuple[float, float]) -> np.ndarray:
+    """The centre bins of a statistic's own y grid (the vdf's grid spans the scene's initial
+    gap, the profiles' the gap when production started: with the servo they differ)."""
+    y = np.asarray(group["y"], float)
+    return (y - walls[0] >= WALL_SKIP) & (walls[1] - y >= WALL_SKIP)
+
+
+def _distributions(out: RunSummary, res: Any, walls: tuple[float, float]) -> None:
     """The VDF histograms, collision-angle histograms and structure distributions pooled
     over the centre bins (count-weighted)."""
     vdf = res.groups.get("statistics/vdf")
     if vdf is not None and "X" in vdf:
+        centre = _centre_of(vdf, walls)
         count = np.asarray(vdf["count"], float)
         w = np.where(centre, count, 0.0)
         x = np.asarray(vdf["X"], float)
@@ -190,6 +275,7 @@ def _distributions(out: RunSummary, res: Any, centre: np.ndarray) -> None:
                                                          centre & (count > 0))
     ang = res.groups.get("statistics/angles")
     if ang is not None and "p_text" in ang:
+        centre = _centre_of(ang, walls)
         pairs = np.asarray(ang["pair_collisions"], float)
         w = np.where(centre, pairs, 0.0)
         theta = np.asarray(ang["theta"], float)
