@@ -76,6 +76,7 @@ def checks(s: dict[str, RunSummary]) -> list:
         ck.vdf_maxwellian(s, trend_names, trend_nu),
         ck.angles_approach(s, trend_names, trend_nu),
         ck.angles_savage_jeffrey(s, K6, ["ν=0.45, ε=1", "ν=0.35, 0.8/0.6"]),
+        ck.elastic_lower_s(s, K6[0], "couette-fixed-nu45"),
         ck.layering(s, trend_names, trend_nu),
         ck.plug(s, FIXED[-1], FIXED_NU[-1]),
         ck.lammps_cross_check(s, K1[1], LAMMPS),
