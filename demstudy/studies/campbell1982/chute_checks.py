@@ -46,7 +46,7 @@ def needs(*names: str):
 
 def convergence(r: ChuteRun) -> str:
     """The convergence numbers of one run, in words."""
-    return (f"trend {r.trend:+.2f}, {100 * r.within:.0f} % of samples within ±20 %, "
+    return (f"trend {pm(r.trend, r.trend_err)}, {100 * r.within:.0f} % of samples within ±20 %, "
             f"KE/N {pm(r.energy_mean, r.energy_err)}, base ratio {pm(r.ratio, r.ratio_err)} "
             f"(tan α {r.tan_alpha:.3f})")
 
@@ -62,7 +62,8 @@ def why_not_steady(r: ChuteRun) -> str:
         return ""
     parts = []
     if not r.converged:
-        parts.append(f"The energy drifts (trend {r.trend:+.2f}, |trend| ≥ 0.2)")
+        parts.append(f"The energy drifts (trend {pm(r.trend, r.trend_err)}: |trend| ≥ 0.2 "
+                     "beyond 2σ)")
     if not r.balanced:
         parts.append(f"The base ratio {pm(r.ratio, r.ratio_err)} ≠ tan α = {r.tan_alpha:.3f}: "
                      "the bed " + ("accelerates" if r.ratio < r.tan_alpha else "decelerates"))
@@ -180,6 +181,11 @@ def c2_plug(runs: Mapping[str, ChuteRun]) -> Check:
     nu, err = plug[0]
     if nu - 2 * err > NU_SQUARE:
         verdict, reason = REPRODUCED, "Campbell's flat base: ν > π/4 beyond 2σ"
+        if stopped(runs["chute-20-flat"]):
+            ordered = ", denser than ν_m = 0.821 (the densest shearable)" if nu > 0.821 else ""
+            verdict = PARTLY
+            reason += (", but in a bed that comes to rest (next row): the dense centre is the "
+                       f"resting packing{ordered}, not a plug riding on a shearing flow")
     elif nu > NU_SQUARE:
         verdict, reason = PARTLY, "Campbell's flat base: ν > π/4, but by less than 2σ"
     else:
@@ -203,21 +209,32 @@ def c2_converged(runs: Mapping[str, ChuteRun]) -> Check:
             parts.append(f"{r.base} base: {convergence(r)}, KE/N at the end {end:.3g}, "
                          f"TC share {100 * r.tc_share:.0f} %")
     r = runs["chute-20-flat"]
+    if stopped(r):
+        return Check(ref, statement, thesis, "; ".join(parts), NOT_REPRODUCED,
+                     f"flat base: the bed decelerates and comes to rest by t ≈ {rest_time(r):.0f} "
+                     "√(d/g) (energy < 1 % of the initial for good; on the bumps sooner): "
+                     "steady only as a static packing (base ratio = tan α by static friction), "
+                     "not a flow. A resting hard-disc bed is held by the TC model's elastic "
+                     "micro-bounces (share → 100 %). Campbell's 'converged' 20° run was "
+                     "plausibly a slow deceleration judged by its energy history")
     if r.steady:
         return Check(ref, statement, thesis, "; ".join(parts), REPRODUCED, "flat base")
-    reason = "flat base. " + why_not_steady(r)
-    if stopped(r):
-        reason += (". The bed decelerates and comes to rest, a resting plug (on the bumps "
-                   "sooner): a resting hard-disc bed is held by the TC model's elastic "
-                   "micro-bounces (share → 100 %). Campbell's 'converged' 20° run was plausibly "
-                   "a slow deceleration judged by its energy history")
-    return Check(ref, statement, thesis, "; ".join(parts), steady_verdict(r), reason)
+    return Check(ref, statement, thesis, "; ".join(parts), steady_verdict(r),
+                 "flat base. " + why_not_steady(r))
 
 
 def stopped(r: ChuteRun) -> bool:
     """The bed came to rest: the last 5 % of the samples hold < 1 % of the initial energy."""
     end = float(np.mean(r.energy[-max(1, r.energy.size // 20):]))
     return end < 0.01 * float(r.energy[0])
+
+
+def rest_time(r: ChuteRun) -> float:
+    """The time after which the energy stays below 1 % of the initial (NaN: never)."""
+    above = np.flatnonzero(r.energy >= 0.01 * float(r.energy[0]))
+    if above.size == 0:
+        return float(r.t[0])
+    return float(r.t[above[-1] + 1]) if above[-1] + 1 < r.t.size else float("nan")
 
 
 def c3_accelerates(runs: Mapping[str, ChuteRun]) -> Check:
@@ -310,18 +327,42 @@ series of Fig 3.11) | converged"""
                  (BUMPY_NOTE + ". " + why_not_steady(r)).strip(". "))
 
 
-def _same(a: ChuteRun, b: ChuteRun) -> tuple[bool, str]:
-    """Whether b differs from a by at most 2σ or 10 % in u_max, H and KE/N, and the text."""
+#: the reference 30° bumpy chute and its other seeds (initial state and bump heights)
+SEED_RUNS = ("chute-30-bumpy", "chute-30-bumpy-seed2", "chute-30-bumpy-seed3")
+COMPARED = (("u_max", "u_max", "u_max_err"), ("KE/N", "energy_mean", "energy_err"),
+            ("H", "depth", None))
+
+
+def seed_spread(runs: Mapping[str, ChuteRun]) -> dict[str, float]:
+    """Standard deviation of u_max, KE/N and H over the seeds of the 30° bumpy chute (0 with
+    fewer than two seeds): how much two realisations of the same 40-disc flow differ."""
+    present = [runs[n] for n in SEED_RUNS if n in runs]
+    if len(present) < 2:
+        return {key: 0.0 for _, key, _ in COMPARED}
+    return {key: float(np.std([getattr(r, key) for r in present], ddof=1))
+            for _, key, _ in COMPARED}
+
+
+def _same(a: ChuteRun, b: ChuteRun, spread: Mapping[str, float]) -> tuple[bool, str]:
+    """Whether b differs from a by at most 2σ or 10 % in u_max, KE/N and H, and the text; σ
+    combines the two runs' block errors, or the seed-to-seed spread × √2 when larger."""
     out, ok = [], True
-    for what, x, xe, y, ye in (("u_max", a.u_max, a.u_max_err, b.u_max, b.u_max_err),
-                               ("KE/N", a.energy_mean, a.energy_err, b.energy_mean,
-                                b.energy_err),
-                               ("H", a.depth, 0.0, b.depth, 0.0)):
-        rel = (y - x) / x
-        same = within(y, math.hypot(xe, ye), x, 2, SAME * abs(x))
+    for what, key, err_key in COMPARED:
+        x, y = getattr(a, key), getattr(b, key)
+        xe = getattr(a, err_key) if err_key else 0.0
+        ye = getattr(b, err_key) if err_key else 0.0
+        err = max(math.hypot(xe, ye), math.sqrt(2) * spread.get(key, 0.0))
+        same = within(y, err, x, 2, SAME * abs(x))
         ok &= same
-        out.append(f"{what} {pm(y, ye)} ({100 * rel:+.0f} %)")
+        out.append(f"{what} {pm(y, ye)} ({100 * (y - x) / x:+.0f} %)")
     return ok, ", ".join(out)
+
+
+def _spread_text(spread: Mapping[str, float]) -> str:
+    if not any(spread.values()):
+        return "no seed spread (seed runs missing)"
+    return ("seed spread (sd of 3 seeds): " + ", ".join(
+        f"{what} {spread[key]:.2g}" for what, key, _ in COMPARED))
 
 
 def _little_effect(runs: Mapping[str, ChuteRun], ref: str, statement: str, thesis: str,
@@ -329,17 +370,17 @@ def _little_effect(runs: Mapping[str, ChuteRun], ref: str, statement: str, thesi
     if "chute-30-bumpy" not in runs or any(n not in runs for n in names):
         return missing(ref, statement, thesis,
                        [n for n in ("chute-30-bumpy", *names) if n not in runs])
-    a = runs["chute-30-bumpy"]
+    a, spread = runs["chute-30-bumpy"], seed_spread(runs)
     texts, oks = [f"reference {a.label}: u_max {pm(a.u_max, a.u_max_err)}, KE/N "
                   f"{pm(a.energy_mean, a.energy_err)}, H {a.depth:.2f}"], []
     for n in names:
-        ok, text = _same(a, runs[n])
+        ok, text = _same(a, runs[n], spread)
         oks.append(ok)
         texts.append(f"{runs[n].label}: {text}" + ("" if runs[n].steady else " (unsteady)"))
     verdict = REPRODUCED if all(oks) else PARTLY if any(oks) else NOT_REPRODUCED
     return Check(ref, statement, thesis, "; ".join(texts), verdict,
                  base + f"; 'little' = within 2σ or {100 * SAME:.0f} % in u_max, KE/N and H"
-                 + ("" if all(oks) else ": exceeded"))
+                 + ("" if all(oks) else ": exceeded") + "; " + _spread_text(spread))
 
 
 def c6_wall_restitution(runs: Mapping[str, ChuteRun]) -> Check:
@@ -378,14 +419,16 @@ def tc_independence(runs: Mapping[str, ChuteRun]) -> Check:
     texts = [f"t_c {r.tc:g}: TC share {100 * r.tc_share:.1f} %, u_max {pm(r.u_max, r.u_max_err)}"
              f", KE/N {pm(r.energy_mean, r.energy_err)}, H {r.depth:.2f}, ratio "
              f"{pm(r.ratio, r.ratio_err)}" for r in (runs[n] for n in names)]
-    same = [_same(a, runs[n])[0] for n in names if n != "chute-30-bumpy"]
+    spread = seed_spread(runs)
+    same = [_same(a, runs[n], spread)[0] for n in names if n != "chute-30-bumpy"]
     small = a.tc_share < 0.05
     verdict = REPRODUCED if all(same) and small else PARTLY if all(same) or small \
         else NOT_REPRODUCED
     reason = ("independent within 2σ or 10 %" if all(same) else
               "t_c changes the flow beyond 2σ and 10 %") + (
         f"; share at the default {100 * a.tc_share:.1f} % " +
-        ("< 5 %" if small else "≥ 5 % (the engine's warning level)"))
+        ("< 5 %" if small else "≥ 5 % (the engine's warning level)")) + "; " + \
+        _spread_text(spread)
     return Check(ref, statement, thesis, "; ".join(texts), verdict, reason)
 
 
@@ -396,7 +439,8 @@ def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
     if "chute-30-bumpy-lammps" not in runs or "chute-30-bumpy" not in runs:
         return missing(ref, statement, thesis, ["chute-30-bumpy-lammps"])
     a, b = runs["chute-30-bumpy"], runs["chute-30-bumpy-lammps"]
-    ok, text = _same(a, b)
+    spread = seed_spread(runs)
+    ok, text = _same(a, b, spread)
     slip_ok = within(b.slip, math.hypot(a.slip_err, b.slip_err), a.slip, 2, 0.05)
     text += (f", slip {pm(b.slip, b.slip_err)} (hard {pm(a.slip, a.slip_err)}), base ratio "
              f"{pm(b.ratio, b.ratio_err)}; trend {b.trend:+.2f}")
@@ -404,7 +448,8 @@ def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
         else NOT_REPRODUCED
     return Check(ref, statement, thesis, text, verdict,
                  "bumpy base; LAMMPS run 800 + 600 √(d/g) (hard: 800 + 1600)"
-                 + ("" if verdict == REPRODUCED else ": differences beyond 2σ and 10 %"))
+                 + ("" if verdict == REPRODUCED else ": differences beyond 2σ and 10 %")
+                 + "; " + _spread_text(spread))
 
 
 def all_checks(runs: Mapping[str, ChuteRun], quick: bool) -> list[Check]:

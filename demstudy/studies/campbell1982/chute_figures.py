@@ -244,8 +244,9 @@ def tc_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
     profile_panels(axes[:2], runs, labels, what=("u", "nu"))
     for i, r in enumerate(runs):
         axes[2].plot(r.t, r.energy, color=_colour(i), lw=0.7, label=labels[i])
-    axes[2].set(xlabel="t [√(d/g)]", ylabel="kinetic energy per disc [m g d]",
-                title="energy history")
+    axes[2].axvline(runs[0].start, color="k", ls=":", lw=1)
+    axes[2].set(xlabel="t [√(d/g)]  (dotted: end of equilibration)",
+                ylabel="kinetic energy per disc [m g d]", title="energy history")
     tcs = [r.tc for r in runs]
     axes[3].plot(tcs, [100 * r.tc_share for r in runs], "ko-")
     axes[3].set(xscale="log", xlabel="t_c [√(d/g)]", ylabel="TC-elastic pair collisions [%]",
@@ -269,4 +270,5 @@ def series_figure(series: Sequence[tuple[str, Sequence[ChuteRun], Sequence[str]]
         axes[0, j].set_title(f"{title}: u/u_max", fontsize=9)
         axes[1, j].set_title(f"{title}: ν", fontsize=9)
         axes[0, j].legend(fontsize=7, loc="upper left")
-    return _finish(fig, path, "Bumpy base (random bumps, diameter d, spacing 1.2 d).")
+    return _finish(fig, path, "Bumpy base (random bumps, diameter d, spacing 1.2 d). Dotted: "
+                   "ν = π/4. (steady): no energy trend beyond 2σ and base ratio = tan α.")
