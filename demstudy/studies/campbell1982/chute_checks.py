@@ -67,7 +67,7 @@ def why_not_steady(r: ChuteRun) -> str:
     if not r.balanced:
         parts.append(f"The base ratio {pm(r.ratio, r.ratio_err)} ≠ tan α = {r.tan_alpha:.3f}: "
                      "the bed " + ("accelerates" if r.ratio < r.tan_alpha else "decelerates"))
-    return "; ".join(parts)
+    return ". ".join(parts)
 
 
 @needs("chute-30-bumpy")
@@ -88,7 +88,7 @@ def c1_flat(runs: Mapping[str, ChuteRun]) -> Check:
     ref = "C1 on Campbell's base; digest §1.2 (WALLCL F.1), H10"
     statement = "the 30° chute converges on Campbell's flat base with sticking contacts"
     thesis = "converged"
-    names = [f"chute-{a}-flat" for a in (22, 26, 30)]
+    names = [f"chute-{a}-flat" for a in (24, 26, 30)]
     if "chute-30-flat" not in runs:
         return missing(ref, statement, thesis, ["chute-30-flat"])
     flat = [runs[n] for n in names if n in runs]
@@ -109,11 +109,23 @@ def c1_flat(runs: Mapping[str, ChuteRun]) -> Check:
                  "transient that passes his energy criterion. Hence the bumpy base elsewhere")
 
 
+def c1_slip(runs: Mapping[str, ChuteRun]) -> Check:
+    check = _c1_slip(runs)
+    others = [runs[n] for n in SEED_RUNS[1:] if n in runs]
+    if others and check.verdict != NOT_RUN:
+        check.reason += ("; other seeds: " + ", ".join(f"{pm(r.slip, r.slip_err)}"
+                                                      for r in others))
+        if not all(within(r.slip, r.slip_err, SLIP_THESIS, 2, SLIP_TOL) for r in others):
+            check.verdict = PARTLY
+            check.reason += " (outside the tolerance: the slip depends on the bump heights)"
+    return check
+
+
 @needs("chute-30-bumpy")
-def c1_slip(r: ChuteRun) -> Check:
+def _c1_slip(r: ChuteRun) -> Check:
     """C1; §1.2 COL007 (L4800-4828), L625 | wall slip: the thesis's velocity-profile fit F(y/H) \
 has u(0)/u_max = 0.20 | 0.20"""
-    ref, statement, thesis = c1_slip.__doc__.split(" | ")
+    ref, statement, thesis = _c1_slip.__doc__.split(" | ")
     ok = within(r.slip, r.slip_err, SLIP_THESIS, 2, SLIP_TOL)
     return Check(ref, statement, thesis,
                  f"bumpy base: u(0 < y < 1)/u_max = {pm(r.slip, r.slip_err)} "
@@ -259,7 +271,7 @@ def c3_basal_layer(runs: Mapping[str, ChuteRun]) -> Check:
     thesis = "low-density basal layer"
     if "chute-40-flat" not in runs:
         return missing(ref, statement, thesis, ["chute-40-flat"])
-    parts, ok = [], []
+    parts, ok, met = [], [], []
     for name in ("chute-40-flat", "chute-40-bumpy", "chute-30-bumpy"):
         if name in runs:
             r = runs[name]
@@ -267,11 +279,12 @@ def c3_basal_layer(runs: Mapping[str, ChuteRun]) -> Check:
             parts.append(f"{name}: ν(1 < y < 2) {pm(nu, err)}, bed's ν max {top:.2f}")
             if name.startswith("chute-40"):
                 ok.append(nu + 2 * err < 0.5 * top)
+                met.append(f"{r.base} base {'met' if ok[-1] else 'not met beyond 2σ'} "
+                           f"({nu:.2f} vs {0.5 * top:.2f})")
     verdict = REPRODUCED if all(ok) else PARTLY if any(ok) else NOT_REPRODUCED
     return Check(ref, statement, thesis, "; ".join(parts), verdict,
-                 "criterion: the basal strip below half the bed's densest (the steady 30° "
-                 "bumpy bed for contrast)" + ("" if verdict == REPRODUCED else
-                                               "; not met on every base"))
+                 "criterion: the strip 1 < y < 2 below half the bed's densest, by 2σ (the "
+                 "steady 30° bumpy bed for contrast): " + ", ".join(met))
 
 
 def _series_steady(runs: Mapping[str, ChuteRun], names: Sequence[str], ref: str,
@@ -283,6 +296,12 @@ def _series_steady(runs: Mapping[str, ChuteRun], names: Sequence[str], ref: str,
     steady = [r.steady for r in present]
     verdict = REPRODUCED if all(steady) else PARTLY if any(steady) else NOT_REPRODUCED
     reasons = [f"{r.name}: {why_not_steady(r)}" for r in present if not r.steady]
+    loud = [r for r in present if r.steady and r.within < 0.5]
+    if loud and verdict == REPRODUCED:
+        verdict = PARTLY
+    reasons += [f"{r.name}: no trend beyond 2σ and ratio = tan α, but only "
+                f"{100 * r.within:.0f} % of the samples inside ±20 % (the energy wanders "
+                "by a factor of several)" for r in loud]
     return Check(ref, statement, thesis, text, verdict, "; ".join([base, *reasons]))
 
 
@@ -307,9 +326,13 @@ def _unsteady(runs: Mapping[str, ChuteRun], name: str, ref: str, statement: str,
 
 
 def c4_shallow_constant(runs: Mapping[str, ChuteRun]) -> Check:
-    return _unsteady(runs, "chute-30-bumpy-5x4", "C4; L1073-1077, H10",
-                     "the 5 × 4 bed at 30° with constant ε accelerates (too few collisions)",
-                     "accelerated", "bumpy base, ε_p 0.6 (10 × 4 converges there)")
+    check = _unsteady(runs, "chute-30-bumpy-5x4", "C4; L1073-1077, H10",
+                      "the 5 × 4 bed at 30° with constant ε accelerates (too few collisions)",
+                      "accelerated", "bumpy base, ε_p 0.6 (10 × 4 converges there)")
+    if check.verdict == NOT_REPRODUCED:
+        check.reason += ("; on Campbell's flat base every 30° bed accelerates (row 'flat "
+                         "base'), 10 × 4 too: his observation fits the base, not the depth")
+    return check
 
 
 def c5_ep08(runs: Mapping[str, ChuteRun]) -> Check:
@@ -343,19 +366,28 @@ def seed_spread(runs: Mapping[str, ChuteRun]) -> dict[str, float]:
             for _, key, _ in COMPARED}
 
 
-def _same(a: ChuteRun, b: ChuteRun, spread: Mapping[str, float]) -> tuple[bool, str]:
-    """Whether b differs from a by at most 2σ or 10 % in u_max, KE/N and H, and the text; σ
-    combines the two runs' block errors, or the seed-to-seed spread × √2 when larger."""
-    out, ok = [], True
+def _same(a: ChuteRun, b: ChuteRun, spread: Mapping[str, float]) -> tuple[int, str]:
+    """How closely b matches a in u_max, KE/N and H, and the text: 2 = every difference within
+    2σ of the two runs' block errors or 10 %; 1 = within 2σ only with σ raised to √2 × the
+    seed-to-seed spread (another realisation of the same flow differs that much); 0 = not."""
+    out, level = [], 2
     for what, key, err_key in COMPARED:
         x, y = getattr(a, key), getattr(b, key)
         xe = getattr(a, err_key) if err_key else 0.0
         ye = getattr(b, err_key) if err_key else 0.0
-        err = max(math.hypot(xe, ye), math.sqrt(2) * spread.get(key, 0.0))
-        same = within(y, err, x, 2, SAME * abs(x))
-        ok &= same
+        block = math.hypot(xe, ye)
+        seeds = max(block, math.sqrt(2) * spread.get(key, 0.0))
+        if not within(y, block, x, 2, SAME * abs(x)):
+            level = min(level, 1 if within(y, seeds, x, 2, SAME * abs(x)) else 0)
         out.append(f"{what} {pm(y, ye)} ({100 * (y - x) / x:+.0f} %)")
-    return ok, ", ".join(out)
+    return level, ", ".join(out)
+
+
+VERDICT_OF_LEVEL = {2: REPRODUCED, 1: PARTLY, 0: NOT_REPRODUCED}
+LEVEL_TEXT = {2: "within 2σ or 10 %",
+              1: "beyond the block errors and 10 %, within the seed-to-seed spread only (the "
+                 "40-disc flow on 4 random bumps has realisations differing by ×2 in u_max)",
+              0: "beyond the seed-to-seed spread"}
 
 
 def _spread_text(spread: Mapping[str, float]) -> str:
@@ -374,13 +406,13 @@ def _little_effect(runs: Mapping[str, ChuteRun], ref: str, statement: str, thesi
     texts, oks = [f"reference {a.label}: u_max {pm(a.u_max, a.u_max_err)}, KE/N "
                   f"{pm(a.energy_mean, a.energy_err)}, H {a.depth:.2f}"], []
     for n in names:
-        ok, text = _same(a, runs[n], spread)
-        oks.append(ok)
+        level, text = _same(a, runs[n], spread)
+        oks.append(level)
         texts.append(f"{runs[n].label}: {text}" + ("" if runs[n].steady else " (unsteady)"))
-    verdict = REPRODUCED if all(oks) else PARTLY if any(oks) else NOT_REPRODUCED
-    return Check(ref, statement, thesis, "; ".join(texts), verdict,
-                 base + f"; 'little' = within 2σ or {100 * SAME:.0f} % in u_max, KE/N and H"
-                 + ("" if all(oks) else ": exceeded") + "; " + _spread_text(spread))
+    level = min(oks)
+    return Check(ref, statement, thesis, "; ".join(texts), VERDICT_OF_LEVEL[level],
+                 base + f"; 'little' = within 2σ or {100 * SAME:.0f} % in u_max, KE/N and H: "
+                 + LEVEL_TEXT[level] + "; " + _spread_text(spread))
 
 
 def c6_wall_restitution(runs: Mapping[str, ChuteRun]) -> Check:
@@ -403,8 +435,10 @@ def c7_c8(runs: Mapping[str, ChuteRun], name: str, ref: str, statement: str) -> 
     return Check(ref, statement, "converged profile (compared with experiments)",
                  convergence(r), steady_verdict(r),
                  ("bumpy base. " + why_not_steady(r)).strip(". ")
-                 + ("" if r.steady else " (on Campbell's flat base a 40° bed accelerates "
-                                        "too: row C3)"))
+                 + ("" if r.steady else ". The bumps pass less than tan 40° of the weight "
+                                        "(a rougher base might hold it; not tried); on "
+                                        "Campbell's flat base a 40° bed accelerates too "
+                                        "(row C3)"))
 
 
 def tc_independence(runs: Mapping[str, ChuteRun]) -> Check:
@@ -420,12 +454,11 @@ def tc_independence(runs: Mapping[str, ChuteRun]) -> Check:
              f", KE/N {pm(r.energy_mean, r.energy_err)}, H {r.depth:.2f}, ratio "
              f"{pm(r.ratio, r.ratio_err)}" for r in (runs[n] for n in names)]
     spread = seed_spread(runs)
-    same = [_same(a, runs[n], spread)[0] for n in names if n != "chute-30-bumpy"]
+    level = min(_same(a, runs[n], spread)[0] for n in names if n != "chute-30-bumpy")
     small = a.tc_share < 0.05
-    verdict = REPRODUCED if all(same) and small else PARTLY if all(same) or small \
+    verdict = REPRODUCED if level == 2 and small else PARTLY if level or small \
         else NOT_REPRODUCED
-    reason = ("independent within 2σ or 10 %" if all(same) else
-              "t_c changes the flow beyond 2σ and 10 %") + (
+    reason = ("the flow against t_c: " + LEVEL_TEXT[level]) + (
         f"; share at the default {100 * a.tc_share:.1f} % " +
         ("< 5 %" if small else "≥ 5 % (the engine's warning level)")) + "; " + \
         _spread_text(spread)
@@ -440,7 +473,8 @@ def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
         return missing(ref, statement, thesis, ["chute-30-bumpy-lammps"])
     a, b = runs["chute-30-bumpy"], runs["chute-30-bumpy-lammps"]
     spread = seed_spread(runs)
-    ok, text = _same(a, b, spread)
+    level, text = _same(a, b, spread)
+    ok = level == 2
     slip_ok = within(b.slip, math.hypot(a.slip_err, b.slip_err), a.slip, 2, 0.05)
     text += (f", slip {pm(b.slip, b.slip_err)} (hard {pm(a.slip, a.slip_err)}), base ratio "
              f"{pm(b.ratio, b.ratio_err)}; trend {b.trend:+.2f}")
@@ -448,7 +482,7 @@ def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
         else NOT_REPRODUCED
     return Check(ref, statement, thesis, text, verdict,
                  "bumpy base; LAMMPS run 800 + 600 √(d/g) (hard: 800 + 1600)"
-                 + ("" if verdict == REPRODUCED else ": differences beyond 2σ and 10 %")
+                 + ("" if verdict == REPRODUCED else ": " + LEVEL_TEXT[level])
                  + "; " + _spread_text(spread))
 
 

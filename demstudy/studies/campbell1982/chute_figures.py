@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..base import pm
 from .chute_measure import SURFACE_NU, ChuteRun
 
 FOOTER = ("Campbell's chute, hard discs (event-driven, t_c = 1e-5 unless stated) unless "
@@ -105,7 +106,8 @@ def energy_history(runs: dict[str, ChuteRun], main: str, path: Path) -> Path | N
                     label=f"±20 % (Campbell's band); {100 * r.within:.0f} % of samples inside")
         ax1.axvspan(0, r.start, color="C1", alpha=0.08, label="equilibration (not averaged)")
         ax1.set(xlabel="t [√(d/g)]", ylabel="kinetic energy per disc [m g d]",
-                title=f"Fig 2.4 form: {r.name}, trend {r.trend:+.2f} (converged: |trend| < 0.2)",
+                title=f"Fig 2.4 form: {r.name}, trend {pm(r.trend, r.trend_err)} "
+                      "(converged: |trend| < 0.2 within 2σ)",
                 ylim=(0, 2.2 * m))
         ax1.legend(fontsize=8, loc="upper right")
     for i, r in enumerate(runs.values()):

@@ -127,6 +127,7 @@ class ChuteRun:
     slip_err: float
     tc_share: float
     wall_seconds: float
+    seed: int = 12345
     profiles: dict[str, np.ndarray] = field(default_factory=dict)
     stress: dict[str, Any] = field(default_factory=dict)
 
@@ -248,7 +249,7 @@ def summarise(name: str, path: str | Path) -> ChuteRun:
         u_max=u_max, u_max_err=u_max_err, slip=float(slip), slip_err=float(slip_err),
         tc_share=float(res.attrs.get("tc_elastic_fraction", np.nan)),
         wall_seconds=float(res.attrs.get("wall_seconds", np.nan)),
-        profiles=prof, stress=_stress(res, prof, g),
+        seed=int(scene.run.seed), profiles=prof, stress=_stress(res, prof, g),
     )
 
 

@@ -61,7 +61,7 @@ def _figures(runs: Mapping[str, ChuteRun], out: Path) -> list[Figure]:
                          out / "chute_plug_20.png"),
         "Fig 3.14 form: the 20° bed, ν and u/u_max against y/H (π/4 and ν_m marked), and its "
         "energy: it stops.")
-    flat = _pick(runs, ["chute-22-flat", "chute-26-flat", "chute-30-flat"])
+    flat = _pick(runs, ["chute-24-flat", "chute-26-flat", "chute-30-flat"])
     add(figs.flat_scan_figure(flat, runs.get("chute-30-bumpy"), out / "chute_flat_base.png"),
         "Why the bumpy base: on Campbell's flat sticking base the force ratio stays ≈ 0.5 in "
         "the dense phase; the 30° bed accelerates; the bumps give tan 30°.")
@@ -77,13 +77,14 @@ def _figures(runs: Mapping[str, ChuteRun], out: Path) -> list[Figure]:
                                      "chute-30-bumpy-ew1"])),
         ("width, soft discs", _pick(runs, ["chute-30-bumpy", "chute-30-bumpy-10x8",
                                            "chute-30-bumpy-lammps"])),
-        ("40° shallow beds", _pick(runs, ["chute-40-bumpy", "chute-40-bumpy-5x4",
-                                          "chute-40-bumpy-4x4-var"])),
+        ("seeds (bump heights)", _pick(runs, ["chute-30-bumpy", "chute-30-bumpy-seed2",
+                                              "chute-30-bumpy-seed3"])),
     ]
     add(figs.series_figure([(t, rs, [_short(r) for r in rs]) for t, rs in series
                             if len(rs) > 1], out / "chute_series.png"),
-        "The series against y/H: depth (variable ε), ε_p and ε_w, width and soft discs, the "
-        "shallow 40° beds (bumpy base).")
+        "The series against y/H: depth (variable ε), ε_p and ε_w, width and soft discs, seeds "
+        "(bumpy base). The shallow 40° beds (C7, C8) accelerate into a dilute spray: no "
+        "profile to show.")
     return made
 
 
@@ -91,7 +92,8 @@ def _short(r: ChuteRun) -> str:
     law = "var ε" if r.law != "constant" else f"ε_p {r.e_p:g}"
     steady = "steady" if r.steady else "unsteady"
     engine = ", LAMMPS" if r.engine == "lammps" else ""
-    return f"{r.rows}×{r.columns}, {law}, ε_w {r.e_w:g}{engine} ({steady})"
+    seed = "" if r.seed == 12345 else f", seed {r.seed}"
+    return f"{r.rows}×{r.columns}, {law}, ε_w {r.e_w:g}{engine}{seed} ({steady})"
 
 
 def _table(runs: Mapping[str, ChuteRun]) -> str:
@@ -103,8 +105,9 @@ def _table(runs: Mapping[str, ChuteRun]) -> str:
         law = "var" if r.law != "constant" else f"{r.e_p:g}"
         rows.append(
             f"| {r.name} | {r.angle:g}° | {r.base} | {r.rows}×{r.columns} | {law} / {r.e_w:g} | "
-            f"{r.engine}{'' if r.tc is None else f' t_c {r.tc:g}'} | {r.start:g}-{r.t[-1]:g} | "
-            f"{pm(r.energy_mean, r.energy_err)} | {r.trend:+.2f} | {100 * r.within:.0f} % | "
+            f"{r.engine}{'' if r.tc is None else f' t_c {r.tc:g}'} | {r.start:.0f}-{r.t[-1]:.0f} | "
+            f"{pm(r.energy_mean, r.energy_err)} | {pm(r.trend, r.trend_err)} | "
+            f"{100 * r.within:.0f} % | "
             f"{pm(r.ratio, r.ratio_err)} | {r.tan_alpha:.3f} | {pm(r.u_max, r.u_max_err)} | "
             f"{pm(r.slip, r.slip_err)} | {r.depth:.2f} | {np.nanmax(r.profiles['nu']):.2f} | "
             f"{'—' if not np.isfinite(r.tc_share) else f'{100 * r.tc_share:.1f} %'} | "
@@ -119,13 +122,17 @@ says LAMMPS. Campbell's definitions: H = 2 × the mass-mean centre height above 
 u_max the fastest strip of the bed (ν ≥ 0.05); slip = u of the strip 0 < y < 1 over u_max;
 kinetic energy per disc = translation + rotation with the mean flow. **Convergence**: Campbell's
 criterion (§2.5), the fitted change of the energy over the production window below 20 % of its
-mean (`demstudy.analysis.steady`), with the share of samples inside ±20 % reported; **and** the
-steady momentum balance, base force ratio |F_x/F_y| = tan α within 2σ + 0.01. Errors: block
-jackknife over the production window (1σ in the table).
+mean (`demstudy.analysis.steady`) within 2σ (σ from the scatter of 8 block means about the
+line: the energy of 40 discs wanders by ±30 % over hundreds of √(d/g) even when the momentum
+balance holds), with the share of samples inside ±20 % reported; **and** the steady momentum
+balance, base force ratio |F_x/F_y| = tan α within 2σ + 0.01. Errors: block jackknife over the
+production window (1σ in the table). "Little effect" / "insignificant": within 2σ or 10 %, σ
+at least √2 × the spread of three seeds of the 30° bumpy chute (seeds change the initial state
+and the random bump heights).
 
 **Which base.** Campbell's flat base with sticking contacts does not give a steady dense 30°
 flow: its basal discs roll and a dense bed passes at most ≈ 0.5 of its weight as shear, so a
-dense steady flow exists only up to ≈ 25° (rows chute-22/26/30-flat: the dense-phase ratio at
+dense steady flow exists only up to ≈ 25° (rows chute-24/26/30-flat: the dense-phase ratio at
 t = 25-200 against tan α, and docs/studies/campbell1982-chute30.md); at 30° the bed accelerates
 for ~1000 √(d/g) into a levitated state over a hot dilute basal layer. Random bumps of
 diameter d at spacing 1.2 d let the base push back with normal impulses: the 30° bed is steady
