@@ -136,6 +136,32 @@ has u(0)/u_max = 0.20 | 0.20"""
                         "slips more (37-55 %), the bumps' geometry sets the slip"))
 
 
+#: the velocity-profile fit: tolerance of a polynomial fitted to a profile the thesis does not
+#: show (which run it came from is not stated)
+FIT_TOL = 0.1
+
+
+@needs("chute-30-bumpy")
+def c1_profile(r: ChuteRun) -> Check:
+    """C1; §1.2 COL007 (L4800-4828), Fig 3.1 | the velocity profile: Campbell's initial state is \
+'a least squares fit to a velocity profile', F(y/H) (20 % slip, F(0.5) = 0.78) | F(y/H)"""
+    from ...scene.initial import CAMPBELL_CHUTE_FIT
+
+    ref, statement, thesis = c1_profile.__doc__.split(" | ")
+    p = r.profiles
+    bed = (np.nan_to_num(p["nu"]) >= 0.3) & (p["y"] / r.depth <= 1.0)
+    z = p["y"][bed] / r.depth
+    dev = p["u"][bed] / r.u_max - np.polyval(CAMPBELL_CHUTE_FIT[::-1], z)
+    err = p["u_err"][bed] / r.u_max
+    ok = bool(np.all(np.abs(dev) <= 2 * err + FIT_TOL))
+    return Check(ref, statement, thesis,
+                 f"bumpy base, strips with ν ≥ 0.3: u/u_max − F(y/H) from {dev.min():+.3f} to "
+                 f"{dev.max():+.3f} (rms {np.sqrt(np.mean(dev ** 2)):.3f}; 1σ of u/u_max ≤ "
+                 f"{err.max():.3f})", REPRODUCED if ok else PARTLY,
+                 f"bumpy base; tolerance ±{FIT_TOL} + 2σ (the fitted run is not named)"
+                 + ("" if ok else ": some strips lie outside"))
+
+
 @needs("chute-30-bumpy")
 def c1_stresses(r: ChuteRun) -> Check:
     """§4 stresses (L1195-1213, L2852-2856) | the momentum-balance stresses (integrated from \
@@ -489,7 +515,8 @@ def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
 
 def all_checks(runs: Mapping[str, ChuteRun], quick: bool) -> list[Check]:
     """Every chute check, in the catalogue's order."""
-    checks = [c1_converged(runs), c1_flat(runs), c1_slip(runs), c1_stresses(runs),
+    checks = [c1_converged(runs), c1_flat(runs), c1_slip(runs), c1_profile(runs),
+              c1_stresses(runs),
               c2_plug(runs), c2_converged(runs), c3_accelerates(runs), c3_basal_layer(runs),
               c4_depths(runs), c4_shallow_constant(runs), c5_ep08(runs), c5_ep01(runs),
               c6_wall_restitution(runs),

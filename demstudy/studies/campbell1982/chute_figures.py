@@ -57,8 +57,9 @@ def _bed(run: ChuteRun) -> np.ndarray:
 
 
 def profile_panels(axes: Sequence, runs: Sequence[ChuteRun], labels: Sequence[str],
-                   what: Sequence[str] = ("u", "nu", "T", "T_rot")) -> None:
-    """Campbell's profile forms against y/H (vertical): u/u_max, ν, T, T_rot."""
+                   what: Sequence[str] = ("u", "nu", "T", "T_rot"), fit: bool = False) -> None:
+    """Campbell's profile forms against y/H (vertical): u/u_max, ν, T, T_rot; ``fit``: overlay
+    the thesis's velocity-profile fit F(y/H) (COL007, digest §1.2) on u/u_max."""
     titles = {"u": ("u / u_max", "mean velocity"), "nu": ("ν", "solid fraction"),
               "T": ("T [g d]", "translational temperature (⟨u'²⟩+⟨v'²⟩)/2"),
               "T_rot": ("T_rot [g d]", "rotational temperature β⟨w'²⟩")}
@@ -70,6 +71,12 @@ def profile_panels(axes: Sequence, runs: Sequence[ChuteRun], labels: Sequence[st
                 value, err = value / run.u_max, err / abs(run.u_max)
             ax.errorbar(value, p["y"][sel] / run.depth, xerr=err, fmt="o-", ms=3, lw=1,
                         capsize=2, color=_colour(i), label=label)
+        if key == "u" and fit:
+            from ...scene.initial import CAMPBELL_CHUTE_FIT
+
+            z = np.linspace(0.0, 1.0, 101)
+            ax.plot(np.polyval(CAMPBELL_CHUTE_FIT[::-1], z), z, "k--", lw=1.2,
+                    label="Campbell's profile fit F(y/H) (COL007)")
         if key == "nu":
             ax.axvline(NU_SQUARE, color="k", ls=":", lw=1, label="π/4 (square packing)")
         if key in ("T", "T_rot") and any(np.nanmax(r.profiles[key]) > 0 for r in runs):
@@ -126,7 +133,7 @@ def profiles_figure(runs: Sequence[ChuteRun], labels: Sequence[str], path: Path,
         return None
     plt = _plt()
     fig, axes = plt.subplots(1, 4, figsize=(15, 5.8), sharey=True)
-    profile_panels(axes, runs, labels)
+    profile_panels(axes, runs, labels, fit=True)
     fig.suptitle(title, fontsize=10)
     legend_below(fig, axes)
     fig.tight_layout()
