@@ -1,0 +1,121 @@
+"""The chutes part of ``demstudy study campbell1982``: its cases (unique names, the quick
+subset, scenes that validate, the base each statement is tested on) and its analysis on real
+short runs (an accelerating bed is judged unsteady, the momentum balance closes at the base,
+the verdict logic, "not run" for missing runs).
+
+Dimensionless particle units: d = 1, m = 1, g = 1.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import demstudy as ds
+from demstudy.studies import get_study
+from demstudy.studies.base import NOT_REPRODUCED, NOT_RUN, REPRODUCED
+from demstudy.studies.campbell1982 import chutes
+from demstudy.studies.campbell1982.chute_checks import all_checks, c1_converged, c3_accelerates
+from demstudy.studies.campbell1982.chute_measure import summarise
+
+QUICK = {"chute-20-flat", "chute-30-bumpy", "chute-40-flat"}
+#: groups whose statement is about a steady flow: tested on the bumpy base
+STEADY_GROUPS = {"C1", "C4", "C6", "C7", "C8", "width", "tc", "soft"}
+
+
+def test_case_names_are_unique_and_the_quick_subset_is_the_angle_series():
+    full = chutes.cases(False)
+    names = [c.name for c in full]
+    assert len(set(names)) == len(names)
+    assert all("chute" in n for n in names)  # `--only chute` selects them all
+    quick = chutes.cases(True)
+    assert {c.name for c in quick} == QUICK
+    assert all(c.quick for c in quick)
+    study = [c.name for c in get_study("campbell1982").cases(False)]
+    assert len(set(study)) == len(study)  # unique across the whole study too
+
+
+def test_every_scene_validates_and_quick_runs_are_shorter():
+    for case in chutes.cases(False):
+        scene = case.load(False)
+        assert scene.gravity.angle in (20.0, 24.0, 26.0, 30.0, 40.0)
+        assert "stress" in scene.measure.statistics
+        if case.quick:
+            q = case.load(True)
+            assert (q.run.equilibration + q.run.production
+                    < scene.run.equilibration + scene.run.production)
+
+
+def test_each_statement_uses_the_base_the_study_says():
+    by_name = {c.name: c for c in chutes.cases(False)}
+    for case in by_name.values():
+        base = case.load(False).wall("lower").kind
+        if case.group in STEADY_GROUPS:
+            assert base == "bumpy", case.name
+        if case.name.endswith("-flat"):
+            assert base == "flat", case.name
+    depth = [by_name[f"chute-30-bumpy-{n}x4-var"].load(False) for n in (5, 10, 13)]
+    assert [s.initial.rows for s in depth] == [5, 10, 13]
+    assert all(s.contact.law.model == "campbell-exp" for s in depth)
+    wide = by_name["chute-30-bumpy-10x8"].load(False)
+    assert wide.n_particles == 80 and wide.box.size[0] == pytest.approx(9.6)
+    assert by_name["chute-30-bumpy-tc1e-6"].options == {"tc": 1e-6}
+    assert by_name["chute-30-bumpy-ew1"].load(False).wall("lower").restitution == 1.0
+    assert by_name["chute-30-bumpy-lammps"].engine == "lammps"
+
+
+@pytest.fixture(scope="module")
+def accelerating(tmp_path_factory):
+    """Campbell's 40° chute on his flat base, 40 √(d/g): the bed accelerates."""
+    path = tmp_path_factory.mktemp("chute") / "chute-40-flat.h5"
+    scene = ds.load_scene("campbell1982/chute-40", run={"equilibration": 5.0,
+                                                        "production": 35.0},
+                          measure={"statistics": ["profiles", "stress"]})
+    ds.run(scene, engine="edmd", out=path, progress=False)
+    return path
+
+
+def test_an_accelerating_bed_is_judged_unsteady(accelerating):
+    run = summarise("chute-40-flat", accelerating)
+    assert run.trend > 0.2 and not run.converged and not run.steady
+    assert run.ratio < run.tan_alpha  # the base cannot hold tan 40° of the weight
+    assert c3_accelerates({"chute-40-flat": run}).verdict == REPRODUCED
+
+
+def test_the_momentum_balance_closes_at_the_base(accelerating):
+    run = summarise("chute-40-flat", accelerating)
+    s, n = run.stress, 40
+    width = 4.8
+    # the mean normal force of the base carries the weight's normal part, N g cos α / W
+    weight = n * math.cos(math.radians(40.0)) / width
+    assert s["wall_tau_yy"] == pytest.approx(weight, abs=3 * s["wall_tau_yy_err"] + 0.02 * weight)
+    # integrated from the free surface with the unsteady term, the balance meets the wall
+    for comp in ("tau_xy", "tau_yy"):
+        err = math.hypot(s[f"wall_{comp}_err"], s[f"base_balance_{comp}_err"])
+        assert abs(s[f"base_balance_{comp}"] - s[f"wall_{comp}"]) <= 3 * err + 0.02 * weight
+    # depth: twice the mass-mean height lies inside the bed's extent
+    assert 0.5 * run.depth < np.max(run.profiles["y"][run.profiles["nu"] > 0.3]) + 1.0
+
+
+def test_the_verdict_follows_both_tests(accelerating):
+    run = summarise("chute-40-flat", accelerating)
+    steady = dataclasses.replace(run, angle=30.0, trend=0.05, ratio=math.tan(math.radians(30)),
+                                 ratio_err=0.003)
+    assert steady.steady
+    assert c1_converged({"chute-30-bumpy": steady}).verdict == REPRODUCED
+    drifting = dataclasses.replace(steady, trend=0.6, ratio=0.50)
+    assert c1_converged({"chute-30-bumpy": drifting}).verdict == NOT_REPRODUCED
+
+
+def test_missing_runs_give_not_run_checks(accelerating, tmp_path):
+    empty = chutes.analyse({}, tmp_path, quick=False)
+    assert empty.checks and all(c.verdict == NOT_RUN for c in empty.checks)
+    assert empty.figures == []
+    some = chutes.analyse({"chute-40-flat": accelerating}, tmp_path, quick=True)
+    run = [c for c in some.checks if c.verdict != NOT_RUN]
+    assert run and all(c.ref.startswith("C3") for c in run)
+    assert all(f.path.is_file() for f in some.figures)
+    assert len(all_checks({}, False)) == len(empty.checks)
