@@ -43,7 +43,8 @@ def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "")
         f"Generated {_dt.date.today().isoformat()} on {machine}: {len(result.made)} runs made, "
         f"{len(result.reused)} reused, {len(result.failed)} failed"
         + (f" ({', '.join(result.failed)})" if result.failed else "")
-        + f"; {result.wall_seconds / 60:.1f} min in all"
+        + f"; the runs took {result.run_seconds / 60:.1f} min of engine time in all"
+        + f" (this invocation {result.wall_seconds / 60:.1f} min)"
         + (f" (forecast {result.forecast_seconds / 60:.1f} min)"
            if result.forecast_seconds else "") + ".",
         "",

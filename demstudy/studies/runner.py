@@ -64,6 +64,9 @@ class StudyRun:
     reused: list[str] = field(default_factory=list)
     failed: list[str] = field(default_factory=list)
     wall_seconds: float = 0.0
+    #: the runs' own wall times summed (the results files' ``wall_seconds``): the study's
+    #: compute cost, whether its runs were made now or reused
+    run_seconds: float = 0.0
 
 
 def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None = None,
@@ -181,12 +184,24 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     elif dry_run:
         return result
     runs = {t.case.name: t.path for t in tasks if t.path.is_file()}
+    result.run_seconds = sum(_run_seconds(p) for p in runs.values())
     out.mkdir(parents=True, exist_ok=True)
     result.analysis = study.analyse(runs, out, quick)
     result.wall_seconds = time.perf_counter() - started
     result.report = write_report(result, quick)
     echo(f"report: {result.report}")
     return result
+
+
+def _run_seconds(path: Path) -> float:
+    """A results file's ``wall_seconds`` (0 when unreadable: it is then redone anyway)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return float(f.attrs.get("wall_seconds", 0.0))
+    except (OSError, ValueError):
+        return 0.0
 
 
 def _cost_of(lines: list[str], task: StudyTask) -> float:
