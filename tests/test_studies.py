@@ -158,3 +158,24 @@ def test_cli_refuses_an_unknown_study_and_bad_workers_with_exit_2():
     assert "campbell1982, malik2008" in subprocess.run(
         [sys.executable, "-m", "demstudy.cli", "study", "nope"], capture_output=True,
         text=True, timeout=120).stderr
+
+
+def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
+    """A study's runs checkpoint (10 per run); a run stopped midway (here by a wall-clock
+    limit) is continued from its checkpoint by the next ``run_study``, not started again."""
+    from demstudy.errors import RunStopped
+    from demstudy.studies.runner import tasks_of
+
+    task = next(t for t in tasks_of(TOY, False, tmp_path) if t.case.name == "cell-a")
+    assert task.spec.checkpoint_interval == pytest.approx(1.5)  # (5 + 10)/10 time units
+    assert "resume" not in task.spec.options()
+    with pytest.raises(RunStopped):
+        ds.run(task.scene(), engine="edmd", out=task.path, wall_limit=1e-9,
+               checkpoint_interval=task.spec.checkpoint_interval, progress=False)
+    assert not task.path.exists()
+    assert task.spec.options()["resume"] is True
+    res = run_study("toy", out=tmp_path, echo=lambda s: None)
+    assert "cell-a" in res.made
+    done = ds.load(task.path)
+    times = done.timeseries["time"]
+    assert times[-1] == pytest.approx(15.0, abs=1.0)  # the whole run, equilibration + production

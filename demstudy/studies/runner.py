@@ -15,7 +15,7 @@ import platform
 import shutil
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -23,17 +23,43 @@ from ..errors import BadOption, EngineError
 from .base import Analysis, Case, Study
 
 
+#: a study's run checkpoints this many times over its length (an interrupted study loses at
+#: most this fraction of a run: a rerun resumes from the checkpoint)
+CHECKPOINTS_PER_RUN = 10
+
+
 @dataclass(frozen=True)
 class _Spec:
-    """What ``demstudy.accuracy.execute`` needs of a run's settings (duck-typed RunSpec)."""
+    """What ``demstudy.accuracy.execute`` needs of a run's settings (duck-typed RunSpec):
+    ``options()`` are the keywords of ``ds.run`` — the engine options, the checkpoint
+    interval and, when the run's work folder holds a checkpoint, ``resume``."""
 
     name: str
     engine: str
     engine_options: tuple[tuple[str, Any], ...] = ()
     relative_cost: float = 1.0
+    out: str = ""
+    checkpoint_interval: float | None = None
 
     def options(self) -> dict:
-        return dict(self.engine_options)
+        from ..simulation.checkpoint import CHECKPOINT
+        from ..simulation.options import work_folder
+
+        options = dict(self.engine_options)
+        if self.checkpoint_interval:
+            options["checkpoint_interval"] = self.checkpoint_interval
+            if self.out and (work_folder(Path(self.out), self.engine) / CHECKPOINT).is_file():
+                options["resume"] = True  # an interrupted study continues the run
+        return options
+
+
+def checkpoint_interval(scene) -> float | None:
+    """Checkpoints ``CHECKPOINTS_PER_RUN`` times per run, in the run's own unit (time or
+    collisions per particle), never more often than it samples."""
+    run = scene.run
+    length = run.equilibration + run.production
+    interval = max(length / CHECKPOINTS_PER_RUN, run.sample_interval)
+    return interval if math.isfinite(interval) and interval > 0 else None
 
 
 @dataclass(frozen=True)
@@ -86,9 +112,11 @@ def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None
     tasks = []
     for case in cases:
         scene = case.load(quick)
-        tasks.append(StudyTask(case, quick, out / "runs" / f"{case.name}.h5",
+        path = out / "runs" / f"{case.name}.h5"
+        tasks.append(StudyTask(case, quick, path,
                                _Spec(case.name, case.engine,
-                                     tuple(sorted(case.options.items()))),
+                                     tuple(sorted(case.options.items())), out=str(path),
+                                     checkpoint_interval=checkpoint_interval(scene)),
                                scene_to_toml(scene)))
     return tasks
 
@@ -169,8 +197,8 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         if dry_run:
             return result
         todo = [StudyTask(t.case, t.quick, t.path,
-                          _Spec(t.spec.name, t.spec.engine, t.spec.engine_options,
-                                _cost_of(lines, t)), t.scene_toml) for t in todo]
+                          replace(t.spec, relative_cost=_cost_of(lines, t)), t.scene_toml)
+                for t in todo]
 
         def finished(record: dict) -> None:
             result.made.append(record["name"])
