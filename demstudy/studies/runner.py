@@ -22,7 +22,6 @@ from typing import Any
 from ..errors import BadOption, EngineError
 from .base import Analysis, Case, Study
 
-
 #: a study's run checkpoints this many times over its length (an interrupted study loses at
 #: most this fraction of a run: a rerun resumes from the checkpoint)
 CHECKPOINTS_PER_RUN = 10
