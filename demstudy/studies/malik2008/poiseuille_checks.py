@@ -275,16 +275,21 @@ def vdf_checks(data: Runs) -> list[Check]:
             continue
         rows, cores, tails = [], True, False
         for d in ds:
+            skew = d.stat("vdf")["skewness"]
             for k in bins:
                 dev, kur, ker = vdf_shape(d, k - 1)
                 cores &= dev <= 0.1
                 tails |= bool(np.any(np.abs(kur - 3) > 2 * ker))
                 rows.append(f"{_tag(d)} bin {k}: core dev {100 * dev:.0f} %, kurtosis "
-                            + "/".join(pm(a, b, 1) for a, b in zip(kur, ker, strict=True)))
+                            + "/".join(pm(a, b, 1) for a, b in zip(kur, ker, strict=True))
+                            + f", skewness C_x {skew[k - 1, 0]:.2f}")
         verdict = REPRODUCED if cores and tails else PARTLY if (cores or tails) \
             else NOT_REPRODUCED
         reason = "" if verdict == REPRODUCED else (
-            ("core departs from the Gaussian by > 10 % beyond 2σ; " if not cores else "")
+            ("the core departs from the Gaussian by > 10 % beyond 2σ in some bins: C_x is "
+             "skewed (the streamwise VDF is asymmetric, its peak displaced from the mean: "
+             "slow particles from the walls), which the P(0) = 1 scaling turns into a core "
+             "deviation; " if not cores else "")
             + ("kurtosis consistent with 3 (Gaussian tails) " if not tails else ""))
         out.append(Check(ref, statement, "Gaussian core; tails deviate",
                          "; ".join(rows) + " (kurtosis of C_x/C_y/C_z)",
@@ -342,25 +347,25 @@ def lambda_checks(data: Runs) -> list[Check]:
         if not ds:
             out.append(_not_run(ref, statement, "Λ ≠ 1/3", f"φ = {phi:g} runs"))
             continue
-        rows, rough_dev, n_rough = [], 0, 0
+        rows, departs = [], []
         for d in ds:
             m, em = lambda_mean(d)
             lam = d.stat("lambda")
             c, ec = lam["lambda"][CENTRE_BIN - 1], lam["lambda_err"][CENTRE_BIN - 1]
-            dev = abs(m - 1 / 3) > 2 * em
-            if d.flow.beta > -0.5:
-                n_rough += 1
-                rough_dev += dev
+            if abs(m - 1 / 3) > 2 * em:
+                departs.append(d)
             rows.append(f"{_tag(d)}: mean {pm(m, em)}, centre {pm(c, ec)}")
         trend = _lambda_trend(ds)
-        verdict = REPRODUCED if n_rough and rough_dev == n_rough else \
-            PARTLY if rough_dev else NOT_REPRODUCED
+        verdict = REPRODUCED if len(departs) == len(ds) else PARTLY if departs \
+            else NOT_REPRODUCED
+        near = ", ".join(_tag(d) for d in ds if d not in departs)
         out.append(Check(ref, statement, "Λ ≠ 1/3 for rough inelastic spheres (Brilliantov "
                                          "et al. 2007; direction of the trends: digest silent)",
                          "; ".join(rows) + (f". Trend: {trend}" if trend else ""),
-                         verdict, "" if verdict == REPRODUCED else
-                         f"Λ departs from 1/3 beyond 2σ in {rough_dev} of {n_rough} rough "
-                         "(β ≥ 0) runs"))
+                         _cap(verdict, ds[0]) if phi == 0.5 else verdict,
+                         ("" if verdict == REPRODUCED else
+                          f"Λ̄ consistent with 1/3 (2σ) for {near}")
+                         + (_steady_note(ds[0]) if phi == 0.5 else "")))
     return out
 
 
