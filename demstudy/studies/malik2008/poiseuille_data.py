@@ -113,8 +113,9 @@ def load_flow(flow: Flow, path: Path, with_gr: bool = True) -> FlowData:
     """The run of ``flow`` at ``path`` (``with_gr``: compute the in-bin g(r) from frames)."""
     res = read_results(path, skip=("frames", "collisions"))
     data = FlowData(flow, Path(path), res)
-    if with_gr:
-        data.gr = in_bin_gr(Path(path), res.profiles["edges"])
+    if with_gr:  # dilute: wider shells (g ≈ 1 is flat, the counts are few)
+        data.gr = in_bin_gr(Path(path), res.profiles["edges"],
+                            dr=0.1 if flow.phi < 0.05 else 0.05)
     return data
 
 

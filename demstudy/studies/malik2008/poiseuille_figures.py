@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 
 from ...plots.common import LINESTYLES, MARKERS, Run, finish, new_figure, run_colour, save
 from .poiseuille_data import FlowData
@@ -172,11 +173,14 @@ def vcorr_figure(series: Sequence[Series], title: str, out: Path) -> Path:
 def lambda_figure(panels: Sequence[tuple[str, Sequence[FlowData]]], title: str,
                   out: Path) -> Path:
     """Λ(y) horizontal, y vertical, one panel per β with its runs over e, the molecular
-    value 1/3, and an inset of Λ at the centre (bin 13) and the bin mean against e."""
-    fig, axes = new_figure(1, len(panels), width=3.6, height=4.2)
+    value 1/3; below each, the thesis's inset as its own panel (so that it covers no data):
+    Λ at the centre (bin 13) and the bin mean against e."""
+    fig, axes = new_figure(2, len(panels), width=3.6, height=3.0,
+                           gridspec_kw={"height_ratios": [2.2, 1]})
     every = [d for _t, datas in panels for d in datas]
     colours = {id(d): run_colour(i) for i, d in enumerate(every)}
-    for ax, (name, datas) in zip(axes.flat, panels, strict=True):
+    for k, (name, datas) in enumerate(panels):
+        ax = axes[0, k]
         for d in datas:
             lam = d.stat("lambda")
             if "lambda" not in lam:
@@ -184,11 +188,12 @@ def lambda_figure(panels: Sequence[tuple[str, Sequence[FlowData]]], title: str,
             ax.errorbar(lam["lambda"], lam["y"], xerr=lam["lambda_err"], color=colours[id(d)],
                         marker="o", ms=3, lw=1, elinewidth=0.6)
         ax.axvline(1 / 3, color="saddlebrown", lw=1.2)
-        ax.set_xlabel("Λ = <cos²Ψ> (molecular 1/3)")
+        ax.xaxis.set_major_locator(MaxNLocator(4))
+        ax.set_xlabel("Λ = <cos²Ψ> (brown: molecular 1/3)")
         ax.set_ylabel("y/d")
         ax.set_ylim(0, 50)
         ax.set_title(name, fontsize=9)
-        _lambda_inset(ax, datas)
+        _lambda_inset(axes[1, k], datas)
     labels = [f"φ = {d.flow.phi:g}, β = {d.flow.beta:g}, e = {d.flow.e:g}" for d in every]
     finish(fig, _runs(every), title,
            legend=_legend(labels, [colours[id(d)] for d in every]))
@@ -196,19 +201,23 @@ def lambda_figure(panels: Sequence[tuple[str, Sequence[FlowData]]], title: str,
 
 
 def _lambda_inset(ax, datas: Sequence[FlowData]) -> None:
-    good = [d for d in datas if "lambda" in d.stat("lambda")]
-    if len(good) < 2:
-        return
-    inset = ax.inset_axes((0.58, 0.06, 0.38, 0.3))
+    """Λ at the centre (bin 13) and the mean over the bins against e, with errors."""
+    from .poiseuille_checks import lambda_mean
+
+    good = sorted((d for d in datas if "lambda" in d.stat("lambda")), key=lambda d: d.flow.e)
     e = [d.flow.e for d in good]
-    centre = [d.stat("lambda")["lambda"][12] for d in good]
-    mean = [float(np.nanmean(d.stat("lambda")["lambda"])) for d in good]
-    inset.plot(e, centre, "ko-", ms=2, lw=0.8, label="Λ(centre)")
-    inset.plot(e, mean, "s--", color="0.5", ms=2, lw=0.8, label="mean Λ")
-    inset.axhline(1 / 3, color="saddlebrown", lw=0.8)
-    inset.set_xlabel("e", fontsize=6, labelpad=0)
-    inset.tick_params(labelsize=5)
-    inset.legend(fontsize=4, loc="upper left", frameon=False)
+    centre = [(d.stat("lambda")["lambda"][12], d.stat("lambda")["lambda_err"][12])
+              for d in good]
+    mean = [lambda_mean(d) for d in good]
+    if good:
+        ax.errorbar(e, [c[0] for c in centre], yerr=[c[1] for c in centre], fmt="ko-", ms=3,
+                    lw=0.8, capsize=2, label="Λ(centre, bin 13)")
+        ax.errorbar(e, [m[0] for m in mean], yerr=[m[1] for m in mean], fmt="s--",
+                    color="0.5", ms=3, lw=0.8, capsize=2, label="mean Λ over y")
+        ax.legend(fontsize=6, frameon=False)
+    ax.axhline(1 / 3, color="saddlebrown", lw=0.8)
+    ax.set_xlabel("e")
+    ax.set_ylabel("Λ")
 
 
 def wall_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: str,
