@@ -84,8 +84,7 @@ def make_figures(data: Runs, out: Path, quick: bool) -> list[Figure]:
         at_phi = _of(data, phi)
         if at_phi:
             figs.append(Figure(
-                trace_figure(at_phi, [_label(d) for d in at_phi],
-                             f"Malik Figs 3.2d/4.1c/4.15b: kinetic energy vs collisions, "
+                trace_figure(at_phi, f"Malik Figs 3.2d/4.1c/4.15b: kinetic energy vs collisions, "
                              f"φ = {phi:g}{tag}", out / f"poiseuille-trace-phi{phi:g}.png"),
                 f"Kinetic energy per particle against collisions per particle, φ = {phi:g}; "
                 "the bar marks the start of averaging (Figs 3.2d, 4.1c, 4.15b)."))

@@ -63,24 +63,29 @@ def profiles_figure(datas: Sequence[FlowData], labels: Sequence[str], title: str
     return save(fig, out)
 
 
-def trace_figure(datas: Sequence[FlowData], labels: Sequence[str], title: str,
-                 out: Path) -> Path:
+def trace_figure(datas: Sequence[FlowData], title: str, out: Path) -> Path:
     """Kinetic energy per particle (translational, mean flow included) against collisions
-    per particle (2 N_pp/N), the start of production marked (Malik's Figs 3.2d, 4.15b)."""
-    fig, axes = new_figure(1, 1, width=6.5, height=3.8)
-    ax = axes[0, 0]
-    colours = [run_colour(i) for i in range(len(datas))]
-    for i, d in enumerate(datas):
-        ts, n = d.res.timeseries, d.res.scene.particles.count
-        c = 2.0 * ts["collisions"] / n
-        ax.plot(np.maximum(c, 1e-2), ts["kinetic_energy"] / n, color=colours[i], lw=1)
-        t0 = float(d.res.attrs.get("equilibration_end", 0.0))
-        k = min(int(np.searchsorted(ts["time"], t0)), c.size - 1)
-        ax.plot(max(c[k], 1e-2), ts["kinetic_energy"][k] / n, "|", color=colours[i], ms=14)
-    ax.set_xscale("log")
-    ax.set_xlabel("collisions per particle (2 N_pp / N); | = start of averaging")
-    ax.set_ylabel("kinetic energy per particle E/N (m g d)")
-    finish(fig, _runs(datas), title, legend=_legend(labels, colours))
+    per particle (2 N_pp/N), the start of production marked (Malik's Figs 3.2d, 4.15b): one
+    panel per β, one colour per e."""
+    betas = sorted({d.flow.beta for d in datas})
+    es = sorted({d.flow.e for d in datas})
+    fig, axes = new_figure(1, len(betas), width=4.2, height=3.6, sharey=True)
+    for ax, beta in zip(axes.flat, betas, strict=True):
+        for d in (d for d in datas if d.flow.beta == beta):
+            colour = run_colour(es.index(d.flow.e))
+            ts, n = d.res.timeseries, d.res.scene.particles.count
+            c = np.maximum(2.0 * ts["collisions"] / n, 1e-2)
+            ax.plot(c, ts["kinetic_energy"] / n, color=colour, lw=1)
+            t0 = float(d.res.attrs.get("equilibration_end", 0.0))
+            k = min(int(np.searchsorted(ts["time"], t0)), c.size - 1)
+            ax.plot(c[k], ts["kinetic_energy"][k] / n, "|", color=colour, ms=14, mew=2)
+        ax.set_xscale("log")
+        ax.set_title(f"φ = {datas[0].flow.phi:g}, β = {beta:g}", fontsize=9)
+        ax.set_xlabel("collisions per particle (2 N_pp/N)")
+    axes[0, 0].set_ylabel("kinetic energy per particle E/N (m g d)")
+    finish(fig, _runs(datas), title + " (| = start of averaging)",
+           legend=_legend([f"e = {e:g}" for e in es],
+                          [run_colour(i) for i in range(len(es))]))
     return save(fig, out)
 
 
@@ -178,7 +183,9 @@ def lambda_figure(panels: Sequence[tuple[str, Sequence[FlowData]]], title: str,
     fig, axes = new_figure(2, len(panels), width=3.6, height=3.0,
                            gridspec_kw={"height_ratios": [2.2, 1]})
     every = [d for _t, datas in panels for d in datas]
-    colours = {id(d): run_colour(i) for i, d in enumerate(every)}
+    # one colour per e (each panel is one β, so a run is its panel and its colour)
+    es = sorted({d.flow.e for d in every})
+    colours = {id(d): run_colour(es.index(d.flow.e)) for d in every}
     for k, (name, datas) in enumerate(panels):
         ax = axes[0, k]
         for d in datas:
@@ -194,9 +201,9 @@ def lambda_figure(panels: Sequence[tuple[str, Sequence[FlowData]]], title: str,
         ax.set_ylim(0, 50)
         ax.set_title(name, fontsize=9)
         _lambda_inset(axes[1, k], datas)
-    labels = [f"φ = {d.flow.phi:g}, β = {d.flow.beta:g}, e = {d.flow.e:g}" for d in every]
     finish(fig, _runs(every), title,
-           legend=_legend(labels, [colours[id(d)] for d in every]))
+           legend=_legend([f"e = {e:g} (panels: β)" for e in es],
+                          [run_colour(i) for i in range(len(es))]))
     return save(fig, out)
 
 
