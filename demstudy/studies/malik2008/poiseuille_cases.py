@@ -36,6 +36,9 @@ BIN_WIDTH = 2.0  # 25 bins across W = 50 (Malik's default, §4.1)
 #: core-minutes for 13+ runs). φ = 0.5: the quick run showed the dense core's collision rate
 #: rising to ≳ 250 per particle per √(d/g) by t = 12 (≈ 20 s of CPU per √(d/g)), so the scene's
 #: 1300 would take hours: 40 + 10 is what fits, and the analysis says whether it is steady.
+#: Measured on 2026-12-02 (2 shared cores): the φ = 0.5 run had not finished after 11.5
+#: CPU-minutes, nor φ = 0.1 (e = 0.7, β = 0.99 and 0) after 6.2 and 5.1 (forecast 1.2): they
+#: were stopped at the study's CPU budget; the dense collision rate is the open cost.
 RUN = {0.01: {"sample_interval": 4.0},
        0.1: {"equilibration": 200.0, "production": 300.0, "sample_interval": 5.0},
        0.5: {"equilibration": 40.0, "production": 10.0, "sample_interval": 1.0}}
