@@ -1,0 +1,465 @@
+"""The checks of the Poiseuille part: one per statement of the digest (§3.5 validation, §2.3
+β = 0 most dissipative, §4.4 Kn and the transitional regime, §4.6 VDFs, §4.7 g(r), §4.8 Λ,
+§6 dense core and plug, Fig 4.5 S-wave), each with the measured value ± its statistical error
+(block jackknife of the analyses), a verdict and its reason.
+
+Thresholds where the thesis gives only words (its statements are qualitative; the digest
+quotes no numbers): "considerable" slip = at least 20 % of the centre velocity; "nearly
+uniform" = every interior bin within 20 % of the mean φ; a "Gaussian core" = P within 10 % of
+exp(-x²/2) for |x| ≤ 1 (beyond 2σ); "extremely low" Kn = below 0.01. They are stated in each
+check. Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, pm, within
+from .poiseuille_cases import BETAS, RESTITUTIONS
+from .poiseuille_data import (
+    BINS,
+    BINS_DENSE,
+    CENTRE_BIN,
+    FlowData,
+    carnahan_starling,
+    contact_value,
+)
+
+Runs = dict[tuple[float, float, float], FlowData]
+REF = (0.01, 0.99, 0.8)  # Fig 2.11's parameters (φ, β, e), rerun with Ch. 3's N = 2744
+
+
+def _not_run(ref: str, statement: str, thesis: str, what: str) -> Check:
+    return Check(ref, statement, thesis, "n/a", NOT_RUN, f"needs {what}, not in this run")
+
+
+def _ratio(a: float, ea: float, b: float, eb: float) -> tuple[float, float]:
+    r = a / b
+    return r, abs(r) * math.hypot(ea / a if a else 0.0, eb / b if b else 0.0)
+
+
+def _mean(v: np.ndarray, e: np.ndarray) -> tuple[float, float]:
+    ok = np.isfinite(v) & np.isfinite(e)
+    return float(np.mean(v[ok])), float(math.sqrt(np.sum(e[ok] ** 2)) / max(ok.sum(), 1))
+
+
+def _tag(d: FlowData) -> str:
+    return f"β = {d.flow.beta:g}, e = {d.flow.e:g}"
+
+
+def _steady_note(d: FlowData) -> str:
+    info = d.run_info()
+    return "" if info["steady"] else (f" The run ({_tag(d)}) is not in steady state (kinetic "
+                                      f"energy trend {info['trend']:.2g}): no verdict beyond "
+                                      "partly.")
+
+
+def _cap(verdict: str, d: FlowData) -> str:
+    """At most "partly" from a run that did not reach its plateau."""
+    return PARTLY if verdict == REPRODUCED and not d.run_info()["steady"] else verdict
+
+
+# ------------------------------------------------------------------ steady state
+def steady_checks(data: Runs) -> list[Check]:
+    out = []
+    for phi in (0.01, 0.1, 0.5):
+        ds = [d for (p, _b, _e), d in sorted(data.items()) if p == phi]
+        ref, statement = "§1.8 [L583], [L652]", f"φ = {phi:g}: statistics taken in the " \
+                                                 "steady state (plateau of the kinetic energy)"
+        if not ds:
+            out.append(_not_run(ref, statement, "plateau reached", f"the φ = {phi:g} runs"))
+            continue
+        steady = [d for d in ds if d.run_info()["steady"]]
+        bad = ", ".join(_tag(d) for d in ds if d not in steady)
+        out.append(Check(ref, statement, "plateau reached before averaging",
+                         f"{len(steady)} of {len(ds)} runs on a plateau (demstudy's trend "
+                         "test of the kinetic energy over production)",
+                         REPRODUCED if len(steady) == len(ds) else PARTLY,
+                         "" if not bad else f"not steady: {bad} (runs too short for the CPU "
+                                            "budget; see the runs table)"))
+    return out
+
+
+# ------------------------------------------------------------------ §3.5 validation
+def validation_checks(data: Runs) -> list[Check]:
+    d = data.get(REF)
+    items = (("slip", "considerable wall slip", _slip),
+             ("gradient", "larger velocity gradient near the walls", _gradient),
+             ("spin", "ω_z < 0 in the lower half and > 0 in the upper half", _spin_sign),
+             ("density", "density slightly higher at the centre but nearly uniform (no "
+                         "clusters)", _density),
+             ("temps", "T and θ larger near the walls", _temperatures))
+    out = []
+    for _key, statement, fn in items:
+        ref = "§3.5 [L595]-[L613], Fig 2.11; Figs 3.3-3.7"
+        full = f"φ = 0.01, β = 0.99, e = 0.8: {statement}"
+        if d is None:
+            out.append(_not_run(ref, full, statement, "the φ = 0.01, β = 0.99, e = 0.8 run"))
+            continue
+        measured, verdict, reason = fn(d)
+        others = [x for (p, _b, _e), x in data.items() if p == 0.01 and x is not d]
+        if others:
+            holds = sum(fn(x)[1] == REPRODUCED for x in others)
+            measured += f"; holds in {holds} of {len(others)} other φ = 0.01 runs"
+        out.append(Check(ref, full, statement, measured, _cap(verdict, d),
+                         reason + _steady_note(d)))
+    return out
+
+
+def _slip(d: FlowData) -> tuple[str, str, str]:
+    uw, ew = d.wall_value("ux")
+    uc, ec = d.centre_value("ux")
+    s, es = _ratio(uw, ew, uc, ec)
+    ok = s - 2 * es >= 0.2
+    return (f"U_x,w* = {pm(uw, ew)}, U_x,c* = {pm(uc, ec)}, U_w/U_c = {pm(s, es)}",
+            REPRODUCED if ok else NOT_REPRODUCED,
+            "" if ok else "slip below 20 % of the centre velocity (the threshold read for "
+                          "'considerable')")
+
+
+def _gradient(d: FlowData) -> tuple[str, str, str]:
+    u, e = d.series("ux")
+    dy = float(d.y[1] - d.y[0])
+    gw = 0.5 * ((u[1] - u[0]) + (u[-2] - u[-1])) / dy
+    ew = 0.5 * math.sqrt(e[0] ** 2 + e[1] ** 2 + e[-1] ** 2 + e[-2] ** 2) / dy
+    gi = 0.5 * ((u[6] - u[5]) + (u[-7] - u[-6])) / dy  # bins 6-7 and 19-20: y ≈ 12 and 38
+    ei = 0.5 * math.sqrt(e[5] ** 2 + e[6] ** 2 + e[-6] ** 2 + e[-7] ** 2) / dy
+    ok = gw - gi > 2 * math.hypot(ew, ei)
+    return (f"dU_x*/dy at the walls (bins 1-2) {pm(gw, ew)}, at y ≈ 12 (bins 6-7) "
+            f"{pm(gi, ei)} (per d)", REPRODUCED if ok else NOT_REPRODUCED,
+            "" if ok else "the wall gradient is not larger beyond 2σ")
+
+
+def _spin_sign(d: FlowData) -> tuple[str, str, str]:
+    w, e = d.series("omz")
+    lo, elo = _mean(w[:12], e[:12])
+    hi, ehi = _mean(w[13:], e[13:])
+    wrong = int(np.sum(w[:12] > 2 * e[:12]) + np.sum(w[13:] < -2 * e[13:]))
+    ok = lo < -2 * elo and hi > 2 * ehi and wrong == 0
+    return (f"mean ω_z* lower half {pm(lo, elo)}, upper half {pm(hi, ehi)}; bins of the "
+            f"wrong sign (2σ): {wrong}", REPRODUCED if ok else NOT_REPRODUCED,
+            "" if ok else "sign pattern not found within 2σ")
+
+
+def _density(d: FlowData) -> tuple[str, str, str]:
+    f, e = d.series("phi")
+    fc, ec = _mean(f[11:14], e[11:14])
+    near = [1, 2, 22, 23]  # bins 2-3 and 23-24: bins 1 and 25 lose the wall's excluded volume
+    fw, ew = _mean(f[near], e[near])
+    interior = f[1:-1]
+    spread = float(np.max(np.abs(interior / np.mean(interior) - 1)))
+    higher, uniform = fc - fw > 2 * math.hypot(ec, ew), spread < 0.2
+    verdict = REPRODUCED if higher and uniform else PARTLY if (higher or uniform) \
+        else NOT_REPRODUCED
+    reason = "" if verdict == REPRODUCED else (
+        ("centre not denser than the walls beyond 2σ; " if not higher else "")
+        + ("interior φ varies by more than 20 % " if not uniform else ""))
+    return (f"φ centre (bins 12-14) {pm(fc, ec, 2)}, near walls (bins 2-3, 23-24) "
+            f"{pm(fw, ew, 2)}; interior bins within {100 * spread:.0f} % of their mean",
+            verdict, reason)
+
+
+def _temperatures(d: FlowData) -> tuple[str, str, str]:
+    parts, ok = [], True
+    for key, name in (("T", "T*"), ("theta", "θ*")):
+        w, ew = d.wall_value(key)
+        c, ec = d.centre_value(key)
+        parts.append(f"{name} wall {pm(w, ew)} vs centre {pm(c, ec)}")
+        ok &= w - c > 2 * math.hypot(ew, ec)
+    return ("; ".join(parts), REPRODUCED if ok else NOT_REPRODUCED,
+            "" if ok else "a wall value is not above the centre's beyond 2σ")
+
+
+# ------------------------------------------------------------------ β = 0 most dissipative
+def dissipation_checks(data: Runs) -> list[Check]:
+    out = []
+    for phi in (0.01, 0.1):
+        ref = "[L664], [L873]; digest §2.3"
+        statement = (f"φ = {phi:g}: β = 0 is the most dissipative case (lowest T at "
+                     "each e)")
+        rows, held, tested, used = [], 0, 0, []
+        for e in RESTITUTIONS[phi]:
+            runs = {b: r for b in BETAS if (r := data.get((phi, b, e))) is not None}
+            if 0.0 not in runs or len(runs) < 2:  # β = 0 and at least one other
+                continue
+            means = {b: _mean(*r.series("T")) for b, r in runs.items()}
+            used += runs.values()
+            t0, e0 = means[0.0]
+            others = [means[b] for b in runs if b != 0.0]
+            ok = all(t - t0 > 2 * math.hypot(et, e0) for t, et in others)
+            held += ok
+            tested += 1
+            rows.append(f"e = {e:g}: " + ", ".join(f"β = {b:g}: {pm(*means[b])}"
+                                                   for b in runs))
+        if not tested:
+            out.append(_not_run(ref, statement, "lowest T for β = 0",
+                                f"β = 0 and another β at one e (φ = {phi:g})"))
+            continue
+        verdict = REPRODUCED if held == tested else PARTLY if held else NOT_REPRODUCED
+        unsteady = [d for d in used if not d.run_info()["steady"]]
+        out.append(Check(ref, statement, "lowest T for β = 0",
+                         f"channel-mean T*: {'; '.join(rows)}; holds at {held} of {tested} e",
+                         _cap(verdict, unsteady[0]) if unsteady else verdict,
+                         ("" if held == tested else "β = 0 is not the coldest beyond 2σ at "
+                                                    "every e")
+                         + (_steady_note(unsteady[0]) if unsteady else "")))
+    return out
+
+
+# ------------------------------------------------------------------ Kn
+def knudsen_checks(data: Runs) -> list[Check]:
+    out = []
+    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.01]
+    ref = "[L702]-[L712], [L770]; Fig 3.8"
+    statement = ("φ = 0.01: Kn = λ/W > 0.1 across the channel, the transitional regime "
+                 "(free paths relative to the local mean flow)")
+    if not ds:
+        out.append(_not_run(ref, statement, "Kn > 0.1", "the φ = 0.01 runs"))
+    else:
+        lows, rows = [], []
+        for d in ds:
+            k, e = d.series("Kn")
+            i = int(np.nanargmin(k))
+            lows.append(k[i] - 2 * e[i] > 0.1)
+            rows.append(f"{_tag(d)}: min {pm(k[i], e[i])}, centre {pm(*d.centre_value('Kn'))}")
+        held = sum(lows)
+        out.append(Check(ref, statement, "Kn > 0.1 (transitional)",
+                         f"{'; '.join(rows)}; Kn > 0.1 everywhere in {held} of {len(ds)} runs",
+                         REPRODUCED if held == len(ds) else PARTLY if held else NOT_REPRODUCED,
+                         "" if held == len(ds) else "some bins have Kn ≤ 0.1 within 2σ"))
+    out.append(_plug_knudsen(data))
+    return out
+
+
+def _plug_knudsen(data: Runs) -> Check:
+    ref, statement = "[L875]; Fig 4.4f", ("φ = 0.1, e = 0.7: Kn 'extremely low' in the β = 0 "
+                                          "plug (read: centre Kn < 0.01, lowest of the three β)")
+    runs = {b: data.get((0.1, b, 0.7)) for b in BETAS}
+    if runs[0.0] is None:
+        return _not_run(ref, statement, "Kn ≪ 0.1 in the plug", "the φ = 0.1, e = 0.7 runs")
+    kn = {b: r.centre_value("Kn") for b, r in runs.items() if r is not None}
+    k0, e0 = kn[0.0]
+    lowest = all(k0 < k for b, (k, _e) in kn.items() if b != 0.0)
+    ok = k0 + 2 * e0 < 0.01 and lowest
+    return Check(ref, statement, "Kn extremely low",
+                 ", ".join(f"β = {b:g}: {pm(k, e)}" for b, (k, e) in kn.items()),
+                 _cap(REPRODUCED if ok else NOT_REPRODUCED, runs[0.0]),
+                 ("" if ok else "centre Kn not below 0.01 or not the lowest")
+                 + _steady_note(runs[0.0]))
+
+
+# ------------------------------------------------------------------ VDFs
+def vdf_shape(d: FlowData, b: int) -> tuple[float, np.ndarray, np.ndarray]:
+    """(core deviation, kurtosis, its error) in bin ``b`` (0-based): the largest departure of
+    P(C/σ) from the binned Gaussian for |x| ≤ 1 beyond 2σ (relative, translational
+    components), and the kurtosis of C_x, C_y, C_z (3 for a Gaussian)."""
+    v = d.stat("vdf")
+    x, p, e, g = v["malik_centres"], v["malik_P"][b, :3], v["malik_P_err"][b, :3], \
+        v["gaussian_binned"]
+    core = np.abs(x) <= 1.0
+    dev = np.clip(np.abs(p[:, core] - g[core]) - 2 * np.nan_to_num(e[:, core]), 0, None) / g[core]
+    return float(np.nanmax(dev)), v["kurtosis"][b, :3], v["kurtosis_err"][b, :3]
+
+
+def vdf_checks(data: Runs) -> list[Check]:
+    out = []
+    for phi in (0.01, 0.1, 0.5):
+        bins = BINS_DENSE if phi == 0.5 else BINS
+        ds = [d for (p, _b, e), d in sorted(data.items())
+              if p == phi and e == (0.9 if phi == 0.5 else RESTITUTIONS[phi][0])]
+        ref = {0.01: "§4.6, Figs 3.12-3.17", 0.1: "§4.6, Figs 4.7-4.9",
+               0.5: "§4.6, Fig 4.18"}[phi]
+        statement = (f"φ = {phi:g}, bins {', '.join(map(str, bins))}: VDFs with a Gaussian "
+                     "core and non-Gaussian tails (visual in the thesis)")
+        ds = [d for d in ds if "malik_P" in d.stat("vdf")]
+        if not ds:
+            out.append(_not_run(ref, statement, "Gaussian core, tails", f"φ = {phi:g} runs"))
+            continue
+        rows, cores, tails = [], True, False
+        for d in ds:
+            skew = d.stat("vdf")["skewness"]
+            for k in bins:
+                dev, kur, ker = vdf_shape(d, k - 1)
+                cores &= dev <= 0.1
+                tails |= bool(np.any(np.abs(kur - 3) > 2 * ker))
+                rows.append(f"{_tag(d)} bin {k}: core dev {100 * dev:.0f} %, kurtosis "
+                            + "/".join(pm(a, b, 1) for a, b in zip(kur, ker, strict=True))
+                            + f", skewness C_x {skew[k - 1, 0]:.2f}")
+        verdict = REPRODUCED if cores and tails else PARTLY if (cores or tails) \
+            else NOT_REPRODUCED
+        reason = "" if verdict == REPRODUCED else (
+            ("the core departs from the Gaussian by > 10 % beyond 2σ in some bins: C_x is "
+             "skewed (the streamwise VDF is asymmetric, its peak displaced from the mean: "
+             "slow particles from the walls), which the P(0) = 1 scaling turns into a core "
+             "deviation; " if not cores else "")
+            + ("kurtosis consistent with 3 (Gaussian tails) " if not tails else ""))
+        unsteady = [d for d in ds if not d.run_info()["steady"]]
+        if unsteady:
+            verdict = _cap(verdict, unsteady[0])
+            reason += _steady_note(unsteady[0])
+        out.append(Check(ref, statement, "Gaussian core; tails deviate",
+                         "; ".join(rows) + " (kurtosis of C_x/C_y/C_z)",
+                         verdict, reason.strip()))
+    return out
+
+
+# ------------------------------------------------------------------ g(r) contact
+def contact_checks(data: Runs) -> list[Check]:
+    out = []
+    for phi in (0.01, 0.1, 0.5):
+        ds = [d for (p, _b, _e), d in sorted(data.items()) if p == phi and d.gr]
+        ref = {0.01: "§4.7, Figs 3.18-3.20", 0.1: "§4.7, Fig 4.10",
+               0.5: "§4.7, Fig 4.17"}[phi]
+        statement = (f"φ = {phi:g}, bin 13: g(r) contact value vs Enskog's χ "
+                     "(Carnahan-Starling at the bin's φ)")
+        if not ds:
+            out.append(_not_run(ref, statement, "χ(φ) (CS)", f"φ = {phi:g} runs"))
+            continue
+        rows, held = [], 0
+        unsteady = [d for d in ds if not d.run_info()["steady"]] or [ds[0]]
+        for d in ds:
+            g, eg = contact_value(d.gr, CENTRE_BIN - 1)
+            f = d.centre_value("phi")[0]
+            chi = carnahan_starling(f)
+            ok = within(g, eg, chi, 2.0, 0.1 * chi)  # CS/Enskog: ~10 % (dense, inelastic)
+            held += ok
+            rows.append(f"{_tag(d)}: g(d+) {pm(g, eg)} vs χ_CS({f:.3g}) = {chi:.3g}")
+        verdict = REPRODUCED if held == len(ds) else PARTLY if held else NOT_REPRODUCED
+        out.append(Check(ref, statement, "contact value ≈ χ_CS(φ) (no value in the thesis)",
+                         "; ".join(rows) + f"; agree (2σ + 10 %) in {held} of {len(ds)}",
+                         _cap(verdict, unsteady[0]),
+                         ("" if verdict == REPRODUCED else
+                          "the contact value departs from Enskog-CS: pair correlations beyond "
+                          "molecular chaos (inelastic clustering) or ordering")
+                         + _steady_note(unsteady[0])))
+    return out
+
+
+# ------------------------------------------------------------------ Λ
+def lambda_mean(d: FlowData) -> tuple[float, float]:
+    lam = d.stat("lambda")
+    ok = lam["count"] > 0
+    return _mean(lam["lambda"][ok], lam["lambda_err"][ok])
+
+
+def lambda_checks(data: Runs) -> list[Check]:
+    out = []
+    for phi in (0.01, 0.1, 0.5):
+        ds = [d for (p, _b, _e), d in sorted(data.items()) if p == phi
+              and "lambda" in d.stat("lambda")]
+        ref = {0.01: "§4.8 [L819]-[L837], Fig 3.21", 0.1: "§4.8, Fig 4.11",
+               0.5: "§4.8, Fig 4.20"}[phi]
+        statement = (f"φ = {phi:g}: orientational correlation Λ(y) departs from the "
+                     "molecular value 1/3; its variation with β and e (insets)")
+        if not ds:
+            out.append(_not_run(ref, statement, "Λ ≠ 1/3", f"φ = {phi:g} runs"))
+            continue
+        unsteady = [d for d in ds if not d.run_info()["steady"]]
+        rows, departs = [], []
+        for d in ds:
+            m, em = lambda_mean(d)
+            lam = d.stat("lambda")
+            c, ec = lam["lambda"][CENTRE_BIN - 1], lam["lambda_err"][CENTRE_BIN - 1]
+            if abs(m - 1 / 3) > 2 * em:
+                departs.append(d)
+            rows.append(f"{_tag(d)}: mean {pm(m, em)}, centre {pm(c, ec)}")
+        trend = _lambda_trend(ds)
+        verdict = REPRODUCED if len(departs) == len(ds) else PARTLY if departs \
+            else NOT_REPRODUCED
+        near = ", ".join(_tag(d) for d in ds if d not in departs)
+        out.append(Check(ref, statement, "Λ ≠ 1/3 for rough inelastic spheres (Brilliantov "
+                                         "et al. 2007; direction of the trends: digest silent)",
+                         "; ".join(rows) + (f". Trend: {trend}" if trend else ""),
+                         _cap(verdict, unsteady[0]) if unsteady else verdict,
+                         ("" if verdict == REPRODUCED else
+                          f"Λ̄ consistent with 1/3 (2σ) for {near}")
+                         + (_steady_note(unsteady[0]) if unsteady else "")))
+    return out
+
+
+def _lambda_trend(ds: list[FlowData]) -> str:
+    """The sign of dΛ̄/de per β (least squares over e) in words."""
+    parts = []
+    for b in sorted({d.flow.beta for d in ds}):
+        sub = sorted((d for d in ds if d.flow.beta == b), key=lambda d: d.flow.e)
+        if len(sub) < 2:
+            continue
+        e = np.array([d.flow.e for d in sub])
+        m = np.array([lambda_mean(d)[0] for d in sub])
+        slope = float(np.polyfit(e, m, 1)[0])
+        grows = slope * (m.mean() - 1 / 3) < 0  # |Λ̄ - 1/3| larger at smaller e
+        parts.append(f"β = {b:g}: |Λ̄ - 1/3| {'grows' if grows else 'shrinks'} as e falls "
+                     f"(dΛ̄/de = {slope:.2g})")
+    return "; ".join(parts)
+
+
+# ------------------------------------------------------------------ φ = 0.5 and waves
+def dense_checks(data: Runs) -> list[Check]:
+    d = data.get((0.5, 0.9, 0.9))
+    ref, statement = "[L996]-[L1050], Figs 4.15-4.16; §6", \
+        "φ = 0.5: a liquid-like dense core (0.494 < φ < 0.64) flowing as a plug"
+    if d is None:
+        return [_not_run(ref, statement, "liquid-like core, plug", "the φ = 0.5 run")]
+    f, ef = d.series("phi")
+    core = slice(9, 16)  # bins 10-16
+    fc, efc = _mean(f[core], ef[core])
+    u, _eu = d.series("ux")
+    y = d.y
+    shear_core = abs(float(np.polyfit(y[core], u[core], 1)[0]))
+    shear_wall = 0.5 * abs((u[1] - u[0]) - (u[-2] - u[-1])) / float(y[1] - y[0])
+    liquid = 0.494 < fc < 0.64
+    plug = shear_core < 0.2 * shear_wall
+    verdict = REPRODUCED if liquid and plug else PARTLY if (liquid or plug) else NOT_REPRODUCED
+    reason = "" if verdict == REPRODUCED else (
+        ("core φ outside the liquid range; " if not liquid else "")
+        + ("core shear not < 20 % of the wall's" if not plug else ""))
+    return [Check(ref, statement, "liquid-like core and plug",
+                  f"core φ (bins 10-16) {pm(fc, efc, 2)}; |dU_x/dy| core {shear_core:.3g}, "
+                  f"at the walls {shear_wall:.3g} per √(d/g)",
+                  _cap(verdict, d), (reason + _steady_note(d)).strip())]
+
+
+def wave_checks(data: Runs) -> list[Check]:
+    d = data.get((0.1, 0.99, 0.7))
+    ref, statement = "Fig 4.5 [L925]", "φ = 0.1, β = 0.99, e = 0.7: an S-shaped density wave"
+    if d is None:
+        return [_not_run(ref, statement, "S-wave seen", "the φ = 0.1, β = 0.99, e = 0.7 run")]
+    from .poiseuille_waves import s_wave
+
+    ratio, err, text = s_wave(d)
+    seen = ratio - 2 * err > 1.0
+    return [Check(ref, statement, "S-wave (mode (1,1) of the xy density)", text,
+                  _cap(REPRODUCED if seen else NOT_REPRODUCED, d),
+                  ("" if seen else "the antisymmetric (1,1) mode is not above the noise of "
+                                   "independent particles") + _steady_note(d))]
+
+
+# ------------------------------------------------------------------ numbers for the report
+def numbers_text(data: Runs) -> str:
+    """Velocity correlations, Λ and VDF moments in bin 13, per run (markdown table)."""
+    if not data:
+        return "No runs."
+    lines = ["Bin 13 (the centre). C_aa at the first shell beyond contact (r ∈ [1.0, 1.1)) "
+             "and at r ∈ [3.0, 3.1) (normalised by the self term; 0 for independent "
+             "velocities); kurtosis of C_x (3 for a Gaussian).", "",
+             "| run | C_xx(1) | C_yy(1) | C_zz(1) | C_xx(3) | kurtosis C_x | Λ̄ |",
+             "|---|---|---|---|---|---|---|"]
+    for key in sorted(data):
+        d = data[key]
+        vc, cells = d.stat("vcorr"), []
+        if "C" in vc:
+            k1, k3 = int(np.searchsorted(vc["r_edges"], 1.0 - 1e-9)), \
+                int(np.searchsorted(vc["r_edges"], 3.0 - 1e-9))
+            b = CENTRE_BIN - 1
+            cells = [pm(vc["C"][b, a, k1], vc["C_err"][b, a, k1], 1) for a in range(3)]
+            cells.append(pm(vc["C"][b, 0, k3], vc["C_err"][b, 0, k3], 1))
+        else:
+            cells = ["n/a"] * 4
+        kur = d.stat("vdf")
+        ku = pm(kur["kurtosis"][CENTRE_BIN - 1, 0], kur["kurtosis_err"][CENTRE_BIN - 1, 0]) \
+            if "kurtosis" in kur else "n/a"
+        lam = pm(*lambda_mean(d)) if "lambda" in d.stat("lambda") else "n/a"
+        lines.append(f"| {d.flow.name} | " + " | ".join(cells) + f" | {ku} | {lam} |")
+    return "\n".join(lines)
