@@ -56,7 +56,9 @@ def _positions(ax, run: RunWaves) -> None:
 def _contour(fig: Figure, ax, run: RunWaves, plane: str, letter: str) -> None:
     ca, cb, nu, ua, ub = run.snapshot.planes[plane]
     cs = ax.contourf(ca, cb, nu.T, levels=12, cmap="viridis")
-    fig.colorbar(cs, ax=ax, label="solid fraction ν", shrink=0.85)
+    ratio = float(np.ptp(cb) + cb[1] - cb[0]) / float(np.ptp(ca) + ca[1] - ca[0])
+    fig.colorbar(cs, ax=ax, label="solid fraction ν", shrink=float(np.clip(1.3 * ratio, 0.4,
+                                                                            0.85)))
     step_a, step_b = max(1, ca.size // 25), max(1, cb.size // 25)
     ax.quiver(ca[::step_a], cb[::step_b], np.nan_to_num(ua[::step_a, ::step_b].T),
               np.nan_to_num(ub[::step_a, ::step_b].T), color="white", width=0.004)

@@ -27,6 +27,8 @@ PLANES = ("xy", "xz", "yz")
 _AX = {"x": 0, "y": 1, "z": 2}
 #: drift of a mode amplitude between the production halves above this many σ: not stationary
 DRIFT_SIGMAS = 2.0
+#: width (d) of the coarse cells of the second peak-density estimate (the thesis's unstated)
+COARSE = 5.0
 
 
 @dataclass
@@ -104,6 +106,8 @@ class RunWaves:
     drifts: list[Drift]
     ke_halves: tuple[tuple[float, float], tuple[float, float]]
     balance: tuple[float, float]  # dissipation rate / gravity power, error
+    peak: tuple[float, float]  # densest xy cell column (≈ 2 d) per frame, mean over frames
+    peak_coarse: tuple[float, float]  # the same on columns ≈ COARSE d wide
     rate: float  # c/p per √(d/g) in the production
     wall_seconds: float
     tc_fraction: float  # pair collisions the engine's TC model made elastic (not in the thesis)
@@ -236,10 +240,13 @@ def measure(path: Path) -> RunWaves:
         whole, halves = density_waves(size), (density_waves(size), density_waves(size))
         prod = frame_times[frame_times >= eq_end]
         split = prod[len(prod) // 2] if len(prod) else eq_end
-        last = None
+        last, peaks = None, []
         for frame in iter_frames(f, eq_end):
             whole.feed(frame)
             halves[int(frame.time >= split)].feed(frame)
+            coarse = np.maximum(2, np.round(whole.length / COARSE)).astype(int)
+            peaks.append([float(np.max(plane_fields(frame, whole.lo, whole.hi, grid, "xy")[2]))
+                          for grid in (whole.n, coarse)])
             last = frame
     if whole.n_frames < 4 or min(h.n_frames for h in halves) < 2:
         raise ValueError(f"{path}: {whole.n_frames} frames in the production (t >= {eq_end}); "
@@ -262,7 +269,8 @@ def measure(path: Path) -> RunWaves:
         cpp=cpp, ke=ke, eq_end=eq_end, modes=modes, halves=both,
         series_cpp=np.interp(modes.results["series_time"], time, cpp),
         drifts=_drifts(modes, both), ke_halves=_ke_halves(time, ke, eq_end),
-        balance=_energy_balance(ts, eq_end), rate=rate,
+        balance=_energy_balance(ts, eq_end), peak=_blocked_means(np.array(peaks)[:, 0]),
+        peak_coarse=_blocked_means(np.array(peaks)[:, 1]), rate=rate,
         wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
         tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap)
 

@@ -15,10 +15,19 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import BadInputFile
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Analysis, Check, Figure, pm
+from ..base import (
+    NOT_REPRODUCED,
+    NOT_RUN,
+    PARTLY,
+    REPRODUCED,
+    Analysis,
+    Check,
+    Figure,
+    pm,
+)
 from .waves_boxes import BOXES, BRIEF, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
-from .waves_measure import DRIFT_SIGMAS, RunWaves, measure
+from .waves_measure import COARSE, DRIFT_SIGMAS, RunWaves, measure
 
 #: CPU seconds per particle per √(d/g), measured on this machine (N = 600 box, steady
 #: state, one core): the forecast of a run missing when no run of this analysis gives one
@@ -141,10 +150,38 @@ def _series_check(ref: str, statement: str, boxes: Sequence[Box],
                  (f"; not run: {', '.join(missing)}" if missing else ""))
 
 
+def peak_check(measured: Mapping[str, RunWaves]) -> Check:
+    """The densest cells of the structures against the thesis's colour bars (≈ 0.58): the
+    thesis's cells are not stated, so the peak is given on two grids (≈ 2 d and ≈ 5 d)."""
+    ref = "Ch. 5 colour bars (digest §3.4, §6)"
+    statement = "dense plugs and slugs reach a local solid fraction of about 0.58"
+    if not measured:
+        return Check(ref, statement, "≈ 0.58", "not run", NOT_RUN, "no run made")
+    name, run = max(measured.items(), key=lambda item: item[1].peak_coarse[0])
+    fine, coarse = run.peak, run.peak_coarse
+    text = (f"densest cell column of the xy plane (depth-averaged), mean over the production "
+            f"frames, {name}: {pm(*fine)} on 2 d cells, {pm(*coarse)} on {COARSE:g} d cells; "
+            "others (2 d / 5 d): " + "; ".join(
+                f"{n.split('-')[2]} {pm(*r.peak)} / {pm(*r.peak_coarse)}"
+                for n, r in measured.items() if n != name))
+    lo = min(fine[0], coarse[0]) - 2 * max(fine[1], coarse[1]) - 0.03
+    hi = max(fine[0], coarse[0]) + 2 * max(fine[1], coarse[1]) + 0.03
+    cells = ("the thesis's cells (N1 × N2 × N3) are not stated and the peak depends on them "
+             f"({pm(*fine)} on 2 d, {pm(*coarse)} on {COARSE:g} d columns)")
+    if lo <= 0.58 <= hi:
+        return Check(ref, statement, "≈ 0.58", text, PARTLY,
+                     "0.58 lies within the range of the two grids (± 2σ + 0.03, the colour "
+                     "bar's reading), but " + cells)
+    return Check(ref, statement, "≈ 0.58", text, NOT_REPRODUCED,
+                 "0.58 lies outside the range of the two grids (± 2σ + 0.03); " + cells +
+                 ("; not every box run" if len(measured) < len(BOXES) else ""))
+
+
 def _run_table(measured: Mapping[str, RunWaves]) -> str:
     head = ("| case | N | c/p analysed | c/p per √(d/g) | class | dominant xy | stationary | "
-            "max drift | dissipation/input | TC elastic fraction | wall s |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|\n")
+            "max drift | dissipation/input | peak ν (2 d / 5 d cells) | TC elastic fraction | "
+            "wall s |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     rows = []
     for name, run in measured.items():
         worst = run.max_drift
@@ -153,6 +190,7 @@ def _run_table(measured: Mapping[str, RunWaves]) -> str:
             f"| {name} | {run.n} | {run.eq_cpp:.0f}-{run.end_cpp:.0f} | {run.rate:.1f} | "
             f"{run.modes.pattern} | {', '.join(str(k) for k in run.modes.dominant('xy'))} | "
             f"{'yes' if run.stationary else 'no'} | {drift} | {pm(*run.balance)} | "
+            f"{pm(*run.peak)} / {pm(*run.peak_coarse)} | "
             f"{run.tc_fraction:.1e} | {run.wall_seconds:.0f} |")
     return head + "\n".join(rows)
 
@@ -217,6 +255,7 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
                                         "and mode amplitudes against collisions per "
                                         "particle (class " + run.modes.pattern + ")"))
     diagram = [b for b in boxes if b.restitution == RESTITUTION and b.height == b.width]
+    ana.checks.append(peak_check(measured))
     ana.checks += _phase_checks(boxes, diagram, measured)
     thesis = [(b, THESIS[b.fig].cls, "digest") for b in diagram if b.fig in THESIS]
     thesis += [(b, BRIEF[b.fig], "brief") for b in diagram if b.fig in BRIEF]
