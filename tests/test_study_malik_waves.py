@@ -175,3 +175,54 @@ def test_spin_up_run_is_not_steady(tmp_path: Path) -> None:
     assert steady.verdict == NOT_REPRODUCED
     assert ana.checks[0].verdict != NOT_RUN
     assert (tmp_path / f"{case.name.removesuffix('-edmd')}.png").is_file()
+
+
+# -- stationarity is judged on the modes, not on the energy ----------------------------
+def _synthetic_run(path: Path, second_half) -> Path:
+    """A results file whose energy is flat and balanced (input = dissipation) throughout,
+    with 40 production frames: a plug, then ``second_half`` for the last 20."""
+    import h5py
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    frames = list(_frames(plug, frames=20, seed=2)) + list(_frames(second_half, frames=20,
+                                                                   seed=3))
+    n = frames[0].n
+    t = np.arange(0.0, 61.0)  # equilibration to 20, frames at 21..60
+    rng = np.random.default_rng(4)
+    with h5py.File(path, "w") as f:
+        f.attrs["equilibration_end"] = 20.0
+        ts = f.create_group("timeseries")
+        ts["time"] = t
+        ts["collisions"] = (5.0 * n * t).astype(np.int64)
+        ts["kinetic_energy"] = n * (100.0 + rng.normal(0, 0.5, t.size))
+        ts["gravity_work"] = 50.0 * n * t
+        ts["dissipated_energy"] = 50.0 * n * t + rng.normal(0, 0.5 * n, t.size)
+        fr = f.create_group("frames")
+        fr["time"] = t[21:]
+        fr["position"] = np.stack([fr_.position for fr_ in frames])
+        fr["velocity"] = np.zeros((40, n, 3))
+        fr["radius"] = np.full((40, n), 0.5)
+        fr["box_lo"] = np.zeros((40, 3))
+        fr["box_hi"] = np.tile(SIZE, (40, 1))
+    return path
+
+
+def test_plug_turning_into_slug_is_not_steady_though_energy_is(tmp_path: Path) -> None:
+    from demstudy.studies.base import PARTLY, REPRODUCED
+    from demstudy.studies.malik2008.waves_boxes import BOXES
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import steady_check
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    box = next(b for b in BOXES if b.tag == "L45W15H15")
+    changing = measure(_synthetic_run(tmp_path / "changing.h5", slug))
+    assert changing.balanced and changing.plateau  # the energy says steady
+    assert [h.pattern for h in changing.halves] == ["plug", "slug"]
+    assert not changing.stationary
+    assert steady_check(box, changing).verdict == PARTLY
+    steady = measure(_synthetic_run(tmp_path / "steady.h5", plug))
+    assert steady.stationary and steady.modes.pattern == "plug"
+    assert steady_check(box, steady).verdict == REPRODUCED

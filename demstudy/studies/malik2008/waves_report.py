@@ -197,12 +197,15 @@ def _run_table(measured: Mapping[str, RunWaves]) -> str:
 
 METHOD = """\
 **Time.** The thesis measures time in collisions per particle (c/p) without defining it
-(digest §1.6); here c/p = 2 N_pair / N, the pair collisions counted for both partners, wall
-collisions apart. In the steady state of the W = 15 boxes the engine makes ≈ 10 c/p per
-√(d/g) (the table's column): the scenes' equilibration (1000 √(d/g) at W = 15) therefore
-covers ≈ 10^4 c/p, the span of the thesis's snapshots (4000-14000 c/p), and the production
-(3000 √(d/g)) ≈ 3 × 10^4 c/p more. The W = 30 and W = 50 scenes keep the shipped lengths
-(2000 + 4000, 3000 + 5000 √(d/g)); their rates are measured when they run.
+(digest §1.6, §9.15); here c/p = 2 N_pair / N, each pair collision counted for both
+partners, wall collisions apart (had the thesis counted N_pair / N, its 14000 c/p would be
+our 28000). Once
+the energy plateaus (≈ 100 √(d/g)) the W = 15 boxes make 10 (N = 600, a plug) to 29
+(N = 3000, a slug) c/p per √(d/g) (measured, the table's column): the W = 15 scenes'
+equilibration of 1000 √(d/g) therefore covers ≈ 1-3 × 10^4 c/p, beyond the thesis's
+snapshots (4000-14000 c/p), and their production of 3000 √(d/g) ≈ 3-9 × 10^4 c/p more. The
+W = 30 and W = 50 scenes keep the shipped lengths (2000 + 4000 and 3000 + 5000 √(d/g));
+their rates are measured when they run (the table).
 
 **Modes.** demstudy.analysis.waves.DensityWaves over the production frames: cells of ≈ 2 d,
 each plane (xy, xz, yz) the depth average over the third axis, Malik's P = 2 X conj(X) /
@@ -212,6 +215,7 @@ frames with jackknife errors. A family is dominant when its power exceeds 20 × 
 k_x = 0 families → plug ((0,1)); x-varying families mostly antisymmetric about the
 centreline → s-wave ((1,1), (2,1)); mostly symmetric → slug ((0,1) + (1,0)); otherwise mixed
 (wavy slug, sandwich); "+ z" when the xz or yz plane has a dominant family varying along z.
+The yz plane's families are written (k_y, k_z) throughout (the thesis switches, digest §9.13).
 
 **Stationarity.** The analysis is repeated on each half of the production: the class must
 be the same and the amplitudes of the two leading xy families, the leading xz family and the
