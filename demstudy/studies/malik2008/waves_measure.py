@@ -10,6 +10,7 @@ N (each pair collision counts for both partners; wall collisions apart, digest Â
 
 from __future__ import annotations
 
+import tomllib
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -228,29 +229,36 @@ def plane_fields(frame: Frame, lo: np.ndarray, hi: np.ndarray, cells: np.ndarray
     return ca, cb, nu.reshape(na, nb), ua.reshape(na, nb), ub.reshape(na, nb)
 
 
+def _scan(f: h5py.File, eq_end: float, size: np.ndarray):
+    """One pass over the production frames: the mode analysis of the whole production and
+    of each half, the peak densities per frame (2 d and COARSE d columns), the last frame."""
+    whole, halves = density_waves(size), (density_waves(size), density_waves(size))
+    times = f["frames/time"][()]
+    prod = times[times >= eq_end]
+    split = prod[len(prod) // 2] if len(prod) else eq_end
+    last, peaks = None, []
+    for frame in iter_frames(f, eq_end):
+        whole.feed(frame)
+        halves[int(frame.time >= split)].feed(frame)
+        coarse = np.maximum(2, np.round(whole.length / COARSE)).astype(int)
+        peaks.append([float(np.max(plane_fields(frame, whole.lo, whole.hi, grid, "xy")[2]))
+                      for grid in (whole.n, coarse)])
+        last = frame
+    if last is None or whole.n_frames < 4 or min(h.n_frames for h in halves) < 2:
+        raise ValueError(f"{f.filename}: {whole.n_frames} frames in the production (t >= "
+                         f"{eq_end}); the mode analysis needs at least 4 (keep_frames = true)")
+    return whole, halves, np.array(peaks), last
+
+
 def measure(path: Path) -> RunWaves:
     """Measure one results file (module docstring)."""
     with h5py.File(path, "r") as f:
         attrs = read_attrs(f)
         ts = {k: v[()] for k, v in f["timeseries"].items()}
-        frame_times = f["frames/time"][()]
         n = int(f["frames/position"].shape[1])
         size = f["frames/box_hi"][0] - f["frames/box_lo"][0]
-        eq_end = float(attrs.get("equilibration_end", frame_times[0]))
-        whole, halves = density_waves(size), (density_waves(size), density_waves(size))
-        prod = frame_times[frame_times >= eq_end]
-        split = prod[len(prod) // 2] if len(prod) else eq_end
-        last, peaks = None, []
-        for frame in iter_frames(f, eq_end):
-            whole.feed(frame)
-            halves[int(frame.time >= split)].feed(frame)
-            coarse = np.maximum(2, np.round(whole.length / COARSE)).astype(int)
-            peaks.append([float(np.max(plane_fields(frame, whole.lo, whole.hi, grid, "xy")[2]))
-                          for grid in (whole.n, coarse)])
-            last = frame
-    if whole.n_frames < 4 or min(h.n_frames for h in halves) < 2:
-        raise ValueError(f"{path}: {whole.n_frames} frames in the production (t >= {eq_end}); "
-                         "the mode analysis needs at least 4 (keep_frames = true)")
+        eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
+        whole, halves, peaks, last = _scan(f, eq_end, size)
     time = ts["time"]
     cpp = 2.0 * ts["collisions"] / n
     ke = ts["kinetic_energy"] / n
@@ -263,14 +271,13 @@ def measure(path: Path) -> RunWaves:
     snap = Snapshot(last.time, float(np.interp(last.time, time, cpp)),
                     np.asarray(last.position, float),
                     {p: plane_fields(last, lo, hi, cells, p) for p in PLANES})
-    scene = _scene_restitution(attrs)
     return RunWaves(
-        path=Path(path), n=n, size=np.asarray(size, float), restitution=scene, time=time,
-        cpp=cpp, ke=ke, eq_end=eq_end, modes=modes, halves=both,
-        series_cpp=np.interp(modes.results["series_time"], time, cpp),
+        path=Path(path), n=n, size=np.asarray(size, float),
+        restitution=_scene_restitution(attrs), time=time, cpp=cpp, ke=ke, eq_end=eq_end,
+        modes=modes, halves=both, series_cpp=np.interp(modes.results["series_time"], time, cpp),
         drifts=_drifts(modes, both), ke_halves=_ke_halves(time, ke, eq_end),
-        balance=_energy_balance(ts, eq_end), peak=_blocked_means(np.array(peaks)[:, 0]),
-        peak_coarse=_blocked_means(np.array(peaks)[:, 1]), rate=rate,
+        balance=_energy_balance(ts, eq_end), peak=_blocked_means(peaks[:, 0]),
+        peak_coarse=_blocked_means(peaks[:, 1]), rate=rate,
         wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
         tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap)
 
@@ -281,8 +288,6 @@ def _finish(analysis: DensityWaves) -> tuple[dict, dict]:
 
 
 def _scene_restitution(attrs: dict[str, Any]) -> float:
-    import tomllib
-
     try:
         return float(tomllib.loads(attrs["scene_toml"])["contact"]["restitution"])
     except (KeyError, ValueError, TypeError):
