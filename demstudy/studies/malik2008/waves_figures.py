@@ -59,7 +59,7 @@ def _contour(fig: Figure, ax, run: RunWaves, plane: str, letter: str) -> None:
     ratio = float(np.ptp(cb) + cb[1] - cb[0]) / float(np.ptp(ca) + ca[1] - ca[0])
     fig.colorbar(cs, ax=ax, label="solid fraction ν", shrink=float(np.clip(1.3 * ratio, 0.4,
                                                                             0.85)))
-    step_a, step_b = max(1, ca.size // 25), max(1, cb.size // 25)
+    step_a, step_b = max(1, ca.size // 18), max(1, cb.size // 18)
     ax.quiver(ca[::step_a], cb[::step_b], np.nan_to_num(ua[::step_a, ::step_b].T),
               np.nan_to_num(ub[::step_a, ::step_b].T), color="white", width=0.004)
     ax.set_aspect("equal")

@@ -109,6 +109,7 @@ class RunWaves:
     balance: tuple[float, float]  # dissipation rate / gravity power, error
     peak: tuple[float, float]  # densest xy cell column (≈ 2 d) per frame, mean over frames
     peak_coarse: tuple[float, float]  # the same on columns ≈ COARSE d wide
+    close_packed: float  # last frame: fraction of particles with 12 neighbours within 1.05 d
     rate: float  # c/p per √(d/g) in the production
     wall_seconds: float
     tc_fraction: float  # pair collisions the engine's TC model made elastic (not in the thesis)
@@ -277,9 +278,23 @@ def measure(path: Path) -> RunWaves:
         modes=modes, halves=both, series_cpp=np.interp(modes.results["series_time"], time, cpp),
         drifts=_drifts(modes, both), ke_halves=_ke_halves(time, ke, eq_end),
         balance=_energy_balance(ts, eq_end), peak=_blocked_means(peaks[:, 0]),
-        peak_coarse=_blocked_means(peaks[:, 1]), rate=rate,
+        peak_coarse=_blocked_means(peaks[:, 1]),
+        close_packed=close_packed_fraction(last.position, np.asarray(size, float)), rate=rate,
         wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
         tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap)
+
+
+def close_packed_fraction(position: np.ndarray, size: np.ndarray) -> float:
+    """Fraction of the particles with at least 12 neighbours closer than 1.05 d (x and z
+    periodic): an FCC/HCP-like, touching shell, the signature of a close-packed core."""
+    from scipy.spatial import cKDTree
+
+    pos = np.array(position, float)
+    pos[:, 0] %= size[0]
+    pos[:, 2] %= size[2]
+    tree = cKDTree(pos, boxsize=[size[0], 1e9, size[2]])
+    counts = np.array([len(n) - 1 for n in tree.query_ball_point(pos, 1.05)])
+    return float(np.mean(counts >= 12))
 
 
 def _finish(analysis: DensityWaves) -> tuple[dict, dict]:
