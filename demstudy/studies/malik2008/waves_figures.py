@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 
 from ..base import UNITS_NOTE
 from .waves_boxes import Box
@@ -98,6 +99,7 @@ def _energy(ax, run: RunWaves) -> None:
         ax.axvline(t, color="gray", ls=":", lw=0.7)
     ax.plot([], [], color="gray", ls=":", lw=0.7, label="thesis snapshot times")
     ax.set_xlabel("collisions per particle")
+    ax.xaxis.set_major_locator(MaxNLocator(5))
     ax.set_ylabel("KE / N (m g d)")
     ax.set_xlim(0, max(run.end_cpp, THESIS_SNAPSHOTS[-1]) * 1.02)
     ax.set_ylim(0, float(np.nanmax(run.ke)) * 1.35)
@@ -120,6 +122,7 @@ def _series(ax, run: RunWaves) -> None:
         ax.axvline(float(np.interp(half[0], run.time, run.cpp)), color="k", ls="--", lw=0.7,
                    label="halves compared")
     ax.set_xlabel("collisions per particle")
+    ax.xaxis.set_major_locator(MaxNLocator(5))
     ax.set_ylabel("amplitude √P_F")
     ax.set_ylim(0, float(np.nanmax(series)) * 1.45 if series.size else 1.0)
     ax.legend(fontsize=6, loc="upper right", ncol=3)
@@ -175,8 +178,8 @@ def phase_figure(found: Sequence[tuple[Box, str]], missing: Sequence[Box],
     handles += [Line2D([], [], marker="o", markerfacecolor="none", markeredgecolor="k",
                        ls="", markersize=13, label="thesis, digest §1.8 (solid ring)"),
                 Line2D([], [], marker="o", markerfacecolor="none", markeredgecolor="k",
-                       ls="", markersize=13, markeredgewidth=1, label="thesis per the task brief, "
-                       "not in the digest (dashed ring)"),
+                       ls="", markersize=13, markeredgewidth=1,
+                       label="thesis per the task brief\n(not in the digest; dashed)"),
                 Line2D([], [], marker="x", color="0.6", ls="", label="not run")]
     ax.legend(handles=handles, fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
     ax.set_xlabel("aspect ratio L/W")

@@ -64,8 +64,15 @@ def _modes_text(run: RunWaves) -> str:
         parts.append(f"{plane} {', '.join(str(k) for k in dom) if dom else 'none'}")
     lead = run.modes.leading("xy", 1)
     amp = run.modes.amplitude("xy", lead[0]) if lead else (float("nan"), float("nan"))
+    moving = [k for k in run.modes.dominant("xy") if k[0] >= 1]
+    ratio = ""
+    if moving and (0, 1) in run.modes.dominant("xy"):
+        a_x, e_x = run.modes.amplitude("xy", moving[0])
+        a_y, e_y = run.modes.amplitude("xy", (0, 1))
+        ratio = (f"; x-modulation A{moving[0]}/A(0, 1) = "
+                 f"{pm(a_x / a_y, a_x / a_y * float(np.hypot(e_x / a_x, e_y / a_y)))}")
     return (f"dominant families: {'; '.join(parts)}; leading xy {lead[0] if lead else '-'} "
-            f"amplitude {pm(*amp)}")
+            f"amplitude {pm(*amp)}{ratio}")
 
 
 def _stationary_text(run: RunWaves) -> str:
