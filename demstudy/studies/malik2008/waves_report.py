@@ -216,10 +216,12 @@ METHOD = """\
 (digest §1.6, §9.15); here c/p = 2 N_pair / N, each pair collision counted for both
 partners, wall collisions apart (had the thesis counted N_pair / N, its 14000 c/p would be
 our 28000). Once
-the energy plateaus (≈ 100 √(d/g)) the W = 15 boxes make 10 (N = 600, a plug) to 29
-(N = 3000, a slug) c/p per √(d/g) (measured, the table's column): the W = 15 scenes'
-equilibration of 1000 √(d/g) therefore covers ≈ 1-3 × 10^4 c/p, beyond the thesis's
-snapshots (4000-14000 c/p), and their production of 3000 √(d/g) ≈ 3-9 × 10^4 c/p more. The
+the energy plateaus (≈ 100 √(d/g)) the W = 15 boxes make 10 (N = 600, a plug) to 43
+(N = 4800, L/W = 5, a slug) c/p per √(d/g) (measured, the table's column): the W = 15
+scenes' equilibration of 1000 √(d/g) therefore covers ≈ 1-6 × 10^4 c/p, beyond the thesis's
+snapshots (4000-14000 c/p), and their production of 3000 √(d/g) ≈ 3-13 × 10^4 c/p more
+(frames are kept in the production only: the structure at the thesis's snapshot times is
+not sampled, only the KE trace). The
 W = 30 and W = 50 scenes keep the shipped lengths (2000 + 4000 and 3000 + 5000 √(d/g));
 their rates are measured when they run (the table).
 
