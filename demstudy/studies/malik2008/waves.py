@@ -17,9 +17,10 @@ from pathlib import Path
 from ..base import Analysis, Case
 from .waves_boxes import BOXES, QUICK
 
-#: quick runs: two W = 15 boxes, ≈ 1000-2000 c/p to the plateau (80 √(d/g) at 10-29 c/p per
-#: √(d/g), measured) and ≈ 1000-3000 c/p of production (60 frames): indicative only
-QUICK_RUN = {"run": {"equilibration": 80.0, "production": 100.0, "sample_interval": 1.5}}
+#: quick runs: two W = 15 boxes, past the KE's rise (≈ 100 √(d/g); 120 √(d/g) ≈ 1200-3600 c/p
+#: at 10-30 c/p per √(d/g), measured) and ≈ 1000-3000 c/p of production (66 frames): ≈ 30 s
+#: on one core, indicative only
+QUICK_RUN = {"run": {"equilibration": 120.0, "production": 100.0, "sample_interval": 1.5}}
 
 
 def cases(quick: bool) -> list[Case]:
