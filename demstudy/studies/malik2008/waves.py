@@ -1,5 +1,12 @@
-"""PLACEHOLDER part of a study (being written): no cases, no checks yet.
-Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
+"""Malik (2008) Ch. 5, density waves at φ ≈ 0.15: every box of the thesis's table (digest
+§1.5: N = 600 … 323433, e = 0.7, β = 0.1, e_w = β_w = 0.99), the e study at L150W50H50 (e =
+0.9, 0.99; Figs 5.23, 5.24) and the H/W series (Figs 5.19, 5.20), run with hard spheres in
+the event-driven engine; per run the density field's Fourier modes on the xy, xz and yz
+planes, their stationarity, the structure class (digest §4.11), compared with the class the
+thesis reports where the digest says (§1.8), and the phase diagram over (L/W, W/d) (Fig 5.25).
+
+Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts): times in √(d/g); time in
+the thesis is collisions per particle, here c/p = 2 N_pair / N (wall collisions apart).
 """
 
 from __future__ import annotations
@@ -8,11 +15,30 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ..base import Analysis, Case
+from .waves_boxes import BOXES, QUICK
+
+#: quick runs: two W = 15 boxes, past the KE's rise (≈ 100 √(d/g); 120 √(d/g) ≈ 1200-3600 c/p
+#: at 10-30 c/p per √(d/g), measured) and ≈ 1000-3000 c/p of production (66 frames): ≈ 30 s
+#: on one core, indicative only
+QUICK_RUN = {"run": {"equilibration": 120.0, "production": 100.0, "sample_interval": 1.5}}
 
 
 def cases(quick: bool) -> list[Case]:
-    return []
+    """Every box of the thesis's table as shipped (the e study overrides e only); ``quick``:
+    the boxes of ``QUICK`` with short runs."""
+    out = []
+    for box in BOXES:
+        sections = {} if box.restitution == 0.7 else {"contact": {"restitution":
+                                                                  box.restitution}}
+        is_quick = box.tag in QUICK and box.restitution == 0.7
+        if quick and not is_quick:
+            continue
+        out.append(Case(box.name, box.scene, sections=sections, quick=is_quick,
+                        quick_sections=QUICK_RUN if is_quick else {}))
+    return out
 
 
 def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
-    return Analysis()
+    from .waves_report import analyse_waves
+
+    return analyse_waves(runs, out, quick)

@@ -1,0 +1,309 @@
+"""What the density-wave part measures in one run: the kinetic-energy trace against
+collisions per particle, the energy balance, the density field's Fourier modes on the xy, xz
+and yz planes (demstudy.analysis.waves.DensityWaves over the production frames, and over each
+half of them for stationarity), the structure class, and a snapshot of the fields.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts): times in √(d/g), speeds in
+√(gd), energies in m g d. Time in the thesis is collisions per particle: here c/p = 2 N_pair /
+N (each pair collision counts for both partners; wall collisions apart, digest §1.6, §10).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from ...analysis.blocking import BlockAccumulator, jackknife
+from ...analysis.waves import DensityWaves
+from ...io.frames import Frame
+from ...io.results import read_attrs
+
+PLANES = ("xy", "xz", "yz")
+_AX = {"x": 0, "y": 1, "z": 2}
+#: drift of a mode amplitude between the production halves above this many σ: not stationary
+DRIFT_SIGMAS = 2.0
+#: width (d) of the coarse cells of the second peak-density estimate (the thesis's unstated)
+COARSE = 5.0
+
+
+@dataclass
+class Modes:
+    """One DensityWaves result: its datasets, attributes and class."""
+
+    results: dict[str, np.ndarray]
+    attrs: dict[str, Any]
+
+    @property
+    def pattern(self) -> str:
+        """The xy class (none / plug / s-wave / slug / mixed), "+ z" when the xz or yz plane
+        has a dominant family varying along z (Malik's 3D structure)."""
+        z = " + z" if self.attrs.get("z_structure") else ""
+        return f"{self.attrs.get('pattern', '?')}{z}"
+
+    def amplitude(self, plane: str, k: tuple[int, int]) -> tuple[float, float]:
+        """√P_F of family k of ``plane`` and its error (jackknife)."""
+        power = float(self.results[f"family_power_{plane}"][k])
+        err = float(self.results[f"family_power_{plane}_err"][k])
+        amp = float(np.sqrt(max(power, 0.0)))
+        return amp, (0.5 * err / amp if amp > 0 else float("nan"))
+
+    def dominant(self, plane: str) -> list[tuple[int, int]]:
+        return [tuple(int(v) for v in row) for row in
+                np.asarray(self.results[f"dominant_{plane}"], int).reshape(-1, 2)]
+
+    def leading(self, plane: str, count: int) -> list[tuple[int, int]]:
+        return [tuple(int(v) for v in row) for row in
+                np.asarray(self.results[f"leading_{plane}"], int).reshape(-1, 2)[:count]]
+
+
+@dataclass
+class Drift:
+    """A family's amplitude in the first and second half of the production."""
+
+    plane: str
+    k: tuple[int, int]
+    first: tuple[float, float]
+    second: tuple[float, float]
+
+    @property
+    def sigmas(self) -> float:
+        err = float(np.hypot(self.first[1], self.second[1]))
+        diff = abs(self.second[0] - self.first[0])
+        return diff / err if err > 0 else float("inf")
+
+
+@dataclass
+class Snapshot:
+    """The last frame: centres, and per plane the depth-averaged solid fraction and the mean
+    velocity (the box mean subtracted) on the analysis grid."""
+
+    time: float
+    cpp: float
+    position: np.ndarray
+    planes: dict[str, tuple[np.ndarray, ...]] = field(default_factory=dict)
+
+
+@dataclass
+class RunWaves:
+    """Everything measured in one run (see the module docstring)."""
+
+    path: Path
+    n: int
+    size: np.ndarray
+    restitution: float
+    time: np.ndarray
+    cpp: np.ndarray
+    ke: np.ndarray  # translational KE per particle (mean flow included)
+    eq_end: float
+    modes: Modes
+    halves: tuple[Modes, Modes]
+    series_cpp: np.ndarray
+    drifts: list[Drift]
+    ke_halves: tuple[tuple[float, float], tuple[float, float]]
+    balance: tuple[float, float]  # dissipation rate / gravity power, error
+    peak: tuple[float, float]  # densest xy cell column (≈ 2 d) per frame, mean over frames
+    peak_coarse: tuple[float, float]  # the same on columns ≈ COARSE d wide
+    close_packed: float  # last frame: fraction of particles with 12 neighbours within 1.05 d
+    rate: float  # c/p per √(d/g) in the production
+    wall_seconds: float
+    tc_fraction: float  # pair collisions the engine's TC model made elastic (not in the thesis)
+    snapshot: Snapshot
+
+    @property
+    def end_cpp(self) -> float:
+        return float(self.cpp[-1])
+
+    @property
+    def eq_cpp(self) -> float:
+        return float(np.interp(self.eq_end, self.time, self.cpp))
+
+    @property
+    def stationary(self) -> bool:
+        """Modes stationary: the same class in both halves and no family drifting by more
+        than DRIFT_SIGMAS."""
+        same = self.halves[0].pattern == self.halves[1].pattern
+        return same and all(d.sigmas <= DRIFT_SIGMAS for d in self.drifts)
+
+    @property
+    def max_drift(self) -> Drift | None:
+        return max(self.drifts, key=lambda d: d.sigmas) if self.drifts else None
+
+    @property
+    def plateau(self) -> bool:
+        """KE of the two production halves equal within 2σ."""
+        (m1, e1), (m2, e2) = self.ke_halves
+        return abs(m2 - m1) <= 2.0 * float(np.hypot(e1, e2))
+
+    @property
+    def balanced(self) -> bool:
+        ratio, err = self.balance
+        return abs(ratio - 1.0) <= 2.0 * err
+
+
+def density_waves(size: np.ndarray) -> DensityWaves:
+    """The package's density-wave analysis on a channel of ``size`` (walls along y: the
+    centres reach y in [d/2, W - d/2], as ``demstudy analyze`` sets it), cells ≈ 2 d."""
+    return DensityWaves(dim=3, ranges=[None, (0.5, float(size[1]) - 0.5), None])
+
+
+def iter_frames(f: h5py.File, start: float) -> Iterator[Frame]:
+    """The stored frames from time ``start`` on, read one at a time (a 10^5-particle run
+    holds GBs of frames)."""
+    fr = f["frames"]
+    times = fr["time"][()]
+    for i in np.flatnonzero(times >= start):
+        yield Frame(time=float(times[i]), box_lo=fr["box_lo"][i], box_hi=fr["box_hi"][i],
+                    position=fr["position"][i], velocity=fr["velocity"][i],
+                    angular_velocity=np.zeros((0, 3)), radius=fr["radius"][i])
+
+
+def _blocked_means(samples: np.ndarray) -> tuple[float, float]:
+    acc = BlockAccumulator(1, 16)
+    for v in samples:
+        acc.add(np.array([v]))
+    est, err = jackknife(acc, lambda m: m)
+    return float(np.ravel(est)[0]), float(np.ravel(err)[0])
+
+
+def _energy_balance(ts: dict[str, np.ndarray], start: float) -> tuple[float, float]:
+    """Dissipation rate over gravity's power in the production, jackknife error over time
+    blocks (steady state: 1; digest §1.8 [L1088])."""
+    t = ts["time"]
+    keep = t >= start
+    rates = np.stack([np.diff(ts["gravity_work"][keep]), np.diff(ts["dissipated_energy"][keep])],
+                     axis=1) / np.diff(t[keep])[:, None]
+    if rates.shape[0] < 4:
+        return float("nan"), float("nan")
+    acc = BlockAccumulator(2, 16)
+    for row in rates:
+        acc.add(row)
+    est, err = jackknife(acc, lambda m: np.array([m[1] / m[0]]))
+    return float(np.ravel(est)[0]), float(np.ravel(err)[0])
+
+
+def _ke_halves(time: np.ndarray, ke: np.ndarray, start: float):
+    keep = np.flatnonzero(time >= start)
+    half = keep.size // 2
+    return (_blocked_means(ke[keep[:half]]), _blocked_means(ke[keep[half:]]))
+
+
+def _drifts(modes: Modes, halves: tuple[Modes, Modes]) -> list[Drift]:
+    """The two leading xy families and the leading xz and yz family, in both halves."""
+    picks = [("xy", k) for k in modes.leading("xy", 2)]
+    picks += [("xz", k) for k in modes.leading("xz", 1)]
+    # yz: the leading family varying along z (its (k_y, 0) families repeat xy's (0, k_y))
+    picks += [("yz", k) for k in modes.leading("yz", 5) if k[1] >= 1][:1]
+    return [Drift(p, k, halves[0].amplitude(p, k), halves[1].amplitude(p, k))
+            for p, k in picks]
+
+
+def plane_fields(frame: Frame, lo: np.ndarray, hi: np.ndarray, cells: np.ndarray,
+                 plane: str) -> tuple[np.ndarray, ...]:
+    """(centres a, centres b, solid fraction, u_a, u_b) of one frame on ``plane``: cell
+    columns averaged over the third axis, the velocity the mean over the particles of a
+    column minus the frame's mean velocity (NaN in empty columns)."""
+    a, b = _AX[plane[0]], _AX[plane[1]]
+    c = 3 - a - b
+    pos = np.asarray(frame.position, float)
+    vel = np.asarray(frame.velocity, float) - np.mean(frame.velocity, axis=0)
+    h = (hi - lo) / cells
+    idx = np.floor((pos - lo) / h).astype(np.int64)
+    idx[:, 0] %= cells[0]
+    idx[:, 2] %= cells[2]
+    inside = (idx[:, 1] >= 0) & (idx[:, 1] < cells[1])
+    na, nb = int(cells[a]), int(cells[b])
+    flat = idx[inside, a] * nb + idx[inside, b]
+    vol = np.pi / 6.0 * (2.0 * np.asarray(frame.radius, float)[inside]) ** 3
+    nu = np.bincount(flat, vol, na * nb) / (h[a] * h[b] * (hi[c] - lo[c]))
+    count = np.bincount(flat, minlength=na * nb).astype(float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ua = np.bincount(flat, vel[inside, a], na * nb) / count
+        ub = np.bincount(flat, vel[inside, b], na * nb) / count
+    ca = lo[a] + (np.arange(na) + 0.5) * h[a]
+    cb = lo[b] + (np.arange(nb) + 0.5) * h[b]
+    return ca, cb, nu.reshape(na, nb), ua.reshape(na, nb), ub.reshape(na, nb)
+
+
+def _scan(f: h5py.File, eq_end: float, size: np.ndarray):
+    """One pass over the production frames: the mode analysis of the whole production and
+    of each half, the peak densities per frame (2 d and COARSE d columns), the last frame."""
+    whole, halves = density_waves(size), (density_waves(size), density_waves(size))
+    times = f["frames/time"][()]
+    prod = times[times >= eq_end]
+    split = prod[len(prod) // 2] if len(prod) else eq_end
+    last, peaks = None, []
+    for frame in iter_frames(f, eq_end):
+        whole.feed(frame)
+        halves[int(frame.time >= split)].feed(frame)
+        coarse = np.maximum(2, np.round(whole.length / COARSE)).astype(int)
+        peaks.append([float(np.max(plane_fields(frame, whole.lo, whole.hi, grid, "xy")[2]))
+                      for grid in (whole.n, coarse)])
+        last = frame
+    if last is None or whole.n_frames < 4 or min(h.n_frames for h in halves) < 2:
+        raise ValueError(f"{f.filename}: {whole.n_frames} frames in the production (t >= "
+                         f"{eq_end}); the mode analysis needs at least 4 (keep_frames = true)")
+    return whole, halves, np.array(peaks), last
+
+
+def measure(path: Path) -> RunWaves:
+    """Measure one results file (module docstring)."""
+    with h5py.File(path, "r") as f:
+        attrs = read_attrs(f)
+        ts = {k: v[()] for k, v in f["timeseries"].items()}
+        n = int(f["frames/position"].shape[1])
+        size = f["frames/box_hi"][0] - f["frames/box_lo"][0]
+        eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
+        whole, halves, peaks, last = _scan(f, eq_end, size)
+    time = ts["time"]
+    cpp = 2.0 * ts["collisions"] / n
+    ke = ts["kinetic_energy"] / n
+    modes = Modes(*_finish(whole))
+    both = (Modes(*_finish(halves[0])), Modes(*_finish(halves[1])))
+    keep = time >= eq_end
+    rate = float(np.ptp(cpp[keep]) / np.ptp(time[keep])) if keep.sum() > 1 else float("nan")
+    lo, hi = np.asarray(whole.attrs["lo"], float), np.asarray(whole.attrs["hi"], float)
+    cells = np.asarray(whole.attrs["cells"], int)
+    snap = Snapshot(last.time, float(np.interp(last.time, time, cpp)),
+                    np.asarray(last.position, float),
+                    {p: plane_fields(last, lo, hi, cells, p) for p in PLANES})
+    return RunWaves(
+        path=Path(path), n=n, size=np.asarray(size, float),
+        restitution=_scene_restitution(attrs), time=time, cpp=cpp, ke=ke, eq_end=eq_end,
+        modes=modes, halves=both, series_cpp=np.interp(modes.results["series_time"], time, cpp),
+        drifts=_drifts(modes, both), ke_halves=_ke_halves(time, ke, eq_end),
+        balance=_energy_balance(ts, eq_end), peak=_blocked_means(peaks[:, 0]),
+        peak_coarse=_blocked_means(peaks[:, 1]),
+        close_packed=close_packed_fraction(last.position, np.asarray(size, float)), rate=rate,
+        wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
+        tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap)
+
+
+def close_packed_fraction(position: np.ndarray, size: np.ndarray) -> float:
+    """Fraction of the particles with at least 12 neighbours closer than 1.05 d (x and z
+    periodic): an FCC/HCP-like, touching shell, the signature of a close-packed core."""
+    from scipy.spatial import cKDTree
+
+    pos = np.array(position, float)
+    pos[:, 0] %= size[0]
+    pos[:, 2] %= size[2]
+    tree = cKDTree(pos, boxsize=[size[0], 1e9, size[2]])
+    counts = np.array([len(n) - 1 for n in tree.query_ball_point(pos, 1.05)])
+    return float(np.mean(counts >= 12))
+
+
+def _finish(analysis: DensityWaves) -> tuple[dict, dict]:
+    analysis.finish()
+    return analysis.results, analysis.attrs
+
+
+def _scene_restitution(attrs: dict[str, Any]) -> float:
+    try:
+        return float(tomllib.loads(attrs["scene_toml"])["contact"]["restitution"])
+    except (KeyError, ValueError, TypeError):
+        return float("nan")

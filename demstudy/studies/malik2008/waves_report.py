@@ -1,0 +1,328 @@
+"""The density-wave part's checks, figures and report sections (see waves.py): per run the
+structure class against what the thesis reports (where the digest says), the steady state
+(energy balance, KE plateau, stationary Fourier modes), and the phase diagrams (Figs
+5.25-5.27). A run missing gives "not run" checks with a forecast, never an error.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts): times in √(d/g); time in
+the thesis is collisions per particle, here c/p = 2 N_pair / N.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ...errors import BadInputFile
+from ..base import (
+    NOT_REPRODUCED,
+    NOT_RUN,
+    PARTLY,
+    REPRODUCED,
+    Analysis,
+    Check,
+    Figure,
+    pm,
+)
+from .waves_boxes import BOXES, BRIEF, QUICK, RESTITUTION, THESIS, Box
+from .waves_figures import phase_figure, run_figure
+from .waves_measure import COARSE, DRIFT_SIGMAS, RunWaves, measure
+
+#: CPU seconds per particle per √(d/g), measured on this machine (N = 600 box, steady
+#: state, one core): the forecast of a run missing when no run of this analysis gives one
+COST_PER_PARTICLE_TIME = 2.0e-5
+STEADY_REF = "[L1088], [L1149]-[L1159] (digest §1.8)"
+
+
+def _boxes(quick: bool) -> list[Box]:
+    return [b for b in BOXES if not quick or (b.tag in QUICK and b.restitution == RESTITUTION)]
+
+
+def _duration(box: Box, quick: bool) -> float:
+    """The case's run length in √(d/g) (equilibration + production)."""
+    from .waves import cases
+
+    case = next(c for c in cases(quick) if c.name == box.name)
+    run = case.load(quick).run
+    return float(run.equilibration + run.production)
+
+
+def _forecast(box: Box, quick: bool, cost: float) -> str:
+    seconds = cost * box.n * _duration(box, quick)
+    text = f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
+    return (f"forecast ≈ {text} on one core ({cost:.1e} s per particle per √(d/g), the "
+            f"slowest measured here, × N × "
+            f"{_duration(box, quick):.0f} √(d/g); `demstudy study malik2008 --only "
+            f"{box.name} --dry-run` gives the engine's own)")
+
+
+def _modes_text(run: RunWaves) -> str:
+    parts = []
+    for plane in ("xy", "xz", "yz"):
+        dom = run.modes.dominant(plane)
+        parts.append(f"{plane} {', '.join(str(k) for k in dom) if dom else 'none'}")
+    lead = run.modes.leading("xy", 1)
+    amp = run.modes.amplitude("xy", lead[0]) if lead else (float("nan"), float("nan"))
+    moving = [k for k in run.modes.dominant("xy") if k[0] >= 1]
+    ratio = ""
+    if moving and (0, 1) in run.modes.dominant("xy"):
+        a_x, e_x = run.modes.amplitude("xy", moving[0])
+        a_y, e_y = run.modes.amplitude("xy", (0, 1))
+        ratio = (f"; x-modulation A{moving[0]}/A(0, 1) = "
+                 f"{pm(a_x / a_y, a_x / a_y * float(np.hypot(e_x / a_x, e_y / a_y)))}")
+    return (f"dominant families: {'; '.join(parts)}; leading xy {lead[0] if lead else '-'} "
+            f"amplitude {pm(*amp)}{ratio}")
+
+
+def _stationary_text(run: RunWaves) -> str:
+    worst = run.max_drift
+    drift = (f"largest drift {worst.sigmas:.1f}σ ({worst.plane} {worst.k}: "
+             f"{pm(*worst.first)} → {pm(*worst.second)})" if worst else "no modes")
+    halves = " / ".join(h.pattern for h in run.halves)
+    return (f"modes {'stationary' if run.stationary else 'NOT stationary'} over "
+            f"{run.eq_cpp:.0f}-{run.end_cpp:.0f} c/p (halves: {halves}; {drift})")
+
+
+def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
+    """The structure class of ``box`` against the thesis's (digest) where known."""
+    ref = (f"Fig {box.fig} (N = {box.n}, L/W = {box.aspect:.2g}, W/d = {box.width}, "
+           f"H/d = {box.height}, e = {box.restitution:g}); digest §4.11")
+    thesis = THESIS.get(box.fig)
+    brief = BRIEF.get(box.fig)
+    thesis_text = (thesis.text if thesis else
+                   f"not in the digest (the task brief reads it as {brief})" if brief else
+                   "not in the digest")
+    statement = "steady density structure (plug, S-wave, slug, ...) of this box"
+    if run is None:
+        return Check(ref, statement, thesis_text, "not run", NOT_RUN, missing)
+    measured = f"{run.modes.pattern}; {_modes_text(run)}; {_stationary_text(run)}"
+    found = run.modes.pattern.split(" ")[0]
+    if thesis:
+        if found != thesis.cls:
+            return Check(ref, statement, thesis_text, measured, NOT_REPRODUCED,
+                         f"demstudy finds {found}, the thesis {thesis.cls}; run to "
+                         f"{run.end_cpp:.0f} c/p" + ("" if run.stationary else
+                                                     ", modes still drifting"))
+        if not run.stationary:
+            return Check(ref, statement, thesis_text, measured, PARTLY,
+                         "same class, but the modes are not stationary")
+        return Check(ref, statement, thesis_text, measured, REPRODUCED)
+    why = "thesis class not in the digest"
+    if brief:
+        why += (f"; the task brief's reading ({brief}) "
+                f"{'agrees' if found == brief else 'differs: demstudy finds ' + found}")
+    if not run.stationary:
+        why += "; the modes are not stationary (class of a transient)"
+    return Check(ref, statement, thesis_text, measured, PARTLY, why)
+
+
+def steady_check(box: Box, run: RunWaves) -> Check:
+    """Energy balance, KE plateau and stationary modes in the production of ``run``."""
+    ratio, err = run.balance
+    (m1, e1), (m2, e2) = run.ke_halves
+    measured = (f"dissipation / gravity power = {pm(ratio, err)}; KE/N halves {pm(m1, e1)} → "
+                f"{pm(m2, e2)} m g d; {_stationary_text(run)}; {run.rate:.1f} c/p per √(d/g)")
+    statement = (f"N = {box.n} ({box.tag}, e = {box.restitution:g}): steady state, gravity's "
+                 "input balances dissipation and the KE levels off; a plateau alone is not "
+                 "enough, the Fourier modes must be stationary")
+    thesis = "balance = 1; KE plateau; stationary modes"
+    if not run.balanced:
+        return Check(STEADY_REF, statement, thesis, measured, NOT_REPRODUCED,
+                     "input and dissipation do not balance within 2σ: the production starts "
+                     "before the steady state (longer equilibration needed)")
+    if not run.plateau:
+        return Check(STEADY_REF, statement, thesis, measured, PARTLY,
+                     "energy balance holds but the KE of the two halves differs by > 2σ")
+    if not run.stationary:
+        return Check(STEADY_REF, statement, thesis, measured, PARTLY,
+                     f"energy balanced and KE on a plateau, but a mode drifts by > "
+                     f"{DRIFT_SIGMAS:g}σ or the class changes between the halves: the "
+                     "structure has not settled (the thesis's warning, N = 50094)")
+    return Check(STEADY_REF, statement, thesis, measured, REPRODUCED)
+
+
+def _series_check(ref: str, statement: str, boxes: Sequence[Box],
+                  measured: Mapping[str, RunWaves]) -> Check:
+    """Figs 5.26/5.27: classes along a series; the digest gives none of the thesis's."""
+    found = [f"{b.tag} e = {b.restitution:g}: {measured[b.name].modes.pattern}"
+             for b in boxes if b.name in measured]
+    if not found:
+        return Check(ref, statement, "not in the digest", "not run", NOT_RUN,
+                     "none of the series' runs made: " + ", ".join(b.name for b in boxes))
+    missing = [b.tag + (f" e = {b.restitution:g}" if b.restitution != RESTITUTION else "")
+               for b in boxes if b.name not in measured]
+    return Check(ref, statement, "not in the digest", "; ".join(found), PARTLY,
+                 "thesis classes not in the digest" +
+                 (f"; not run: {', '.join(missing)}" if missing else ""))
+
+
+def peak_check(measured: Mapping[str, RunWaves]) -> Check:
+    """The densest cells of the structures against the thesis's colour bars (≈ 0.58): the
+    thesis's cells are not stated, so the peak is given on two grids (≈ 2 d and ≈ 5 d)."""
+    ref = "Ch. 5 colour bars (digest §3.4, §6)"
+    statement = "dense plugs and slugs reach a local solid fraction of about 0.58"
+    if not measured:
+        return Check(ref, statement, "≈ 0.58", "not run", NOT_RUN, "no run made")
+    name, run = max(measured.items(), key=lambda item: item[1].peak_coarse[0])
+    fine, coarse = run.peak, run.peak_coarse
+    text = (f"densest cell column of the xy plane (depth-averaged), mean over the production "
+            f"frames, {name}: {pm(*fine)} on 2 d cells, {pm(*coarse)} on {COARSE:g} d cells "
+            f"({100 * run.close_packed:.1f} % of its particles have 12 neighbours within "
+            "1.05 d in the last frame); "
+            "others (2 d / 5 d): " + "; ".join(
+                f"{n.split('-')[2]} {pm(*r.peak)} / {pm(*r.peak_coarse)}"
+                for n, r in measured.items() if n != name))
+    lo = min(fine[0], coarse[0]) - 2 * max(fine[1], coarse[1]) - 0.03
+    hi = max(fine[0], coarse[0]) + 2 * max(fine[1], coarse[1]) + 0.03
+    cells = ("the thesis's cells (N1 × N2 × N3) are not stated and the peak depends on them "
+             f"({pm(*fine)} on 2 d, {pm(*coarse)} on {COARSE:g} d columns)")
+    if lo <= 0.58 <= hi:
+        return Check(ref, statement, "≈ 0.58", text, PARTLY,
+                     "0.58 lies within the range of the two grids (± 2σ + 0.03, the colour "
+                     "bar's reading), but " + cells)
+    packed = (f"; {100 * run.close_packed:.1f} % of the particles of {name} touch 12 "
+              "neighbours (a close-packed, FCC/HCP-like core; random close packing is 0.64): "
+              "the clump compacts beyond the thesis's, possibly helped by the engine's TC "
+              "model (elastic pair collisions within t_c = 10⁻⁵, absent from the thesis) and "
+              "sampled far later (production from "
+              f"{run.eq_cpp:.0f} c/p, the thesis's snapshots ≤ 14000)"
+              if run.close_packed > 0.01 else "")
+    return Check(ref, statement, "≈ 0.58", text, NOT_REPRODUCED,
+                 "0.58 lies outside the range of the two grids (± 2σ + 0.03); " + cells +
+                 packed)
+
+
+def _run_table(measured: Mapping[str, RunWaves]) -> str:
+    head = ("| case | N | c/p analysed | c/p per √(d/g) | class | dominant xy | stationary | "
+            "max drift | dissipation/input | peak ν (2 d / 5 d cells) | close-packed | "
+            "TC elastic fraction | wall s |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    rows = []
+    for name, run in measured.items():
+        worst = run.max_drift
+        drift = f"{worst.sigmas:.1f}σ {worst.plane} {worst.k}" if worst else "-"
+        rows.append(
+            f"| {name} | {run.n} | {run.eq_cpp:.0f}-{run.end_cpp:.0f} | {run.rate:.1f} | "
+            f"{run.modes.pattern} | {', '.join(str(k) for k in run.modes.dominant('xy'))} | "
+            f"{'yes' if run.stationary else 'no'} | {drift} | {pm(*run.balance)} | "
+            f"{pm(*run.peak)} / {pm(*run.peak_coarse)} | {100 * run.close_packed:.1f} % | "
+            f"{run.tc_fraction:.1e} | {run.wall_seconds:.0f} |")
+    return head + "\n".join(rows)
+
+
+METHOD = """\
+**Time.** The thesis measures time in collisions per particle (c/p) without defining it
+(digest §1.6, §9.15); here c/p = 2 N_pair / N, each pair collision counted for both
+partners, wall collisions apart (had the thesis counted N_pair / N, its 14000 c/p would be
+our 28000). Once
+the energy plateaus (≈ 100 √(d/g)) the W = 15 boxes make 10 (N = 600, a plug) to 43
+(N = 4800, L/W = 5, a slug) c/p per √(d/g) (measured, the table's column): the W = 15
+scenes' equilibration of 1000 √(d/g) therefore covers ≈ 1-6 × 10^4 c/p, beyond the thesis's
+snapshots (4000-14000 c/p), and their production of 3000 √(d/g) ≈ 3-13 × 10^4 c/p more
+(frames are kept in the production only: the structure at the thesis's snapshot times is
+not sampled, only the KE trace). The
+W = 30 and W = 50 scenes keep the shipped lengths (2000 + 4000 and 3000 + 5000 √(d/g));
+their rates are measured when they run (the table).
+
+**Modes.** demstudy.analysis.waves.DensityWaves over the production frames: cells of ≈ 2 d,
+each plane (xy, xz, yz) the depth average over the third axis, Malik's P = 2 X conj(X) /
+(N1 N2)², integer harmonics, the ± modes summed into families (|k_a|, |k_b|), mean over the
+frames with jackknife errors. A family is dominant when its power exceeds 20 × the median
+(noise floor) per member and 3 errors. Class (xy plane): no dominant family → none; only
+k_x = 0 families → plug ((0,1)); x-varying families mostly antisymmetric about the
+centreline → s-wave ((1,1), (2,1)); mostly symmetric → slug ((0,1) + (1,0)); otherwise mixed
+(wavy slug, sandwich); "+ z" when the xz or yz plane has a dominant family varying along z.
+The yz plane's families are written (k_y, k_z) throughout (the thesis switches, digest §9.13).
+
+**Stationarity.** The analysis is repeated on each half of the production: the class must
+be the same and the amplitudes of the two leading xy families, the leading xz family and the
+leading z-varying yz family must agree within 2σ; the kinetic energy of the halves must
+agree within 2σ, and the dissipation rate must equal gravity's power within 2σ (block
+jackknife errors). The engine's TC model (Luding & McNamara, t_c = 10⁻⁵ √(d/g)) makes a
+small fraction of pair collisions elastic (column): a deviation from the thesis's model,
+which has none.
+
+**Peak density.** The densest cell column of the xy plane in each production frame (mean
+over the frames), on the 2 d grid and on ≈ 5 d columns, since the thesis's cells are not
+stated; and in the last frame the fraction of particles with 12 neighbours closer than
+1.05 d (a touching FCC/HCP-like shell: a close-packed core).
+"""
+
+
+def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
+    """Checks, figures and sections of the density-wave part (module docstring)."""
+    ana = Analysis()
+    boxes = _boxes(quick)
+    measured: dict[str, RunWaves] = {}
+    failed: dict[str, str] = {}
+    for box in boxes:
+        path = runs.get(box.name)
+        if path is None:
+            continue
+        try:
+            measured[box.name] = measure(Path(path))
+        except (OSError, KeyError, ValueError, BadInputFile) as exc:
+            failed[box.name] = f"results file unreadable for the mode analysis: {exc}"
+    costs = [r.wall_seconds / (r.n * r.time[-1]) for r in measured.values()
+             if np.isfinite(r.wall_seconds) and r.time[-1] > 0]
+    cost = max(costs) if costs else COST_PER_PARTICLE_TIME
+    for box in boxes:
+        run = measured.get(box.name)
+        if run is None:
+            ana.checks.append(class_check(box, None, failed.get(box.name) or
+                                          "run missing; " + _forecast(box, quick, cost)))
+            continue
+        ana.checks.append(class_check(box, run))
+        ana.checks.append(steady_check(box, run))
+        path = run_figure(run, box, out / f"{box.name.removesuffix('-edmd')}.png")
+        ana.figures.append(Figure(path, f"Fig {box.fig}'s form: N = {box.n} in {box.tag}, "
+                                        f"e = {box.restitution:g}: positions, density "
+                                        "contours with velocity vectors, power spectra, KE "
+                                        "and mode amplitudes against collisions per "
+                                        "particle (class " + run.modes.pattern + ")"))
+    diagram = [b for b in boxes if b.restitution == RESTITUTION and b.height == b.width]
+    ana.checks.append(peak_check(measured))
+    ana.checks += _phase_checks(boxes, diagram, measured)
+    thesis = [(b, THESIS[b.fig].cls, "digest") for b in diagram if b.fig in THESIS]
+    thesis += [(b, BRIEF[b.fig], "brief") for b in diagram if b.fig in BRIEF]
+    path = phase_figure([(b, measured[b.name].modes.pattern) for b in diagram
+                         if b.name in measured],
+                        [b for b in diagram if b.name not in measured], thesis,
+                        out / "waves-phase-diagram.png")
+    ana.figures.append(Figure(path, "Fig 5.25's form: the structure class of each box over "
+                                    "(L/W, W/d), demstudy (filled) and the thesis where the "
+                                    "digest or the brief gives it (rings); × not run"))
+    ana.sections.append(("Density waves (Malik Ch. 5): method", METHOD))
+    if measured:
+        ana.sections.append(("Density waves: the runs", _run_table(measured)))
+    return ana
+
+
+def _phase_checks(boxes: Sequence[Box], diagram: Sequence[Box],
+                  measured: Mapping[str, RunWaves]) -> list[Check]:
+    checks = []
+    if diagram:
+        found = [f"{b.tag}: {measured[b.name].modes.pattern}" for b in diagram
+                 if b.name in measured]
+        ref = "Fig 5.25 [L1465] (digest §7)"
+        statement = "phase diagram of the steady structures over (L/W, W/d), e = 0.7, H = W"
+        if found:
+            checks.append(Check(ref, statement, "classes not in the digest, except N = 50094 "
+                                "(L/W = 1.4, W/d = 50): slug", "; ".join(found), PARTLY,
+                                f"{len(found)} of {len(diagram)} boxes run; the thesis's "
+                                "classes are not in the digest (one box excepted)"))
+        else:
+            checks.append(Check(ref, statement, "not in the digest", "not run", NOT_RUN,
+                                "no box of the diagram run"))
+    tall = [b for b in boxes if b.length == 150 and b.width == 50
+            and b.restitution == RESTITUTION]
+    if tall:
+        checks.append(_series_check("Fig 5.26 [L1475]", "structures against H/W (L/W = 3, "
+                                    "W/d = 50; H/d = 10, 50, 150)", tall, measured))
+    e_series = [b for b in boxes if b.tag == "L150W50H50"]
+    if e_series:
+        checks.append(_series_check("Fig 5.27 [L1479]; Figs 5.13, 5.23, 5.24",
+                                    "structures against e (L/W = 3, W/d = H/d = 50; e = "
+                                    "0.7, 0.9, 0.99)", e_series, measured))
+    return checks

@@ -1,0 +1,228 @@
+"""The density-wave part of ``demstudy study malik2008`` (Malik 2008, Ch. 5): its cases are
+the thesis's boxes exactly, the classifier gives the classes of analytic density fields, and
+a study without its runs reports "not run" instead of failing.
+
+Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from demstudy.io.frames import Frame
+from demstudy.studies.base import NOT_RUN, VERDICTS
+from demstudy.studies.malik2008 import STUDY, waves
+from demstudy.studies.malik2008.waves_measure import density_waves
+from demstudy.studies.malik2008.waves_report import analyse_waves
+
+#: the thesis's table (digest §1.5): N, L, W, H of every Ch. 5 box
+THESIS_TABLE = {(600, 9, 15, 15), (4800, 18, 30, 30), (22000, 30, 50, 50), (1400, 21, 15, 15),
+                (10800, 42, 30, 30), (50094, 70, 50, 50), (3000, 45, 15, 15),
+                (24000, 90, 30, 30), (107811, 150, 50, 50), (4800, 75, 15, 15),
+                (40000, 150, 30, 30), (180000, 250, 50, 50), (21952, 150, 50, 10),
+                (323433, 150, 50, 150)}
+
+
+def _box_of(scene) -> tuple[int, int, int, int]:
+    size = tuple(int(round(v)) for v in scene.box.size)
+    assert all(math.isclose(v, round(v)) for v in scene.box.size)
+    return (scene.particles.count, *size)
+
+
+def test_cases_are_the_thesis_boxes_with_its_collision_parameters() -> None:
+    cases = waves.cases(False)
+    scenes = {c.name: c.load() for c in cases}  # every scene validates
+    e07 = {n: s for n, s in scenes.items() if s.contact.restitution == 0.7}
+    assert {_box_of(s) for s in e07.values()} == THESIS_TABLE
+    assert len(e07) == len(THESIS_TABLE)
+    study = [(_box_of(s), s.contact.restitution) for s in scenes.values()
+             if s.contact.restitution != 0.7]
+    assert sorted(study) == [((107811, 150, 50, 50), 0.9), ((107811, 150, 50, 50), 0.99)]
+    for scene in scenes.values():
+        assert scene.contact.tangential.beta == 0.1
+        assert [w.restitution for w in scene.walls] == [0.99, 0.99]
+        assert [w.tangential.beta for w in scene.walls] == [0.99, 0.99]
+        assert tuple(scene.gravity.direction) == (1.0, 0.0, 0.0)
+        assert scene.measure.keep_frames
+        n, length, width, height = _box_of(scene)
+        assert 0.148 < n * math.pi / 6 / (length * width * height) < 0.156  # φ ≈ 0.15
+
+
+def test_case_names_unique_and_the_background_run_reused() -> None:
+    names = [c.name for c in STUDY.cases(False)]
+    assert len(set(names)) == len(names)
+    big = [c for c in waves.cases(False) if c.name == "waves-phi0.15-L150W50H50-edmd"]
+    assert big and big[0].scene == "malik2008/waves-phi0.15-L150W50H50"
+    assert (big[0].engine, dict(big[0].sections), dict(big[0].options)) == ("edmd", {}, {})
+    for case in waves.cases(False):
+        scene = case.load()
+        e = "" if scene.contact.restitution == 0.7 else f"-e{scene.contact.restitution:g}"
+        n, length, width, height = _box_of(scene)
+        assert case.name == f"waves-phi0.15-L{length}W{width}H{height}{e}-edmd"
+
+
+def test_quick_subset_is_small_and_short() -> None:
+    quick = waves.cases(True)
+    assert 1 <= len(quick) <= 2 and all(c.quick for c in quick)
+    for case in quick:
+        scene = case.load(quick=True)
+        assert scene.box.size[1] == 15 and scene.particles.count <= 3000
+        assert scene.run.equilibration + scene.run.production <= 300
+        # enough production frames for the halves' stationarity test
+        assert scene.run.production / scene.run.sample_interval >= 20
+
+
+# -- the classifier on analytic density fields -----------------------------------------
+SIZE = np.array([45.0, 15.0, 15.0])
+Y_LO, Y_HI = 0.5, 14.5
+Y_C = 0.5 * (Y_LO + Y_HI)
+
+
+def _frames(density, n: int = 4000, frames: int = 12, seed: int = 1):
+    """Frames of ``n`` centres drawn (rejection) from ``density(x, y)`` (max ≤ 1)."""
+    rng = np.random.default_rng(seed)
+    for i in range(frames):
+        pos = np.empty((0, 3))
+        while pos.shape[0] < n:
+            trial = rng.uniform([0, Y_LO, 0], [SIZE[0], Y_HI, SIZE[2]], size=(4 * n, 3))
+            keep = rng.uniform(size=4 * n) < density(trial[:, 0], trial[:, 1])
+            pos = np.vstack([pos, trial[keep]])
+        pos = pos[:n]
+        yield Frame(time=float(i), box_lo=np.zeros(3), box_hi=SIZE, position=pos,
+                    velocity=np.zeros((n, 3)), angular_velocity=np.zeros((n, 3)),
+                    radius=np.full(n, 0.5))
+
+
+def _pattern(density) -> str:
+    analysis = density_waves(SIZE)
+    return analysis.run(_frames(density)).attrs["pattern"]
+
+
+def _blob(x, y, x0, y0, sx=4.0, sy=2.0):
+    dx = (x - x0 + 0.5 * SIZE[0]) % SIZE[0] - 0.5 * SIZE[0]  # periodic along x
+    return np.exp(-0.5 * (dx / sx) ** 2 - 0.5 * ((y - y0) / sy) ** 2)
+
+
+def test_classifier_plug() -> None:
+    # dense core at the centreline, uniform along the flow: Malik's (0, 1)
+    assert _pattern(lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)) == "plug"
+
+
+def test_classifier_s_wave() -> None:
+    # dense on one side of the centreline facing dilute on the other, alternating along x
+    def s_wave(x, y):
+        return 0.1 + 0.9 * np.maximum(_blob(x, y, 0.25 * SIZE[0], Y_C + 3.5),
+                                      _blob(x, y, 0.75 * SIZE[0], Y_C - 3.5))
+    assert _pattern(s_wave) == "s-wave"
+
+
+def test_classifier_slug() -> None:
+    # one dense clump on the centreline, localised along x: (0, 1) + (1, 0)
+    assert _pattern(lambda x, y: 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)) == "slug"
+
+
+def test_classifier_homogeneous_gas_has_no_structure() -> None:
+    assert _pattern(lambda x, y: np.ones_like(x)) == "none"
+
+
+# -- missing runs ----------------------------------------------------------------------
+@pytest.mark.parametrize("quick", [True, False])
+def test_missing_runs_give_not_run_checks(tmp_path: Path, quick: bool) -> None:
+    ana = analyse_waves({}, tmp_path, quick)
+    boxes = {c.name for c in waves.cases(quick)}
+    per_box = [c for c in ana.checks if c.ref.startswith("Fig 5.") and "digest §4.11" in c.ref]
+    assert len(per_box) == len(boxes)
+    assert all(c.verdict == NOT_RUN and "forecast" in c.reason for c in per_box)
+    assert all(c.verdict in VERDICTS for c in ana.checks)
+    assert not any(c.verdict != NOT_RUN for c in ana.checks)
+    assert (tmp_path / "waves-phase-diagram.png").is_file()
+
+
+def test_unreadable_run_is_not_run(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.h5"
+    bad.write_bytes(b"not hdf5")
+    name = waves.cases(True)[0].name
+    ana = analyse_waves({name: bad}, tmp_path, True)
+    row = ana.checks[0]
+    assert "N = 600" in row.ref
+    assert row.verdict == NOT_RUN and "unreadable" in row.reason
+
+
+def test_spin_up_run_is_not_steady(tmp_path: Path) -> None:
+    """A short run of the N = 600 box stops while gravity still accelerates the flow (the KE
+    levels off after ≈ 100 √(d/g)): gravity's input exceeds the dissipation, and the steady
+    check must say so rather than call it steady."""
+    from demstudy.api import run
+    from demstudy.scene import load_scene
+    from demstudy.studies.base import NOT_REPRODUCED
+    from demstudy.studies.malik2008.waves_measure import measure
+
+    case = waves.cases(True)[0]
+    scene = load_scene(case.scene, run={"equilibration": 10.0, "production": 16.0,
+                                        "sample_interval": 1.0})
+    path = tmp_path / f"{case.name}.h5"
+    run(scene, engine="edmd", out=path, progress=False)
+    measured = measure(path)
+    ratio, err = measured.balance
+    assert ratio + 2 * err < 1.0  # input > dissipation while the flow accelerates
+    assert measured.ke_halves[1][0] > measured.ke_halves[0][0]
+    ana = analyse_waves({case.name: path}, tmp_path, True)
+    steady = next(c for c in ana.checks if c.ref.startswith("[L1088]"))
+    assert steady.verdict == NOT_REPRODUCED
+    assert ana.checks[0].verdict != NOT_RUN
+    assert (tmp_path / f"{case.name.removesuffix('-edmd')}.png").is_file()
+
+
+# -- stationarity is judged on the modes, not on the energy ----------------------------
+def _synthetic_run(path: Path, second_half) -> Path:
+    """A results file whose energy is flat and balanced (input = dissipation) throughout,
+    with 40 production frames: a plug, then ``second_half`` for the last 20."""
+    import h5py
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    frames = list(_frames(plug, frames=20, seed=2)) + list(_frames(second_half, frames=20,
+                                                                   seed=3))
+    n = frames[0].n
+    t = np.arange(0.0, 61.0)  # equilibration to 20, frames at 21..60
+    rng = np.random.default_rng(4)
+    with h5py.File(path, "w") as f:
+        f.attrs["equilibration_end"] = 20.0
+        ts = f.create_group("timeseries")
+        ts["time"] = t
+        ts["collisions"] = (5.0 * n * t).astype(np.int64)
+        ts["kinetic_energy"] = n * (100.0 + rng.normal(0, 0.5, t.size))
+        ts["gravity_work"] = 50.0 * n * t
+        ts["dissipated_energy"] = 50.0 * n * t + rng.normal(0, 0.5 * n, t.size)
+        fr = f.create_group("frames")
+        fr["time"] = t[21:]
+        fr["position"] = np.stack([fr_.position for fr_ in frames])
+        fr["velocity"] = np.zeros((40, n, 3))
+        fr["radius"] = np.full((40, n), 0.5)
+        fr["box_lo"] = np.zeros((40, 3))
+        fr["box_hi"] = np.tile(SIZE, (40, 1))
+    return path
+
+
+def test_plug_turning_into_slug_is_not_steady_though_energy_is(tmp_path: Path) -> None:
+    from demstudy.studies.base import PARTLY, REPRODUCED
+    from demstudy.studies.malik2008.waves_boxes import BOXES
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import steady_check
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    box = next(b for b in BOXES if b.tag == "L45W15H15")
+    changing = measure(_synthetic_run(tmp_path / "changing.h5", slug))
+    assert changing.balanced and changing.plateau  # the energy says steady
+    assert [h.pattern for h in changing.halves] == ["plug", "slug"]
+    assert not changing.stationary
+    assert steady_check(box, changing).verdict == PARTLY
+    steady = measure(_synthetic_run(tmp_path / "steady.h5", plug))
+    assert steady.stationary and steady.modes.pattern == "plug"
+    assert steady_check(box, steady).verdict == REPRODUCED
