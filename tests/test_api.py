@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -78,28 +79,68 @@ def test_a_native_crash_in_an_isolated_run_is_an_exception(tmp_path, monkeypatch
     assert ballistic.attrs["engine"] == "crashing"
 
 
-def test_an_interrupt_of_the_caller_alone_stops_the_isolated_run_after_a_checkpoint(tmp_path):
+# the caller's patched ``wait`` and the child's first stop check leave marker files, so the
+# test interrupts exactly when the caller waits for a running loop (no guessed delay: a set-up
+# slowed by load was interrupted before the child existed)
+MARKED_RUN = """
+import sys
+from pathlib import Path
+import demstudy as ds
+import demstudy.simulation.isolation as iso
+import demstudy.simulation.schedule as sch
+from demstudy.errors import RunStopped
+
+wait, check = iso._Forked.wait, sch.StopRequest.check
+
+def waiting(self, timeout=None):
+    Path("caller-waits").touch()
+    return wait(self, timeout)
+
+def checking(self):
+    Path("loop-runs").touch()
+    return check(self)
+
+iso._Forked.wait, sch.StopRequest.check = waiting, checking
+try:
+    ds.run('shear/lees-edwards-3d', engine='edmd', out='s.h5', progress=False)
+except RunStopped:
+    print('stopped')
+"""
+
+
+@pytest.mark.parametrize("inherited", ["default", "ignored"])
+def test_an_interrupt_of_the_caller_alone_stops_the_isolated_run_after_a_checkpoint(
+        tmp_path, inherited):
     """A notebook's interrupt reaches only the kernel, not the engine's child: the caller
-    passes it on, the child checkpoints and stops, the caller gets RunStopped."""
+    passes it on, the child checkpoints and stops, the caller gets RunStopped. Also when the
+    caller inherited SIGINT ignored (a background job of a script or CI step), where it was
+    lost and the run went on to its end."""
     import signal
     import subprocess
     import sys
     import time
 
-    code = ("import demstudy as ds\n"
-            "from demstudy.errors import RunStopped\n"
-            "try:\n"
-            "    ds.run('shear/lees-edwards-3d', engine='edmd', out='s.h5')\n"
-            "except RunStopped:\n"
-            "    print('stopped')\n")
-    proc = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, text=True,
+    ignore = (lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)) \
+        if inherited == "ignored" else None
+    proc = subprocess.Popen([sys.executable, "-c", MARKED_RUN], cwd=tmp_path, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            start_new_session=True)  # no terminal: signals reach it alone
-    time.sleep(4.0)  # the child is running (set-up takes about a second)
-    proc.send_signal(signal.SIGINT)
-    out, err = proc.communicate(timeout=120)
+                            start_new_session=True,  # no terminal: signals reach it alone
+                            preexec_fn=ignore)
+    try:
+        markers = [tmp_path / "caller-waits", tmp_path / "loop-runs"]
+        start = time.monotonic()
+        while not all(m.exists() for m in markers) and proc.poll() is None:
+            assert time.monotonic() - start < 120, "the run loop never started"
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
     assert out.strip() == "stopped", err[-2000:]
     assert (tmp_path / "s.edmd" / "checkpoint.pkl").exists()
+    assert not (tmp_path / "s.h5").exists()  # stopped, not finished
 
 
 def test_what_the_api_refuses_and_how(tmp_path, monkeypatch):

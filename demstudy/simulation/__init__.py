@@ -20,6 +20,7 @@ from .checkpoint import CHECKPOINT, saved_pilot
 from .loop import Simulation
 from .options import RunOptions, check_run, check_run_options, work_folder
 from .plan import RunPlan, plan_run
+from .schedule import interrupts_honoured
 from .state import RunState
 
 __all__ = ["RunOptions", "RunPlan", "RunState", "Simulation", "check_run",
@@ -30,7 +31,13 @@ def run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
     """Run ``scene`` in ``engine`` (a registered name or a backend class) and return the
     results file's path. Everything the engine cannot do is refused before it starts
     (``UnsupportedByEngine``); ``options.isolate`` or ``options.np > 1`` runs it in a child
-    process, where a crash becomes ``EngineError``."""
+    process, where a crash becomes ``EngineError``. Ctrl-C is honoured throughout, also
+    where this process inherited SIGINT ignored (:func:`interrupts_honoured`)."""
+    with interrupts_honoured():
+        return _run_scene(scene, engine, options)
+
+
+def _run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
     from ..engines import get_backend
     from .isolation import in_worker, launch_child
 

@@ -11,10 +11,9 @@ from __future__ import annotations
 import sys
 
 if __name__ == "__main__":
-    from .isolation import FAILED, worker
+    from .isolation import INTERRUPTED, worker
 
     try:
         sys.exit(worker(sys.argv[1]))
     except KeyboardInterrupt:  # before the engine's own handler (while importing, say)
-        print("error: interrupted before the run started", file=sys.stderr)
-        sys.exit(FAILED)
+        sys.exit(INTERRUPTED)  # the parent says so

@@ -3,7 +3,8 @@ code (a segfault, an MPI abort) ends the child and reaches the caller as an ``En
 
 ``python -m demstudy.simulation.child JOB.json`` is the child's entry point: exit 0 when
 done, 2 when the engine refused the run, 3 when it stopped after a checkpoint (Ctrl-C or the
-wall-clock limit), 1 on an engine error. On one rank the child is a fork of the caller when
+wall-clock limit), 4 when Ctrl-C came before the run loop's handler (nothing ran), 1 on an
+engine error. On one rank the child is a fork of the caller when
 that is safe (Linux, one thread, nothing loaded that a fork must not inherit: the backend's
 ``fork_safe``): it starts without a new interpreter, its imports, the job file and the
 scene's validation (~0.6 s of a LAMMPS run's start). Dimensionless particle units: d = 1,
@@ -30,7 +31,7 @@ from .options import RunOptions, work_folder
 from .schedule import stop_notice
 
 WORKER_FLAG = "DEMSTUDY_ENGINE_WORKER"
-FAILED, REFUSED, STOPPED = 1, 2, 3  # the child's exit codes
+FAILED, REFUSED, STOPPED, INTERRUPTED = 1, 2, 3, 4  # the child's exit codes
 
 __all__ = ["in_worker", "launch_child"]
 
@@ -78,21 +79,15 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     job = out.with_name(f".{out.name}.job.json")
     error = job.with_suffix(".error")
     error.unlink(missing_ok=True)
-    if can_fork(backend, options):  # the child gets the resolved paths, as from the job file
-        proc = _Forked(backend, scene, dataclasses.replace(
-            options, out=out, dump=Path(payload["dump"]) if payload["dump"] else None,
-            isolate=False), error)
-    else:
-        job.write_text(json.dumps(payload))
-        env = dict(os.environ, **{WORKER_FLAG: "1"})
-        cmd = [sys.executable, "-m", "demstudy.simulation.child", str(job)]
-        if options.np > 1:
-            cmd = [*backend.launcher(options.np), *cmd]
-        proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL,
-                                preexec_fn=_die_with_parent if sys.platform == "linux" else None)
+    proc = None
     try:
+        # inside the try: a Ctrl-C once the child exists is passed on to it (the fork holds
+        # SIGINT back until ``wait``), never left behind with a child running on
+        proc = _start_child(backend, scene, options, payload, job, error)
         returncode = proc.wait()
     except KeyboardInterrupt:
+        if proc is None:  # no child yet: nothing ran
+            raise
         print(stop_notice(backend.name), file=sys.stderr, flush=True)
         proc.send_signal(signal.SIGINT)  # a terminal's Ctrl-C reached it already: harmless
         try:
@@ -113,6 +108,9 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     if returncode == STOPPED:
         raise RunStopped("the run stopped after writing a checkpoint: run the same command "
                          "again with --resume to continue")
+    if returncode == INTERRUPTED:  # Ctrl-C while the child set up, before its loop's handler
+        raise RunAborted(f"aborted by Ctrl-C while the {backend.name} run was being set up: "
+                         f"it did not start; {_last_checkpoint(work_folder(out, backend.name))}")
     if returncode == REFUSED:
         raise RunRefused(message or f"the {backend.name} engine refused the run (see the "
                                     "message above)")
@@ -131,6 +129,22 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
                           + (f" (and {log_file})" if message and log else "")
                           + (f"\n  {report}" if report else ""))
     return out
+
+
+def _start_child(backend, scene: Scene, options: RunOptions, payload: dict, job: Path,
+                 error: Path):
+    """The child, forked when that is safe, else a new interpreter (``mpirun`` when np > 1)."""
+    if can_fork(backend, options):  # the child gets the resolved paths, as from the job file
+        return _Forked(backend, scene, dataclasses.replace(
+            options, out=Path(payload["out"]),
+            dump=Path(payload["dump"]) if payload["dump"] else None, isolate=False), error)
+    job.write_text(json.dumps(payload))
+    env = dict(os.environ, **{WORKER_FLAG: "1"})
+    cmd = [sys.executable, "-m", "demstudy.simulation.child", str(job)]
+    if options.np > 1:
+        cmd = [*backend.launcher(options.np), *cmd]
+    return subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL,
+                            preexec_fn=_die_with_parent if sys.platform == "linux" else None)
 
 
 def _end(proc) -> None:
@@ -168,18 +182,26 @@ class _Forked:
     def __init__(self, backend, scene: Scene, options: RunOptions, error: Path):
         sys.stdout.flush()
         sys.stderr.flush()
-        self.pid = os.fork()
+        # SIGINT is held back from the fork until ``wait`` (parent) or the child's first line:
+        # raised in between, the parent's KeyboardInterrupt would leave the child unknown
+        self._mask: set | None = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            self.pid = os.fork()
+        except BaseException:
+            self._release()
+            raise
         if self.pid == 0:  # the child: never returns
             code = FAILED
             try:
+                self._release()  # a fork has no pending signals: none is lost here
                 os.environ[WORKER_FLAG] = "1"
                 _die_with_parent()
                 stdin = os.open(os.devnull, os.O_RDONLY)
                 os.dup2(stdin, 0)
                 os.close(stdin)
                 code = run_in_child(backend, scene, options, error)
-            except KeyboardInterrupt:  # before the loop's own handler
-                print("error: interrupted before the run started", file=sys.stderr)
+            except KeyboardInterrupt:  # before the loop's own handler: the parent says so
+                code = INTERRUPTED
             except BaseException as exc:  # one line, never a bare traceback
                 print(f"error: {type(exc).__name__}: {exc}", file=sys.stderr)
             finally:
@@ -189,7 +211,14 @@ class _Forked:
                 finally:
                     os._exit(code)
 
+    def _release(self) -> None:
+        """Let SIGINT in again (one pending since the fork is handled now)."""
+        if self._mask is not None:
+            mask, self._mask = self._mask, None
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
     def wait(self, timeout: float | None = None) -> int:
+        self._release()  # in the caller's try: a Ctrl-C from here on is passed on
         deadline = None if timeout is None else time.monotonic() + timeout
         while True:
             pid, status = os.waitpid(self.pid, 0 if deadline is None else os.WNOHANG)

@@ -16,6 +16,7 @@ from typing import Any
 
 from ..contact.pilot import PILOT_SECONDS, PilotResult, run_pilot
 from ..contact.stiffness import ContactSetup, contact_setup
+from ..errors import RunAborted, RunStopped
 from ..scene import Scene
 from .forecast import Forecast, RatesNotMeasured, forecast_run
 from .options import RunOptions
@@ -111,6 +112,8 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
                                     pilot, costs, measure=not dry_run)
         except RatesNotMeasured:
             pass  # said by describe(): no forecast
+        except (RunStopped, RunAborted):  # Ctrl-C stopped a benchmark run: never a warning
+            raise _interrupted(backend.name) from None
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     if (forecast is not None and pilot is None and not backend.capabilities.time_step
@@ -120,7 +123,16 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
         pilot = run_pilot(scene, seconds=min(PILOT_SECONDS, 0.1 * forecast.seconds))
         try:
             forecast = forecast_run(scene, backend, None, pilot, costs, measure=not dry_run)
+        except (RunStopped, RunAborted):
+            raise _interrupted(backend.name) from None
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     n = scene.n_particles
     return RunPlan(backend.name, n, setup, pilot, forecast)
+
+
+def _interrupted(engine: str) -> RunAborted:
+    """Ctrl-C while the machine's speed was measured (benchmark runs in child processes,
+    which stop on it): the run does not start, rather than start without its forecast."""
+    return RunAborted(f"aborted by Ctrl-C while measuring this machine's speed for the "
+                      f"forecast: the {engine} run did not start (nothing to resume)")

@@ -7,24 +7,48 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts; with ``run.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import signal
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from ..scene import Scene
 from .options import RunOptions
 
-__all__ = ["Schedule", "StopInInterval", "StopRequest", "stop_notice"]
+__all__ = ["Schedule", "StopInInterval", "StopRequest", "interrupts_honoured", "stop_notice"]
 
 
 def stop_notice(engine: str) -> str:
     """What the first Ctrl-C prints, at once, in the process the user sees."""
     return (f"\n{engine}: stopping after the current segment and a checkpoint (Ctrl-C again "
             "aborts without one)")
+
+
+@contextlib.contextmanager
+def interrupts_honoured() -> Iterator[None]:
+    """Within: SIGINT raises ``KeyboardInterrupt`` (main thread) even where this process
+    inherited it ignored or at its default action.
+
+    Why: a shell starts a background job of a script (``demstudy run … &``, a CI step) with
+    SIGINT ignored, and Python keeps that. The run loop's own handler (``StopRequest``)
+    overrides it, so a Ctrl-C stopped an engine's child, but an interrupt sent to the caller
+    alone (``kill -INT``, a notebook's interrupt) was lost: the run went on to its end, and
+    the caller never printed the stopping notice. A handler the caller installed itself is
+    kept."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) not in (signal.SIG_IGN, signal.SIG_DFL, None)):
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 class StopRequest:
