@@ -179,3 +179,17 @@ def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
     done = ds.load(task.path)
     times = done.timeseries["time"]
     assert times[-1] == pytest.approx(15.0, abs=1.0)  # the whole run, equilibration + production
+
+
+@pytest.mark.parametrize("name", studies.study_names())
+def test_every_case_of_every_study_loads_from_any_folder(name, tmp_path, monkeypatch):
+    """Cases name shipped presets, not paths relative to the repository: a study runs from
+    any working folder (an installed package has no inputs/ beside it)."""
+    monkeypatch.chdir(tmp_path)
+    study = studies.get_study(name)
+    for quick in (True, False):
+        cases = study.cases(quick)
+        assert cases and len({c.name for c in cases}) == len(cases)
+        for case in cases:
+            assert not case.scene.startswith(("inputs/", "/")), case.scene
+            case.load(quick)

@@ -19,9 +19,9 @@ from typing import Any
 
 from ..base import Case
 
-SCENES = {0.01: "inputs/malik2008/poiseuille-phi0.01.toml",
-          0.1: "inputs/malik2008/poiseuille-phi0.1.toml",
-          0.5: "inputs/malik2008/poiseuille-phi0.5.toml"}
+SCENES = {0.01: "malik2008/poiseuille-phi0.01",
+          0.1: "malik2008/poiseuille-phi0.1",
+          0.5: "malik2008/poiseuille-phi0.5"}
 #: the thesis's N and box per nominal φ (digest §1.4-1.5): the tests hold the scenes to these
 THESIS_SYSTEM = {0.01: (2744, (50.0, 50.0, 50.0)), 0.1: (24400, (50.0, 50.0, 50.0)),
                  0.5: (19600, (20.0, 50.0, 20.0))}
