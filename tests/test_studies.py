@@ -193,3 +193,12 @@ def test_every_case_of_every_study_loads_from_any_folder(name, tmp_path, monkeyp
         for case in cases:
             assert not case.scene.startswith(("inputs/", "/")), case.scene
             case.load(quick)
+
+
+def test_only_selects_what_to_run_and_the_report_covers_every_run_made(toy, tmp_path):
+    first = run_study("toy", out=tmp_path, only=["cell-a"], echo=lambda s: None)
+    assert first.made == ["cell-a"]
+    assert [c.verdict for c in first.analysis.checks] == [REPRODUCED, NOT_RUN]
+    second = run_study("toy", out=tmp_path, only=["cell-b"], echo=lambda s: None)
+    assert second.made == ["cell-b"]
+    assert [c.verdict for c in second.analysis.checks] == [REPRODUCED, REPRODUCED]

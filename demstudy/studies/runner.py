@@ -163,8 +163,10 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
               engines: Sequence[str] | None = None, only: Sequence[str] | None = None,
               analyse_only: bool = False, echo=print) -> StudyRun:
     """Run study ``name`` (module doc). ``dry_run``: the forecast only. ``analyse_only``:
-    no runs, analyse the results files already there. A failed run does not stop the
-    others nor the analysis: its checks say "not run" and ``failed`` lists it."""
+    no runs, analyse the results files already there. ``engines``/``only`` select the cases
+    to run; the analysis and report cover every run of the study already made. A failed run
+    does not stop the others nor the analysis: its checks say "not run" and ``failed`` lists
+    it."""
     from ..accuracy.execute import execute, is_done
     from . import get_study
 
@@ -210,7 +212,10 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
             echo(f"warning: {exc}")
     elif dry_run:
         return result
-    runs = {t.case.name: t.path for t in tasks if t.path.is_file()}
+    # the analysis reads every run of the study already made, not only those selected to
+    # make now (``engines``/``only`` choose what to run; the report covers the whole study)
+    every = tasks_of(study, quick, out) if (engines or only) else tasks
+    runs = {t.case.name: t.path for t in every if t.path.is_file()}
     result.run_seconds = sum(_run_seconds(p) for p in runs.values())
     out.mkdir(parents=True, exist_ok=True)
     result.analysis = study.analyse(runs, out, quick)

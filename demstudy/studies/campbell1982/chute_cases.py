@@ -56,6 +56,10 @@ SEEDS = (2, 3)  # besides the scenes' 12345
 VARIABLE = {"law": {"model": "campbell-exp"}}  # e(v) = ½[1 + exp(−3v/√(gR))], pairs only
 
 
+#: the soft-contact engines of the cross-check (both express the bumpy base and gravity)
+SOFT_ENGINES = ("lammps", "liggghts")
+
+
 def bumpy_wall(restitution: float = 0.8) -> list[dict[str, Any]]:
     """The lower wall of chute-bumpy-30 (the whole walls list: overrides replace lists)."""
     return [{"side": "lower", "kind": "bumpy", "restitution": restitution,
@@ -120,7 +124,7 @@ def cases(quick: bool) -> list[Case]:
     tc = [Case(f"chute-30-bumpy-{name}", BUMPY, sections=_sections(STEADY_RUN),
                options={"tc": t}, group="tc") for name, t in TC_VALUES.items()]
     # soft discs: k_n = 1e6 (the scene's; at 1e5 the soft bed creeps), ≈ 4 min here
-    soft = [Case("chute-30-bumpy-lammps", BUMPY, engine="lammps",
-                 sections=_sections(SOFT_RUN),
-                 group="soft")]
+    soft = [Case(f"chute-30-bumpy-{engine}", BUMPY, engine=engine,
+                 sections=_sections(SOFT_RUN), group="soft")
+            for engine in SOFT_ENGINES]
     return angle + flat + more_angles + depth + resti + steep + seeds + tc + soft

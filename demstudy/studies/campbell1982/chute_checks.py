@@ -492,13 +492,15 @@ def tc_independence(runs: Mapping[str, ChuteRun]) -> Check:
     return Check(ref, statement, thesis, "; ".join(texts), verdict, reason)
 
 
-def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
-    ref = "soft-contact cross-check (LAMMPS, k_n = 1e6)"
-    statement = "soft discs give the hard discs' 30° bumpy flow"
+def soft_cross_check(runs: Mapping[str, ChuteRun], engine: str = "lammps") -> Check:
+    label = {"lammps": "LAMMPS", "liggghts": "LIGGGHTS"}.get(engine, engine)
+    ref = f"soft-contact cross-check ({label}, k_n = 1e6)"
+    statement = f"soft discs ({label}) give the hard discs' 30° bumpy flow"
     thesis = "— (the hard-disc limit)"
-    if "chute-30-bumpy-lammps" not in runs or "chute-30-bumpy" not in runs:
-        return missing(ref, statement, thesis, ["chute-30-bumpy-lammps"])
-    a, b = runs["chute-30-bumpy"], runs["chute-30-bumpy-lammps"]
+    name = f"chute-30-bumpy-{engine}"
+    if name not in runs or "chute-30-bumpy" not in runs:
+        return missing(ref, statement, thesis, [name])
+    a, b = runs["chute-30-bumpy"], runs[name]
     spread = seed_spread(runs)
     level, text = _same(a, b, spread)
     ok = level == 2
@@ -508,7 +510,7 @@ def soft_cross_check(runs: Mapping[str, ChuteRun]) -> Check:
     verdict = REPRODUCED if ok and slip_ok and b.balanced else PARTLY if (ok or b.balanced) \
         else NOT_REPRODUCED
     return Check(ref, statement, thesis, text, verdict,
-                 "bumpy base; LAMMPS run 800 + 600 √(d/g) (hard: 800 + 1600)"
+                 f"bumpy base; {label} run 800 + 600 √(d/g) (hard: 800 + 1600)"
                  + ("" if verdict == REPRODUCED else ": " + LEVEL_TEXT[level])
                  + "; " + _spread_text(spread))
 
@@ -526,5 +528,6 @@ def all_checks(runs: Mapping[str, ChuteRun], quick: bool) -> list[Check]:
               c7_c8(runs, "chute-40-bumpy-4x4-var", "C8; Fig 3.6, L193, L1039",
                     "the 4 × 4 bed at 40° with the variable ε gives a steady mass-flow profile "
                     "(compared with Ridgway & Rupp)"),
-              width_doubling(runs), tc_independence(runs), soft_cross_check(runs)]
+              width_doubling(runs), tc_independence(runs), soft_cross_check(runs, "lammps"),
+              soft_cross_check(runs, "liggghts")]
     return checks
