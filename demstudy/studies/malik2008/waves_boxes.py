@@ -79,16 +79,13 @@ class ThesisClass:
 
 #: only what the digest states (§1.8 [L1149]-[L1159]; §4.11 cites [L1118] for the plug
 #: definition, right after Fig 5.2's caption [L1116], and [L1155] for the plug → S-wave
-#: transition inside the N = 50094 discussion). Fig 5.1's class (plug) is the task brief's
-#: reading, not in the digest's text: recorded, but the verdict stays "partly".
+#: transition inside the N = 50094 discussion). No other box's class is in the digest.
 THESIS: dict[str, ThesisClass] = {
     "5.6-5.10": ThesisClass("slug", "N = 50094, L/W = 1.4, W/d = 50: the energy plateaus at "
                             "t ≈ 11000 c/p but the structure keeps evolving (plug → one-hump "
                             "S-wave, birth of (1,1), [L1155]) until a slug forms at t ≈ 14000 "
                             "c/p (digest §1.8, [L1149]-[L1159])"),
 }
-#: classes attributed to the thesis outside the digest's text (recorded; verdict "partly")
-BRIEF: dict[str, str] = {"5.1": "plug"}
 
 
 def box_of(name: str) -> Box:

@@ -168,18 +168,15 @@ def phase_figure(found: Sequence[tuple[Box, str]], missing: Sequence[Box],
                         xytext=(7, -10), fontsize=7)
     for box in missing:
         ax.scatter(box.aspect, box.width, marker="x", color="0.6", s=50, zorder=2)
-    for box, cls, source in thesis:
+    for box, cls, _source in thesis:
         marker, colour = STYLE.get(cls, ("*", "k"))
         ax.scatter(box.aspect, box.width, marker=marker, facecolors="none", edgecolors=colour,
-                   s=330, linewidths=1.6, linestyle="--" if source == "brief" else "-",
+                   s=330, linewidths=1.6,
                    zorder=4)
     handles = [Line2D([], [], marker=m, color=c, ls="", markersize=8, label=f"demstudy: {k}")
                for k, (m, c) in STYLE.items()]
     handles += [Line2D([], [], marker="o", markerfacecolor="none", markeredgecolor="k",
                        ls="", markersize=13, label="thesis, digest §1.8 (solid ring)"),
-                Line2D([], [], marker="o", markerfacecolor="none", markeredgecolor="k",
-                       ls="", markersize=13, markeredgewidth=1,
-                       label="thesis per the task brief\n(not in the digest; dashed)"),
                 Line2D([], [], marker="x", color="0.6", ls="", label="not run")]
     ax.legend(handles=handles, fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
     ax.set_xlabel("aspect ratio L/W")

@@ -25,7 +25,7 @@ from ..base import (
     Figure,
     pm,
 )
-from .waves_boxes import BOXES, BRIEF, QUICK, RESTITUTION, THESIS, Box
+from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
 from .waves_measure import COARSE, DRIFT_SIGMAS, RunWaves, measure
 
@@ -89,10 +89,7 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     ref = (f"Fig {box.fig} (N = {box.n}, L/W = {box.aspect:.2g}, W/d = {box.width}, "
            f"H/d = {box.height}, e = {box.restitution:g}); digest §4.11")
     thesis = THESIS.get(box.fig)
-    brief = BRIEF.get(box.fig)
-    thesis_text = (thesis.text if thesis else
-                   f"not in the digest (the task brief reads it as {brief})" if brief else
-                   "not in the digest")
+    thesis_text = thesis.text if thesis else "not in the digest"
     statement = "steady density structure (plug, S-wave, slug, ...) of this box"
     if run is None:
         return Check(ref, statement, thesis_text, "not run", NOT_RUN, missing)
@@ -109,9 +106,6 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
                          "same class, but the modes are not stationary")
         return Check(ref, statement, thesis_text, measured, REPRODUCED)
     why = "thesis class not in the digest"
-    if brief:
-        why += (f"; the task brief's reading ({brief}) "
-                f"{'agrees' if found == brief else 'differs: demstudy finds ' + found}")
     if not run.stationary:
         why += "; the modes are not stationary (class of a transient)"
     return Check(ref, statement, thesis_text, measured, PARTLY, why)
@@ -285,14 +279,13 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     ana.checks.append(peak_check(measured))
     ana.checks += _phase_checks(boxes, diagram, measured)
     thesis = [(b, THESIS[b.fig].cls, "digest") for b in diagram if b.fig in THESIS]
-    thesis += [(b, BRIEF[b.fig], "brief") for b in diagram if b.fig in BRIEF]
     path = phase_figure([(b, measured[b.name].modes.pattern) for b in diagram
                          if b.name in measured],
                         [b for b in diagram if b.name not in measured], thesis,
                         out / "waves-phase-diagram.png")
     ana.figures.append(Figure(path, "Fig 5.25's form: the structure class of each box over "
                                     "(L/W, W/d), demstudy (filled) and the thesis where the "
-                                    "digest or the brief gives it (rings); × not run"))
+                                    "digest gives it (rings); × not run"))
     ana.sections.append(("Density waves (Malik Ch. 5): method", METHOD))
     if measured:
         ana.sections.append(("Density waves: the runs", _run_table(measured)))
