@@ -52,13 +52,15 @@ def _tag(d: FlowData) -> str:
 def _steady_note(d: FlowData) -> str:
     info = d.run_info()
     return "" if info["steady"] else (f" The run ({_tag(d)}) is not in steady state (kinetic "
-                                      f"energy trend {info['trend']:.2g}): no verdict beyond "
-                                      "partly.")
+                                      f"energy trend {info['trend']:.2g}): inconclusive, "
+                                      "\"partly\" either way.")
 
 
 def _cap(verdict: str, d: FlowData) -> str:
-    """At most "partly" from a run that did not reach its plateau."""
-    return PARTLY if verdict == REPRODUCED and not d.run_info()["steady"] else verdict
+    """"partly" from a run that did not reach its plateau: its numbers can neither confirm
+    nor refute a statement about the steady flow."""
+    return PARTLY if verdict in (REPRODUCED, NOT_REPRODUCED) and not d.run_info()["steady"] \
+        else verdict
 
 
 # ------------------------------------------------------------------ steady state
