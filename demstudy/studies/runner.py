@@ -121,15 +121,15 @@ def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None
 
 
 def forecast(tasks: Sequence[StudyTask], workers: int
-             ) -> tuple[float | None, list[str], dict[str, str]]:
+             ) -> tuple[float | None, list[str], dict[str, str], dict[str, float]]:
     """The wall time of ``tasks`` on ``workers`` (each run's ``--dry-run`` forecast,
-    scheduled longest first; None when a run has no forecast), one line per run, and the
-    runs the engine refuses (name → why: they are not run)."""
+    scheduled longest first; None when a run has no forecast), one line per run, the runs
+    the engine refuses (name → why: they are not run) and each forecast run's seconds."""
     from ..accuracy.forecast import makespan
     from ..api import run
     from ..errors import UnsupportedByEngine
 
-    seconds, lines, unknown, refused = [], [], False, {}
+    seconds, lines, unknown, refused = {}, [], False, {}
     for task in tasks:
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
@@ -144,10 +144,10 @@ def forecast(tasks: Sequence[StudyTask], workers: int
             lines.append(f"  {task.case.name} ({task.case.engine}): no forecast "
                          f"({plan.get('forecast', 'not measured')})")
             continue
-        seconds.append(float(s))
+        seconds[task.case.name] = float(s)
         lines.append(f"  {task.case.name} ({task.case.engine}): {_duration(s)}")
-    total = makespan(seconds, workers) if seconds else 0.0
-    return (None if unknown else total), lines, refused
+    total = makespan(list(seconds.values()), workers) if seconds else 0.0
+    return (None if unknown else total), lines, refused, seconds
 
 
 def _duration(seconds: float) -> str:
@@ -185,7 +185,7 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     echo(f"study {study.name}{' (quick)' if quick else ''}: {len(tasks)} runs, "
          f"{len(done)} already made, {len(todo)} to make; results in {out}/")
     if todo and not analyse_only:
-        seconds, lines, refused = forecast(todo, 1 if dask is not None else workers)
+        seconds, lines, refused, each = forecast(todo, 1 if dask is not None else workers)
         result.forecast_seconds = seconds
         result.failed = list(refused)
         todo = [t for t in todo if t.case.name not in refused]
@@ -198,7 +198,8 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         if dry_run:
             return result
         todo = [StudyTask(t.case, t.quick, t.path,
-                          replace(t.spec, relative_cost=_cost_of(lines, t)), t.scene_toml)
+                          replace(t.spec, relative_cost=each.get(t.case.name, 1.0)),
+                          t.scene_toml)
                 for t in todo]
 
         def finished(record: dict) -> None:
@@ -236,31 +237,10 @@ def _run_seconds(path: Path) -> float:
         return 0.0
 
 
-def _cost_of(lines: list[str], task: StudyTask) -> float:
-    """The forecast seconds of ``task`` from its forecast line (for longest-first order)."""
-    for line in lines:
-        if line.startswith(f"  {task.case.name} ("):
-            text = line.rsplit(": ", 1)[-1]
-            try:
-                value, unit = text.split()[:2]
-                return float(value) * {"s": 1, "min": 60, "h": 3600}.get(unit, 1)
-            except ValueError:
-                return 1.0
-    return 1.0
-
-
 def _machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    import os
+    from ..simulation.forecast import cpu_model
 
-    return f"{cpu}, {os.cpu_count()} logical CPUs, Python {platform.python_version()}"
+    return f"{cpu_model()}, Python {platform.python_version()}"
 
 
 def write_report(result: StudyRun, quick: bool) -> Path:
