@@ -189,7 +189,7 @@ def _cmd_forecast(args: argparse.Namespace) -> int:
 
     for engine in args.engine or ["lammps", "edmd"]:
         for dim in args.dim or [2, 3]:
-            soft = get_backend(engine).capabilities.time_step
+            soft = get_backend(engine).capabilities.soft_contact
             for model in (args.model or ["hooke"]) if soft else [None]:
                 measure_costs(engine, dim, model, remeasure=args.measure)
     rates = load_rates()
@@ -500,7 +500,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="soft contact models (default hooke; repeatable)")
     p.set_defaults(func=_cmd_forecast)
 
-    soft = [e for e in engines if get_backend(e).capabilities.time_step]
+    soft = [e for e in engines if get_backend(e).capabilities.soft_contact]
     p = sub.add_parser("calibrate", help="measure binary soft collisions (e, beta, t_c, peak "
                                          "force) and wall motions against theory")
     p.add_argument("--engine", default=DEFAULT_ENGINE, choices=soft)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from demstudy.effects import EFFECTS, Cannot, Translation
+from demstudy.effects import EFFECTS, LATTICE_ONLY, Cannot, Translation
 from demstudy.engines.backend import BackendBase, Capabilities, EngineOption
 from demstudy.io.frames import Frame
 from demstudy.scene.initial import build_initial_state
@@ -24,6 +24,7 @@ class BallisticBackend(BackendBase):
     kind = "ballistic"
     capabilities = Capabilities()
     translations = {name: NO_FORCES for name in EFFECTS} | {
+        "lattice": LATTICE_ONLY,
         "planar": Translation(how="2D positions"),
         "rotation": Translation(how="spins never change: there are no contacts"),
     }

@@ -22,7 +22,7 @@ UPPER = {"side": "upper", "restitution": 0.9}
 
 
 def scene(**changes):
-    return validate_scene({**BARE, **changes})
+    return validate_scene({k: v for k, v in {**BARE, **changes}.items() if v is not None})
 
 
 # each effect: a scene that calls for it (and for as little else as possible)
@@ -38,6 +38,8 @@ CALLS_FOR = {
     "bumpy-walls": {"walls": [{**LOWER, "kind": "bumpy", "bumps": {}}, UPPER]},
     "gravity": {"gravity": {"direction": [1.0, 0.0, 0.0]}},
     "lees-edwards": {"shear": {"rate": 1.0}},
+    "lattice": {"dimension": 2, "box": None, "particles": {}, "walls": [LOWER, UPPER],
+                "lattice": {"nxt": 6, "nyt": 4, "initial": [{"md": 1, "x1": 1, "y1": 2}]}},
 }
 
 
@@ -54,7 +56,9 @@ def test_each_effect_is_present_exactly_when_asked(name):
     present = {e.name for e in present_effects(scene(**CALLS_FOR[name]))}
     assert name in present
     walls = {"walls", "moving-walls", "noslip-walls", "servo", "bumpy-walls"}
-    assert present <= {name} | (walls if name in walls else set())
+    # a lattice scene is 2D and has its two wall rows
+    implied = {"lattice": {"planar", "walls"}}.get(name, walls if name in walls else set())
+    assert present <= {name} | implied
 
 
 @pytest.mark.parametrize("engine", backend_names())

@@ -124,7 +124,7 @@ def connect(address: str):
 def _soft_engines(engines: Sequence[str] | None) -> list[str]:
     """The ladder's soft engines, checked: registered, time-stepped (soft contacts)."""
     names = ["lammps"] if engines is None else list(dict.fromkeys(engines))
-    known = [n for n in backend_names() if get_backend(n).capabilities.time_step]
+    known = [n for n in backend_names() if get_backend(n).capabilities.soft_contact]
     bad = [n for n in names if n not in known]
     if bad or not names:
         raise BadOption("--engine", bad or names,

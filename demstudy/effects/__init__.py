@@ -25,8 +25,8 @@ from typing import Any
 from ..errors import UnsupportedByEngine
 from ..scene import Scene
 
-__all__ = ["EFFECTS", "Cannot", "Effect", "Translation", "apply_effects", "check_effects",
-           "present_effects"]
+__all__ = ["EFFECTS", "LATTICE_ONLY", "Cannot", "Effect", "Translation", "apply_effects",
+           "check_effects", "present_effects"]
 
 
 @dataclass(frozen=True)
@@ -73,8 +73,18 @@ def _rough(rule: Any) -> bool:
     return rule.model not in ("smooth", "campbell-noslip")
 
 
+#: what every off-lattice engine says to a lattice scene
+LATTICE_ONLY = Cannot("a [lattice] scene is Gutt's lattice grain dynamics: grains on the nodes "
+                      "of a triangular lattice with integer offsets, moved by whole lattice "
+                      "steps and colliding along the lattice bonds only; an off-lattice engine "
+                      "would simulate different physics, so only --engine lgd runs it (for "
+                      "the same flow off the lattice, write an ordinary scene)")
+
 #: every effect, in the order engines apply them (a LAMMPS deck lists its blocks this way)
 EFFECTS: dict[str, Effect] = {e.name: e for e in (
+    Effect("lattice", "Gutt's lattice grain dynamics ([lattice]: grains on lattice nodes)",
+           lambda s: s.lattice is not None,
+           lambda s: ("lattice", f"nxt = {s.lattice.nxt}, nyt = {s.lattice.nyt}")),
     Effect("planar", "2D discs confined to the plane",
            lambda s: s.dimension == 2, lambda s: ("dimension", s.dimension)),
     Effect("rotation", "tangential contact forces that change spins (rough, β or Coulomb "

@@ -1,6 +1,7 @@
 """Engine backends, registered by name: ``lammps`` (soft contacts in LAMMPS), ``liggghts``
-(soft contacts in LIGGGHTS, always in a child process) and ``edmd`` (demstudy's
-event-driven hard particles).
+(soft contacts in LIGGGHTS, always in a child process), ``edmd`` (demstudy's
+event-driven hard particles) and ``lgd`` (Gutt's 1989 lattice grain dynamics, lattice scenes
+only).
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts. A backend implements
 the small protocol of :mod:`demstudy.engines.backend`; the one simulation loop
@@ -21,6 +22,7 @@ _BACKENDS: dict[str, Any] = {
     "lammps": "demstudy.engines.lammps.backend:LammpsBackend",
     "edmd": "demstudy.engines.edmd.backend:EdmdBackend",
     "liggghts": "demstudy.engines.liggghts.backend:LiggghtsBackend",
+    "lgd": "demstudy.engines.lgd.backend:LgdBackend",
 }
 
 

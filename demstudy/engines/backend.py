@@ -49,7 +49,10 @@ class Capabilities:
     """What an engine can do beyond advancing particles.
 
     ``time_step``: time-stepped (samples fall on whole steps; the servo updates at sample
-    ends) rather than event-driven (exact times, collision counts); ``collision_count``:
+    ends) rather than event-driven (exact times, collision counts); ``soft_contact``: soft
+    contacts whose stiffness and step the contact mapping chooses (the pilot, calibration,
+    the soft forecast); ``step_count``: counts whole steps of its own (``run.unit = 'steps'``:
+    the lattice engine); ``collision_count``:
     counts pair collisions (``run.unit = 'collisions'``, collision-counted servo);
     ``collision_log``: logs collisions (angles, free paths); ``stress``: the interaction
     stress it sums per bin, "collisional" (cumulative impulse moments) or "contact"
@@ -58,6 +61,8 @@ class Capabilities:
     files that run without demstudy (``demstudy deck``)."""
 
     time_step: bool = False
+    soft_contact: bool = False
+    step_count: bool = False
     collision_count: bool = False
     collision_log: bool = False
     stress: str | None = None
@@ -157,6 +162,16 @@ class BackendBase:
     def collisions(self) -> int:
         """Pair collisions so far (collision-counting engines)."""
         return 0
+
+    @property
+    def steps(self) -> int:
+        """Whole steps so far (step-counting engines: ``capabilities.step_count``)."""
+        return 0
+
+    def advance_steps(self, steps: int, stop: Callable[[], bool] | None = None) -> bool:
+        """Advance to step number ``steps`` (``run.unit = 'steps'``); False when a stop
+        request (``stop()`` true) ended it earlier."""
+        raise NotImplementedError(f"{self.name} counts no steps of its own")
 
     def wall_impulse(self) -> dict[str, np.ndarray]:
         """Cumulative impulse of each wall on the particles since the start, (3,) per side."""

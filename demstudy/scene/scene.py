@@ -11,6 +11,7 @@ from typing import Literal
 from pydantic import model_validator
 
 from .base import StrictModel
+from .lattice import ROW_HEIGHT, LatticeSpec, lattice_box, lattice_grains
 from .schema import (
     INERTIA_K,
     MAX_PACKING,
@@ -49,6 +50,19 @@ class Scene(StrictModel):
     run: Run
     soft: Soft = Soft()
     measure: Measure = Measure()
+    lattice: LatticeSpec | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _lattice_box(cls, data):
+        """A lattice scene's box is its lattice: filled in when [box] is left out."""
+        if isinstance(data, dict) and isinstance(data.get("lattice"), dict) \
+                and "box" not in data:
+            spec = data["lattice"]
+            nxt, nyt = spec.get("nxt"), spec.get("nyt")
+            if isinstance(nxt, int) and isinstance(nyt, int) and nxt > 0 and nyt > 1:
+                data = {**data, "box": {"size": [float(nxt), (nyt - 1) * ROW_HEIGHT]}}
+        return data
 
     # ---- derived quantities -------------------------------------------------------------
     @property
@@ -87,6 +101,8 @@ class Scene(StrictModel):
     @property
     def n_particles(self) -> int:
         p, init = self.particles, self.initial
+        if self.lattice is not None:  # the movable grains of the initial lattice
+            return lattice_grains(self.lattice)[0]
         if init.placement == "lattice":
             layers = (init.layers or 1) if self.dimension == 3 else 1
             return init.rows * init.columns * layers
@@ -165,7 +181,16 @@ class Scene(StrictModel):
             if "y" not in periodic and not self.walls:
                 problems.append(f"box.periodic = {periodic}: y is bounded but no wall is given")
         problems += self._wall_problems()
-        problems += self._particle_problems()
+        if self.lattice is not None:
+            problems += self._lattice_problems()
+            if problems:
+                raise ValueError("; ".join(problems))
+        else:
+            problems += self._particle_problems()
+            if self.run.unit == "steps":
+                problems.append("run.unit = 'steps': whole lattice steps exist only in "
+                                "lattice scenes ([lattice], --engine lgd); allowed here: "
+                                "'time' or 'collisions'")
         if self.shear is not None and (self.walls or not self.y_periodic):
             problems.append("shear: Lees–Edwards shear needs a y-periodic box without walls")
         g = self.gravity
@@ -173,7 +198,8 @@ class Scene(StrictModel):
             problems.append(f"gravity.direction = {g.direction}: needs {dim} components")
         elif self.shear is not None and g is not None:
             problems += self._sheared_gravity_problems()
-        problems += self._initial_problems()
+        if self.lattice is None:
+            problems += self._initial_problems()
         from ..analysis.registry import scene_problems  # the statistics' own registry
 
         problems += scene_problems(self)
@@ -193,6 +219,57 @@ class Scene(StrictModel):
         if problems:
             raise ValueError("; ".join(problems))
         return self
+
+    def _lattice_problems(self) -> list[str]:
+        """A lattice scene: 2D, its box the lattice, both wall rows declared as walls at
+        their places, grains from md lines only, whole steps with ``run.unit = 'steps'``."""
+        spec, problems = self.lattice, []
+        if self.dimension != 2:
+            problems.append(f"dimension = {self.dimension}: a lattice scene is 2D (Gutt's "
+                            "triangular lattice); allowed: 2")
+        box = lattice_box(spec)
+        if len(self.box.size) != 2 or any(abs(a - b) > 1e-9 * max(1.0, b)
+                                          for a, b in zip(self.box.size, box, strict=False)):
+            problems.append(f"box.size = {self.box.size}: a lattice scene's box is its lattice, "
+                            f"[nxt, (nyt − 1)·√3/2] = [{box[0]:g}, {box[1]:.10g}]; leave [box] "
+                            "out to have it filled in")
+        sides = sorted(w.side for w in self.walls)
+        if sides != ["lower", "upper"]:
+            problems.append(f"walls: {sides}; a lattice scene needs both walls, lower and "
+                            "upper: rows 1 and nyt are always wall rows (listing L1831–L1856)")
+        for i, wall in enumerate(self.walls):
+            want = 0.0 if wall.side == "lower" else box[1]
+            if wall.position is not None and abs(wall.position - want) > 1e-9 * max(1, want):
+                problems.append(f"walls[{i}].position = {wall.position:g}: the {wall.side} "
+                                f"wall row of the lattice is at y = {want:.10g}; leave "
+                                "position out")
+        if self.initial != Initial():
+            problems.append("initial: a lattice scene's grains come from lattice.initial / "
+                            "lattice.initial_file (Gutt's md lines); leave [initial] out")
+        if self.particles.solid_fraction is not None:
+            problems.append(f"particles.solid_fraction = {self.particles.solid_fraction:g}: "
+                            "a lattice scene's grains come from its md lines; leave it out")
+        try:
+            count = lattice_grains(spec)[0]
+        except (ValueError, OSError) as exc:  # the initial-data file
+            return problems + [f"lattice.initial_file = {spec.initial_file!r}: {exc}"]
+        if count == 0:
+            problems.append("lattice: the md lines place no movable grain")
+        if self.particles.count is not None and self.particles.count != count:
+            problems.append(f"particles.count = {self.particles.count}: the lattice's md "
+                            f"lines place {count} movable grains")
+        if self.run.unit == "steps":
+            run = self.run
+            for name in ("equilibration", "production", "sample_interval",
+                         "checkpoint_interval"):
+                value = getattr(run, name)
+                if value is not None and value != int(value):
+                    problems.append(f"run.{name} = {value:g}: with unit = 'steps' a whole "
+                                    "number of steps is allowed")
+            if run.sample_interval < 1:
+                problems.append(f"run.sample_interval = {run.sample_interval:g}: with unit = "
+                                "'steps' at least 1 step is allowed")
+        return problems
 
     def _sheared_gravity_problems(self) -> list[str]:
         """Gravity with a y component under Lees–Edwards shear has no support: y is periodic

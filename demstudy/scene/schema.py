@@ -330,13 +330,14 @@ class Initial(StrictModel):
 
 
 class Run(StrictModel):
-    """Run control, in time units (or collisions per particle with ``unit = 'collisions'``)."""
+    """Run control, in time units (or collisions per particle with ``unit = 'collisions'``,
+    or whole lattice steps with ``unit = 'steps'``: lattice scenes only, docs/lgd-engine.md)."""
 
     equilibration: Float = Field(ge=0.0, le=1e12)
     production: Float = Field(gt=0.0, le=1e12)
     sample_interval: Float = Field(default=1.0, ge=MIN_INTERVAL)
     seed: Int = Field(default=12345, ge=1, lt=2**31)
-    unit: Literal["time", "collisions"] = "time"
+    unit: Literal["time", "collisions", "steps"] = "time"
     checkpoint_interval: Float | None = Field(default=None, ge=MIN_INTERVAL)
 
 

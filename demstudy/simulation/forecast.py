@@ -217,7 +217,7 @@ def _benchmark(engine: str, dim: int, model: str | None) -> tuple[dict[str, floa
     from . import RunOptions, run_scene
 
     backend = get_backend(engine)
-    soft = backend.capabilities.time_step
+    soft = backend.capabilities.soft_contact
     rows, seconds, what = [], [], []
     for n, phi, duration, interval, sheared, rough in SOFT_CASES if soft else EVENT_CASES:
         scene = _benchmark_scene(dim, n, phi, 1.0, 1.0, model, sheared, rough)
@@ -264,7 +264,7 @@ def runs_model(engine: str, model: str | None, dim: int = 2) -> bool:
     from ..engines import get_backend
 
     backend = get_backend(engine)
-    if not backend.capabilities.time_step:
+    if not backend.capabilities.soft_contact:
         return True
     return _expresses(backend, _benchmark_scene(dim, 20, 0.3, 1.0, 1.0, model, False, False))
 
@@ -371,12 +371,12 @@ def forecast_run(scene: Scene, backend: Any, timestep: float | None = None,
     """The forecast of ``scene`` in ``backend`` (a backend class): time-stepped engines need
     the ``timestep``; ``costs`` (seconds per count) override the machine's measured ones
     (measured now if not cached, unless ``measure`` is False: ``RatesNotMeasured``)."""
-    model = scene.soft.model if backend.capabilities.time_step else None
+    model = scene.soft.model if backend.capabilities.soft_contact else None
     key = rate_key(backend.name, scene.dimension, model)
     where = key if costs is None else "given costs"
     if costs is None:
         costs = measure_costs(backend.name, scene.dimension, model, measure=measure)
-    if backend.capabilities.time_step:
+    if backend.capabilities.soft_contact:
         if timestep is None:
             raise ValueError("a time-stepped engine's forecast needs its time step")
         counts = soft_counts(scene, timestep)

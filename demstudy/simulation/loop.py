@@ -2,7 +2,8 @@
 
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
 or the shear rate sets the time unit τ); with ``run.unit = 'collisions'`` the schedule counts
-pair collisions per particle instead of time.
+pair collisions per particle instead of time, with ``run.unit = 'steps'`` the lattice engine's
+whole steps (``Backend.advance_steps``).
 
 :class:`Simulation` runs a scene in any engine backend (:mod:`demstudy.engines.backend`):
 samples every ``run.sample_interval`` from t = 0 (the initial state), equilibration and
@@ -161,6 +162,13 @@ class Simulation:
         """Advance to sample ``state.samples``: a time, or a collision count with
         ``run.unit = 'collisions'``; event-driven servo updates happen on the way."""
         backend, sched = self.backend, self.schedule
+        if sched.by_steps:  # whole lattice steps: no servo (lattice walls have none)
+            if backend.advance_steps(round(state.samples * sched.interval), self.stop.check):
+                return
+            if self.stop.reason is not None:
+                raise StopInInterval
+            raise EngineError(f"the {backend.name} engine stopped at step {backend.steps} "
+                              "before the sample's step count")
         if sched.by_collisions:
             t_end, target = 1e300, round(state.samples * sched.interval * backend.n_particles)
         else:
@@ -358,7 +366,7 @@ class Simulation:
 
     def _loop(self, state: RunState, started: float) -> None:
         sched, backend = self.schedule, self.backend
-        unit = "coll/N" if sched.by_collisions else "τ"
+        unit = "coll/N" if sched.by_collisions else "steps" if sched.by_steps else "τ"
         bar = tqdm(total=sched.n_total * sched.interval, initial=state.samples * sched.interval,
                    unit=unit, disable=not self.options.progress or backend.rank != 0,
                    mininterval=0.5 if sys.stderr.isatty() else 30.0,

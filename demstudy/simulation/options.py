@@ -115,6 +115,10 @@ def check_run(backend: Any, scene: Any, options: RunOptions) -> None:
     if scene.run.unit == "collisions" and not backend.capabilities.collision_count:
         raise UnsupportedByEngine(backend.name, "run.unit", scene.run.unit,
                                   "this engine counts no collisions: give times")
+    if scene.run.unit == "steps" and not backend.capabilities.step_count:
+        raise UnsupportedByEngine(backend.name, "run.unit", scene.run.unit,
+                                  "this engine has no whole steps of its own (lattice scenes, "
+                                  "--engine lgd): give times")
     needs_frames = keep_frames_refused(scene, options)
     if needs_frames:
         raise UnsupportedByEngine(backend.name, "keep_frames", False, f"{needs_frames!r} in "

@@ -87,7 +87,7 @@ def needs_pilot(scene: Scene, backend: Any, dry_run: bool = False) -> bool:
     ``--dry-run`` (a run forecasts its events from the Enskog rate, and runs a pilot only
     when that forecast exceeds ``PILOT_WORTH``: a pilot of up to seconds would multiply the
     fixed cost of short event-driven runs)."""
-    if backend.capabilities.time_step:
+    if backend.capabilities.soft_contact:
         return scene.soft.stiffness is None and scene.soft.hardness is None
     return dry_run and backend.name == "edmd" and scene.run.unit == "time"
 
@@ -103,7 +103,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
     if pilot is None and needs_pilot(scene, backend, dry_run):
         pilot = run_pilot(scene)
     setup = None
-    if backend.capabilities.time_step:
+    if backend.capabilities.soft_contact:
         setup = contact_setup(scene, backend.name, pilot)
     forecast = None
     if backend.name in FORECAST_ENGINES:
@@ -116,7 +116,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
             raise _interrupted(backend.name) from None
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
-    if (forecast is not None and pilot is None and not backend.capabilities.time_step
+    if (forecast is not None and pilot is None and not backend.capabilities.soft_contact
             and backend.name == "edmd" and scene.run.unit == "time"
             and forecast.seconds > PILOT_WORTH):
         # a long event-driven run: a pilot of ≤ 10 % of it measures the real collision rate

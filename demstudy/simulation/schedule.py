@@ -153,20 +153,22 @@ class StopInInterval(Exception):
 
 @dataclass(frozen=True)
 class Schedule:
-    """Samples every ``interval`` (time, or collisions per particle); ``n_eq`` of them in
-    equilibration, ``n_total`` in all, a checkpoint every ``n_ckpt`` (0: none)."""
+    """Samples every ``interval`` (time, collisions per particle, or whole lattice steps with
+    ``by_steps``); ``n_eq`` of them in equilibration, ``n_total`` in all, a checkpoint every
+    ``n_ckpt`` (0: none)."""
 
     interval: float
     n_eq: int
     n_total: int
     n_ckpt: int
     by_collisions: bool
+    by_steps: bool = False
 
     @classmethod
     def of(cls, scene: Scene, options: RunOptions, time_step: float | None) -> Schedule:
         run = scene.run
         ckpt = options.checkpoint_interval or run.checkpoint_interval
-        if time_step:  # whole steps: the interval and both phases rounded to them
+        if time_step and run.unit != "steps":  # the interval and phases in whole steps
             n_sample = max(1, round(run.sample_interval / time_step))
 
             def steps(duration: float) -> int:
@@ -179,6 +181,7 @@ class Schedule:
         dt = run.sample_interval
         n_eq = round(run.equilibration / dt)
         return cls(dt, n_eq, n_eq + max(1, round(run.production / dt)),
-                   max(1, round(ckpt / dt)) if ckpt else 0, run.unit == "collisions")
+                   max(1, round(ckpt / dt)) if ckpt else 0, run.unit == "collisions",
+                   run.unit == "steps")
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from ...effects import Cannot, Translation, apply_effects
+from ...effects import LATTICE_ONLY, Cannot, Translation, apply_effects
 from ...errors import UnsupportedByEngine
 from ...scene import Scene
 
@@ -91,6 +91,7 @@ def _check_bumps(scene: Scene) -> None:
 
 #: every effect's event-driven translation
 TRANSLATIONS: dict[str, Translation | Cannot] = {
+    "lattice": LATTICE_ONLY,
     "planar": Translation(how="discs: 2D positions, spins about z"),
     "rotation": Translation(_pair_rule, how="β, rough or Walton's Coulomb rule per contact"),
     "restitution-law": Translation(_pair_rule, _check_law, how="e(v) in the pair rule"),

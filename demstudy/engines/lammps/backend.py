@@ -83,7 +83,8 @@ class LammpsBackend(BackendBase):
 
     name = "lammps"
     kind = "soft-contact"
-    capabilities = Capabilities(time_step=True, stress="contact", mpi=True, dump=True,
+    capabilities = Capabilities(time_step=True, soft_contact=True, stress="contact", mpi=True,
+                                dump=True,
                                 inputs=True)
     translations = TRANSLATIONS
     #: False: the deck's data file is written and read (``read_data``), as ``lmp -in``

@@ -205,8 +205,8 @@ def _check_parameters(v: dict[str, int], path: Path) -> None:
     if v["nxt"] < 6 or v["nxt"] % 6:
         raise bad("nxt", "a multiple of 6 (move templates have period 3, collision "
                          "templates period 2; listing L1671)")
-    if v["nyt"] < 3:
-        raise bad("nyt", ">= 3 (rows 1 and nyt are the wall rows)")
+    if v["nyt"] < 4:
+        raise bad("nyt", ">= 4 (rows 1 and nyt are the wall rows; the step needs two more)")
     if v["nxt"] % v["mvx"]:
         raise bad("mvx", f"a divisor of nxt = {v['nxt']} (listing L1645)")
     if (v["nyt"] - 2) % v["mvy"]:

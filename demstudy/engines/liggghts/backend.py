@@ -88,7 +88,7 @@ class LiggghtsBackend(BackendBase):
 
     name = "liggghts"
     kind = "soft-contact"
-    capabilities = Capabilities(time_step=True, stress="contact", inputs=True)
+    capabilities = Capabilities(time_step=True, soft_contact=True, stress="contact", inputs=True)
     translations = TRANSLATIONS
     version = f"demstudy {__version__} (liggghts checkpoint 1)"
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from ...contact.mapping import ContactParameters, damping_ratio
 from ...contact.stiffness import ContactSetup
-from ...effects import Cannot, Translation, apply_effects
+from ...effects import LATTICE_ONLY, Cannot, Translation, apply_effects
 from ...effects.bumps import bump_padding, bump_rows
 from ...errors import EngineError, UnsupportedByEngine
 from ...scene import Scene
@@ -301,6 +301,7 @@ def _bump_note(scene: Scene, deck: LiggghtsDeck) -> None:
 
 #: every effect's LIGGGHTS translation, or why LIGGGHTS cannot express it
 TRANSLATIONS: dict[str, Translation | Cannot] = {
+    "lattice": LATTICE_ONLY,
     "planar": Translation(_planar, how="dimension 2 and fix enforce2d (LIGGGHTS gives 2D "
                                        "bodies the disc inertia ½ m R² itself)"),
     "rotation": Translation(check=_check_inertia,

@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ....contact.stiffness import ContactSetup
-from ....effects import Cannot, Translation
+from ....effects import LATTICE_ONLY, Cannot, Translation
 from ....effects.servo import servo_samples
 from ....errors import UnsupportedByEngine
 from ....scene import Scene
@@ -196,6 +196,7 @@ def enforce2d_block() -> Block:
 
 #: every effect's LAMMPS translation, or why LAMMPS cannot express it
 TRANSLATIONS: dict[str, Translation | Cannot] = {
+    "lattice": LATTICE_ONLY,
     "planar": Translation(lambda s, d: d.final.append(enforce2d_block()),
                           how="dimension 2, density/disc masses, nve/sphere disc, enforce2d"),
     "rotation": Translation(_beta_note, _check_rotation,
