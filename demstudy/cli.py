@@ -53,10 +53,11 @@ def _engine_options(args: argparse.Namespace) -> dict:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .engines import get_backend
+    from .engines.lgd.convert import load_scene_or_problem
     from .simulation import RunOptions, check_run, plan_run, run_scene
 
-    scene = load_scene(args.scene, args.set)
-    name = Path(args.scene).stem
+    scene = load_scene_or_problem(args.scene, args.set)  # or Gutt's LGD problem (`in`)
+    name = scene.meta.name if Path(args.scene).name == "in" else Path(args.scene).stem
     out = Path(args.out or Path("results") / f"{name}-{args.engine}.h5")
     options = RunOptions(out=out, np=args.np, dump=args.dump, resume=args.resume,
                          progress=not args.quiet, keep_frames=args.keep_frames or None,
@@ -69,6 +70,24 @@ def _cmd_run(args: argparse.Namespace) -> int:
         return 0
     path = run_scene(scene, args.engine, options)
     print(f"results: {path}")
+    return 0
+
+
+def _cmd_lgd_import(args: argparse.Namespace) -> int:
+    from .engines.lgd.convert import load_scene_or_problem
+    from .scene import scene_to_toml
+
+    scene = load_scene_or_problem(args.problem, args.set)
+    text = ("# Gutt's LGD problem " + str(args.problem) + " as a demstudy lattice scene\n"
+            "# (demstudy lgd-import). Units: [lattice] and its md lines in the listing's "
+            "integers;\n# the rest in particle units (d = 1 = lattice spacing, m = 1, g = 1 "
+            "with gravity,\n# otherwise the wall speed or the initial r.m.s. speed; "
+            "docs/lgd-engine.md).\n" + scene_to_toml(scene))
+    if args.out:
+        Path(args.out).write_text(text)
+        print(f"wrote {args.out}")
+    else:
+        print(text, end="")
     return 0
 
 
@@ -401,7 +420,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_deck)
 
     p = sub.add_parser("run", parents=[overrides], help="run a scene")
-    p.add_argument("scene", help=scene_help)
+    p.add_argument("scene", help=scene_help + "; with --engine lgd also Gutt's LGD problem "
+                                              "(its control file `in` or its folder)")
     p.add_argument("--engine", default=DEFAULT_ENGINE, choices=engines)
     p.add_argument("--np", type=int, default=1, help="MPI ranks (default 1)")
     p.add_argument("--out", help="results file (default results/<scene>-<engine>.h5)")
@@ -424,6 +444,12 @@ def build_parser() -> argparse.ArgumentParser:
                        dest=f"engine_option_{name}", metavar=option.metavar,
                        help="; ".join(f"{engine} only: {o.help}" for engine, o in declared))
     p.set_defaults(func=_cmd_run)
+
+    p = sub.add_parser("lgd-import", parents=[overrides],
+                       help="write Gutt's LGD problem files (control file `in`) as a scene")
+    p.add_argument("problem", help="Gutt's control file `in`, or the folder holding it")
+    p.add_argument("-o", "--out", help="scene file to write (default: print it)")
+    p.set_defaults(func=_cmd_lgd_import)
 
     p = sub.add_parser("plot", help="figures of results files: profiles, stress, statistics",
                        description="One figure per kind, in the seed theses' forms; kinds a "

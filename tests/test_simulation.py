@@ -12,7 +12,6 @@ import pytest
 from ballistic_backend import BallisticBackend
 
 from demstudy.analysis.registry import STATISTICS
-from demstudy.effects import check_effects
 from demstudy.engines import backend_names, get_backend, register_backend
 from demstudy.errors import EngineError, UnsupportedByEngine
 from demstudy.io.results import read_results
@@ -155,7 +154,7 @@ def test_a_statistic_an_engine_cannot_supply_is_refused_before_it_starts(name, t
         with pytest.raises(UnsupportedByEngine) as info:
             run_scene(scene, engine, opts)
         try:  # an engine that can express the scene refuses it for the statistic
-            check_effects(scene, engine, backend.translations)
+            backend.check(scene, opts)  # its effects (and the lattice engine: a lattice)
             assert info.value.value == name, info.value
         except UnsupportedByEngine:
             pass
