@@ -103,6 +103,7 @@ class LgdBackend(BackendBase):
         self.n_wall = {"lower": nxt, "upper": nxt,
                        "extra": int(np.count_nonzero(self.lat.mlp[1:-1] < 0))}
         self.last = (dict(self.total), self.time)  # the previous sample's sums and time
+        self.last_step_ticks = 0  # the latest step's length (sizes the chunks of advance)
         self.first = saved is None
 
     # -- advancing ------------------------------------------------------------------------
@@ -134,8 +135,8 @@ class LgdBackend(BackendBase):
         step's length (steps shrink as grains speed up), then single steps."""
         ticks = t * self.units.ticks_per_time
         while self.lat.itt < ticks - 1e-9 * max(1.0, ticks):
-            last = getattr(self, "last_step_ticks", 0) or 1
-            ahead = int(0.8 * (ticks - self.lat.itt) / last)
+            last = self.last_step_ticks  # 0: no step yet, so no estimate: one step
+            ahead = int(0.8 * (ticks - self.lat.itt) / last) if last else 1
             self._run(max(1, min(CHUNK, ahead)))
             if self.lat.itt < ticks and stop is not None and stop():
                 return False

@@ -1,0 +1,188 @@
+"""The LGD backend through the simulation loop: conservation in an elastic gas box, frames in
+particle units, the time unit (free fall from rest, the first step of a uniform gas), wall
+stresses and their signs in Couette flow, whole steps and times, checkpoint/resume, the
+native and reference steps, and Gutt's own problem files.
+
+Units: particle units (d = 1 = lattice spacing, m = 1, g = 1 with gravity; without gravity
+the wall speed or the grains' initial r.m.s. speed is the speed unit); md lines in the
+listing's integers.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from demstudy.engines.backend import Needs
+from demstudy.engines.lgd.backend import LgdBackend
+from demstudy.engines.lgd.convert import load_scene_or_problem, scene_problem
+from demstudy.engines.lgd.problem import read_problem, write_problem
+from demstudy.errors import EngineError
+from demstudy.io.results import read_results
+from demstudy.scene import validate_scene
+from demstudy.simulation import RunOptions, run_scene
+
+ROW = math.sqrt(3) / 2
+
+
+def gas(speed: int = 1024, **changes) -> dict:
+    """24 × 14 lattice, 96 grains at density 1/3, half moving +x, half −x (Gutt's gas box)."""
+    data = {"dimension": 2, "particles": {}, "contact": {"restitution": 1.0},
+            "walls": [{"side": "lower", "restitution": 1.0},
+                      {"side": "upper", "restitution": 1.0}],
+            "run": {"equilibration": 0, "production": 200, "sample_interval": 20,
+                    "unit": "steps"},
+            "measure": {"bin_width": ROW},
+            "lattice": {"nxt": 24, "nyt": 14, "initial": [
+                {"md": 6, "x1": 1, "y1": 2, "x2": 24, "y2": 7, "vx": speed},
+                {"md": 6, "x1": 1, "y1": 8, "x2": 24, "y2": 13, "vx": -speed}]}}
+    data.update(changes)
+    return data
+
+
+def run(data: dict, out: Path, **options):
+    scene = validate_scene(data)
+    return read_results(run_scene(scene, "lgd", RunOptions(out=out, progress=False,
+                                                           **options)))
+
+
+def backend_of(data: dict, tmp_path: Path) -> LgdBackend:
+    scene = validate_scene(data)
+    backend = LgdBackend(scene, RunOptions(out=tmp_path / "x.h5"), tmp_path / "x.lgd")
+    backend.setup(Needs(), None, None)
+    return backend
+
+
+def test_elastic_gas_keeps_its_grains_and_energy_up_to_round_off(tmp_path):
+    """Walls at rest, e = 1 everywhere: the grain count is exact; the energy changes only by
+    the listing's integer rounding, which shrinks as the integer speeds grow (16× the speed:
+    ≥ 6× less drift)."""
+    drift = {}
+    for speed in (1024, 16384):
+        res = run(gas(speed), tmp_path / f"g{speed}.h5", keep_frames=True)
+        assert [len(p) for p in res.frames["position"]] == [96] * 10
+        energy = res.timeseries["kinetic_energy"]
+        assert energy[0] == pytest.approx(48.0)  # ½ N v², v = 1 (the r.m.s. speed unit)
+        drift[speed] = np.max(np.abs(energy / energy[0] - 1))
+    assert drift[16384] < 3e-3
+    assert drift[1024] > 6 * drift[16384]
+
+
+def test_frames_are_in_particle_units(tmp_path):
+    backend = backend_of(gas(), tmp_path)
+    frame = backend.frame()
+    assert frame.n == 96 and frame.time == 0.0
+    np.testing.assert_array_equal(np.abs(frame.velocity[:, 0]), 1.0)  # ±rms speed = ±1
+    assert frame.box_hi.tolist() == [24.0, pytest.approx(13 * ROW)]
+    # node centres: each grain's nearest neighbour is √3 spacings away (density 1/3)
+    p = frame.position
+    dx = p[:, None, 0] - p[None, :, 0]
+    dx -= 24 * np.round(dx / 24)
+    dist = np.hypot(dx, p[:, None, 1] - p[None, :, 1]) + 99 * np.eye(96)
+    assert dist.min() == pytest.approx(math.sqrt(3))
+    assert set(np.round(p[:, 1] / ROW).astype(int)) == set(range(1, 13))
+    # one step: the fastest grain crosses one spacing, so it lasts d/v_max = 1 time unit
+    backend.advance_steps(1)
+    assert backend.time == pytest.approx(1.0, abs=1 / backend.units.ticks_per_time)
+
+
+def test_free_fall_sets_the_time_unit_root_d_over_g(tmp_path):
+    """One grain at rest, gravity along −y: the first step is the fall time over one row
+    height (the listing uses idy there): √(2·(√3/2)/g) = 3^¼ time units, and the grain then
+    moves at −g t."""
+    data = gas(gravity={"direction": [0.0, -1.0]},
+               lattice={"nxt": 12, "nyt": 10, "initial": [{"md": 1, "x1": 5, "y1": 6}]})
+    backend = backend_of(data, tmp_path)
+    backend.advance_steps(1)
+    t = backend.time
+    assert t == pytest.approx(3 ** 0.25, abs=2 / backend.units.ticks_per_time)
+    v = backend.frame().velocity[0]
+    assert v[0] == 0.0
+    assert v[1] == pytest.approx(-t, abs=1 / backend.units.speed)
+
+
+def test_couette_wall_stresses_have_the_signs_of_the_drive(tmp_path):
+    """Walls at ±1 (speed_scale 4096): the grains drag the upper wall back (−x) and the
+    lower one forward (+x), and push both walls outwards; the per-wall-particle values are
+    the loop's total wall forces divided by nxt."""
+    data = gas(walls=[{"side": "lower", "restitution": 0.75, "velocity": -1.0},
+                      {"side": "upper", "restitution": 0.75, "velocity": 1.0}],
+               lattice={"nxt": 24, "nyt": 14, "speed_scale": 4096, "initial": [
+                   {"md": 6, "x1": 1, "y1": 2, "x2": 24, "y2": 13}]})
+    ts = run(data, tmp_path / "c.h5").timeseries
+    later = slice(3, None)
+    assert np.mean(ts["wall_shear_upper"][later]) < 0 < np.mean(ts["wall_shear_lower"][later])
+    assert np.mean(ts["wall_normal_lower"][later]) < 0 < np.mean(ts["wall_normal_upper"][later])
+    np.testing.assert_allclose(ts["wall_force_upper"][1:, 0], 24 * ts["wall_shear_upper"][1:],
+                               rtol=1e-12)
+    np.testing.assert_allclose(ts["wall_force_lower"][1:, 1],
+                               24 * ts["wall_normal_lower"][1:], rtol=1e-12)
+    assert np.isnan(ts["wall_shear_extra"]).all()  # no extra wall particles
+
+
+def test_samples_fall_on_whole_steps_or_just_past_their_times(tmp_path):
+    steps = run(gas(), tmp_path / "s.h5").timeseries
+    assert steps["steps"].tolist() == list(range(0, 201, 20))
+    timed = run(gas(run={"equilibration": 0.0, "production": 20.0, "sample_interval": 2.0}),
+                tmp_path / "t.h5").timeseries
+    late = timed["time"] - 2.0 * np.arange(11)
+    assert (late >= 0).all() and (late < 1.0).all()  # within one step (≤ d/v_max ≈ 1)
+
+
+def test_resumed_run_equals_an_uninterrupted_one(tmp_path):
+    data = gas(run={"equilibration": 40, "production": 80, "sample_interval": 20,
+                    "unit": "steps"})
+    whole = run(data, tmp_path / "w.h5")
+    out, stops = tmp_path / "p.h5", 0
+    for _ in range(20):  # every part stops at its first sample, after a checkpoint
+        try:
+            run(data, out, wall_limit=0.0, resume=(tmp_path / "p.lgd").exists())
+            break
+        except EngineError as stopped:
+            assert "--resume" in str(stopped)
+            stops += 1
+    assert stops == 5  # 6 samples after the initial one: stopped after each but the last
+    parts = read_results(out)
+    for key, value in whole.timeseries.items():
+        np.testing.assert_array_equal(value, parts.timeseries[key], err_msg=key)
+    for key, value in whole.profiles.items():
+        np.testing.assert_array_equal(value, parts.profiles[key], err_msg=key)
+
+
+def test_reference_step_gives_the_native_results(tmp_path):
+    data = gas(run={"equilibration": 0, "production": 30, "sample_interval": 10,
+                    "unit": "steps"})
+    native = run(data, tmp_path / "n.h5").timeseries
+    reference = run(data, tmp_path / "r.h5", extra={"impl": "reference"}).timeseries
+    for key, value in native.items():
+        np.testing.assert_array_equal(value, reference[key], err_msg=key)
+
+
+def test_gutts_problem_files_run_and_round_trip(tmp_path):
+    folder = tmp_path / "couette"
+    folder.mkdir()
+    (folder / "in").write_text("0\npar\nsum\ndump\n")
+    (folder / "par").write_text(
+        "nam2 = init id = 1048576 icb = 0 iep1 = 16 iew1 = 12\n"
+        "idl = 2048 idx = 1024 idy = 1774 iep2 = 16 iew2 = 12\n"
+        "igx = 0 igy = 0 jx1 = -4096 jx2 = 4096\n"
+        "kq = 1560 kx = 780 ky = 1351 ke = 16\n"
+        "mvx = 6 mvy = 4\n"
+        "nt = 40 nxt = 24 nyt = 14 ntu = 3 nto = 20\n")
+    (folder / "init").write_text("  nl = 1\n 6 1 2 24 13 0 0\n")
+    scene = load_scene_or_problem(folder / "in")
+    assert [w.velocity for w in scene.walls] == [-1.0, 1.0]
+    assert scene.run.unit == "steps" and scene.run.production == 40
+    problem = read_problem(folder)
+    again = scene_problem(scene)  # the integers the engine runs are the file's
+    assert again.params == problem.params.resolved()
+    assert again.lines == problem.lines and again.nt == 40
+    res = read_results(run_scene(scene, "lgd", RunOptions(out=tmp_path / "c.h5",
+                                                          progress=False)))
+    assert res.timeseries["steps"].tolist() == [0, 20, 40]
+    assert res.attrs["lgd_jx2"] == 4096 and res.attrs["lgd_idl"] == 2048
+    write_problem(tmp_path / "out", again)
+    assert read_problem(tmp_path / "out").params == problem.params.resolved()
