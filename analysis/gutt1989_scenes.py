@@ -129,7 +129,7 @@ def couette(name: str, e_pp: float, e_pw: float, speed: int, what: str) -> str:
         "# Gutt (1989) §3 (L1069–L1079, figs 3.20–3.23): gravity-free Couette flow between "
         "wall rows\n# moving at ±U: 5760 grains in a channel 60 rows wide and 192 long "
         "(5760 = ½·60·192, so\n# nyt = 62: 60 open rows + 2 wall rows, derived), 1024 "
-        "steps. " + what + "\n" + HEADER_UNITS["wall"],
+        "steps.\n# " + what + "\n" + HEADER_UNITS["wall"],
         f'description = "Couette flow, e_pp = {e_pp}, e_pw = {e_pw}, walls at -+{speed} '
         '(the listing\'s integers; +-1 in particle units); ASSUMED layout: grains at rest on '
         'every other row (density 1/2; figure 3.20 missing)"\n'
