@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from demstudy.cli import main
 from demstudy.engines.backend import Needs
 from demstudy.engines.lgd.backend import LgdBackend
 from demstudy.engines.lgd.convert import load_scene_or_problem, scene_problem
@@ -161,7 +162,7 @@ def test_reference_step_gives_the_native_results(tmp_path):
         np.testing.assert_array_equal(value, reference[key], err_msg=key)
 
 
-def test_gutts_problem_files_run_and_round_trip(tmp_path):
+def couette_problem(tmp_path: Path) -> Path:
     folder = tmp_path / "couette"
     folder.mkdir()
     (folder / "in").write_text("0\npar\nsum\ndump\n")
@@ -173,6 +174,11 @@ def test_gutts_problem_files_run_and_round_trip(tmp_path):
         "mvx = 6 mvy = 4\n"
         "nt = 40 nxt = 24 nyt = 14 ntu = 3 nto = 20\n")
     (folder / "init").write_text("  nl = 1\n 6 1 2 24 13 0 0\n")
+    return folder
+
+
+def test_gutts_problem_files_run_and_round_trip(tmp_path):
+    folder = couette_problem(tmp_path)
     scene = load_scene_or_problem(folder / "in")
     assert [w.velocity for w in scene.walls] == [-1.0, 1.0]
     assert scene.run.unit == "steps" and scene.run.production == 40
@@ -186,3 +192,19 @@ def test_gutts_problem_files_run_and_round_trip(tmp_path):
     assert res.attrs["lgd_jx2"] == 4096 and res.attrs["lgd_idl"] == 2048
     write_problem(tmp_path / "out", again)
     assert read_problem(tmp_path / "out").params == problem.params.resolved()
+
+
+def test_command_line_runs_and_imports_gutts_problems(tmp_path, capsys):
+    folder = couette_problem(tmp_path)
+    assert main(["run", str(folder), "--engine", "lgd", "-q", "--out",
+                 str(tmp_path / "a.h5")]) == 0
+    assert main(["lgd-import", str(folder / "in"), "-o", str(tmp_path / "c.toml")]) == 0
+    assert main(["run", str(tmp_path / "c.toml"), "--engine", "lgd", "-q", "--out",
+                 str(tmp_path / "b.h5")]) == 0
+    a, b = read_results(tmp_path / "a.h5"), read_results(tmp_path / "b.h5")
+    np.testing.assert_array_equal(a.timeseries["kinetic_energy"],
+                                  b.timeseries["kinetic_energy"])
+    (folder / "par").write_text((folder / "par").read_text().replace("ke = 16", "ke = x"))
+    capsys.readouterr()
+    assert main(["run", str(folder), "--engine", "lgd", "-q"]) == 2  # refused: nothing ran
+    assert "par, line 4: ke = 'x' is not an integer" in capsys.readouterr().err

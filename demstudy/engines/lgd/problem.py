@@ -54,6 +54,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import BadInputFile
 from .lattice import MOVABLE, WALL, Lattice, LgdParams
 
 __all__ = ["MD_CODES", "PARAMETER_LINES", "Control", "MdLine", "Problem", "ProblemError",
@@ -74,8 +75,9 @@ PARAMETER_LINES: tuple[tuple[str, ...], ...] = (
 MD_CODES = (-6, -3, -2, -1, 0, 1, 2, 3, 6)
 
 
-class ProblemError(ValueError):
-    """A problem file that cannot be read: names the file, the line and the field."""
+class ProblemError(BadInputFile):
+    """A problem file that cannot be read: names the file, the line and the field (exit 2 on
+    the command line: nothing ran)."""
 
 
 @dataclass(frozen=True)
