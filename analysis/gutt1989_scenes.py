@@ -45,8 +45,11 @@ def walls(e: float, e_name: str, velocities=(0.0, 0.0)) -> str:
 
 def scene(name: str, header: str, meta: str, body: str, lattice: str, lines: list[str],
           run: str) -> str:
+    nxt, nyt = (int(v.split("=")[1].split("#")[0]) for v in lattice.splitlines()[:2])
+    box = (f"\n[box]   # the lattice: [nxt, (nyt − 1)·√3/2], wall-row centre to centre\n"
+           f"size = [{float(nxt)!r}, {(nyt - 1) * ROW!r}]\n")
     return (header + "\ndimension = 2\n\n[meta]\n" + f'name = "gutt1989-{name}"\n' + meta +
-            "\n[particles]   # the grains are the lattice's (md lines)\n\n" + body +
+            box + "\n[particles]   # the grains are the lattice's (md lines)\n\n" + body +
             "\n" + run + '\n[measure]\nbin_width = 0.8660254037844386   # one lattice row '
                          '(√3/2) per bin\n\n[lattice]\n' + lattice + "initial = [\n" +
             "\n".join(lines) + "\n]\n")
