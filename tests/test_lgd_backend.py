@@ -65,6 +65,9 @@ def test_elastic_gas_keeps_its_grains_and_energy_up_to_round_off(tmp_path):
     for speed in (1024, 16384):
         res = run(gas(speed), tmp_path / f"g{speed}.h5", keep_frames=True)
         assert [len(p) for p in res.frames["position"]] == [96] * 10
+        # the profiles see every grain (each sample: 96 discs of area π/4 in the box)
+        area = res.profiles["solid_fraction"].sum() * res.profile_attrs["bin_width"] * 24.0
+        assert area == pytest.approx(96 * math.pi / 4, rel=1e-12)
         energy = res.timeseries["kinetic_energy"]
         assert energy[0] == pytest.approx(48.0)  # ½ N v², v = 1 (the r.m.s. speed unit)
         drift[speed] = np.max(np.abs(energy / energy[0] - 1))
@@ -133,19 +136,27 @@ def test_samples_fall_on_whole_steps_or_just_past_their_times(tmp_path):
     assert (late >= 0).all() and (late < 1.0).all()  # within one step (≤ d/v_max ≈ 1)
 
 
-def test_resumed_run_equals_an_uninterrupted_one(tmp_path):
+@pytest.mark.parametrize("chunk", [256, 7])
+def test_resumed_run_equals_an_uninterrupted_one(tmp_path, monkeypatch, chunk):
+    """Stopped at every sample (chunks of 256 steps) or inside the intervals (chunks of 7
+    steps, intervals of 20): the resumed parts give the uninterrupted run's results."""
+    from demstudy.engines.lgd import backend
+
     data = gas(run={"equilibration": 40, "production": 80, "sample_interval": 20,
                     "unit": "steps"})
     whole = run(data, tmp_path / "w.h5")
+    monkeypatch.setattr(backend, "CHUNK", chunk)
     out, stops = tmp_path / "p.h5", 0
-    for _ in range(20):  # every part stops at its first sample, after a checkpoint
+    for _ in range(100):  # every part stops after its first chunk, after a checkpoint
         try:
             run(data, out, wall_limit=0.0, resume=(tmp_path / "p.lgd").exists())
             break
         except EngineError as stopped:
             assert "--resume" in str(stopped)
             stops += 1
-    assert stops == 5  # 6 samples after the initial one: stopped after each but the last
+    # 6 samples after the initial one: stopped after each but the last (chunks of 256), or
+    # after every chunk of 7 steps but the last (120 steps: 3 chunks per interval of 20)
+    assert stops == (5 if chunk == 256 else 6 * 3 - 1)
     parts = read_results(out)
     for key, value in whole.timeseries.items():
         np.testing.assert_array_equal(value, parts.timeseries[key], err_msg=key)

@@ -24,14 +24,10 @@ from pydantic import Field, model_validator
 
 from .base import Float, Int, PosFloat, PosInt, StrictModel
 
-__all__ = ["LatticeLine", "LatticeSpec", "lattice_box", "lattice_grains", "row_height"]
+__all__ = ["ROW_HEIGHT", "LatticeLine", "LatticeSpec", "lattice_box", "lattice_grains"]
 
 #: y distance between two lattice rows, in spacings
 ROW_HEIGHT = math.sqrt(3.0) / 2.0
-
-
-def row_height() -> float:
-    return ROW_HEIGHT
 
 
 class LatticeLine(StrictModel):

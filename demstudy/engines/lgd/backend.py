@@ -97,12 +97,15 @@ class LgdBackend(BackendBase):
                                pv=tuple(saved["pv"]), nn=int(saved["nn"]),
                                itt=int(saved["itt"]), ng=int(saved["ng"]))
             self.total, self.nq = dict(saved["total"]), int(saved["nq"])
+            # a stop inside a sample interval: its sums so far carry over
+            self.last = (dict(saved["last_total"]), float(saved["last_time"]))
         self.n_particles = self.lat.ng
         # wall particles per group (the listing's nxt, nxt and nw)
         nyt, nxt = self.lat.mlp.shape
         self.n_wall = {"lower": nxt, "upper": nxt,
                        "extra": int(np.count_nonzero(self.lat.mlp[1:-1] < 0))}
-        self.last = (dict(self.total), self.time)  # the previous sample's sums and time
+        if saved is None:
+            self.last = (dict(self.total), self.time)  # the previous sample's sums, time
         self.last_step_ticks = 0  # the latest step's length (sizes the chunks of advance)
         self.first = saved is None
 
@@ -199,7 +202,8 @@ class LgdBackend(BackendBase):
         lat = self.lat
         return {"lattice": {k: getattr(lat, k).copy() for k in ARRAYS},
                 "pv": tuple(int(v) for v in lat.pv), "nn": lat.nn, "itt": lat.itt,
-                "ng": lat.ng, "total": dict(self.total), "nq": self.nq}
+                "ng": lat.ng, "total": dict(self.total), "nq": self.nq,
+                "last_total": dict(self.last[0]), "last_time": self.last[1]}
 
     def result_attrs(self) -> dict:
         par = self.params.resolved()
