@@ -334,6 +334,7 @@ SCENES = [
     dict(seed=3, g=(0, 0), e=(16, 16, 12, 12), icb=0, extra=0.0),  # elastic gas, no gravity
     dict(seed=4, g=(-8, 0), e=(12, 15, 16, 4), ntu=1, nxt=36, nyt=10),
     dict(seed=5, density=0.8, speed=6000, icb=3000),  # dense and fast
+    dict(seed=6, speed=400_000, icb=100_000, nxt=18),  # products beyond 2^32
 ]
 
 
