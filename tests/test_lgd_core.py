@@ -218,6 +218,38 @@ def test_c_pair_and_wall_above_cb():
     assert lat.ipx[2, 9] == -5438
 
 
+def test_walls_on_the_other_side_of_each_bond():
+    """colb with the wall at m1 (moving top row), colc with the wall at m0, colf with the
+    wall at m1 (bottom row): the listing's surviving branches."""
+    lat = box(jx2=-1000)
+    c = derived(icb=2000, iew1=12)  # iew1 = 28
+    grain(lat, 4, 3, v=(0, 600), p=(-500, -700))  # G = 4, R = 5: template 3; b → top wall
+    ref.collide(lat, c, 3, "b")
+    # kc1 = (780·(0 + 1000) + 1351·600 + 780)/1560 = 1591380/1560 = 1020; ikc = 28·1020
+    # ikcx = (780·28560 + 12480)/24960 = 22289280/24960 = 893 (exact)
+    # ikcy = (1351·28560 + 12480)/24960 = 38597040/24960 = 1546
+    assert (lat.ivx[4, 3], lat.ivy[4, 3]) == (-893, 600 - 1546)
+    assert (lat.ipx[5, 3], lat.ipy[5, 3]) == (893, 1546)
+    # ip = (3547·(−500) − 2048·(−700))/4096 = −339900/4096 = −82 (trunc)
+    # ipx = (−82·3547)/4096 = −290854/4096 = −71; ipy = (82·2048)/4096 = 41
+    assert (lat.ipx[4, 3], lat.ipy[4, 3]) == (-71, 41)
+
+    grain(lat, 2, 6, mode=WALL)  # G = 7, R = 3: template 4; its c partner (2, 5)
+    grain(lat, 2, 5, v=(700, 0), p=(900, 33))
+    ref.collide(lat, c, 4, "c")
+    # kc1 = 700 − 0; ikc = 28·700 = 19600; ikcx = (19600 + 8)/16 = 1225 (rebound .75·700)
+    assert (lat.ivx[2, 5], lat.ipx[2, 5], lat.ipy[2, 5]) == (700 - 1225, 0, 33)
+    assert lat.ipx[2, 6] == 1225
+
+    grain(lat, 1, 3, v=(-200, -800))  # G = 4, R = 2: template 1; f partner: wall (0, 4)
+    ref.collide(lat, c, 1, "f")
+    # kc1 = (780·(−200 − 0) + 1351·(0 + 800) + 780)/1560 = 925580/1560 = 593; ikc = 16604
+    # ikcx = (780·16604 + 12480)/24960 = 12963600/24960 = 519
+    # ikcy = (1351·16604 + 12480)/24960 = 22444484/24960 = 899
+    assert (lat.ivx[1, 3], lat.ivy[1, 3]) == (-200 - 519, -800 + 899)
+    assert (lat.ipx[0, 4], lat.ipy[0, 4]) == (519, -899)
+
+
 # --------------------------------------------------------------------------- time step
 def test_time_step_without_gravity():
     c = derived()
@@ -229,6 +261,18 @@ def test_time_step_without_gravity():
     core.prepare(lat, par)
     assert lat.pv == (25_000_000, 3000, 4000)
     assert core.run_steps(lat, par, 1, impl="reference")["it"][0] == 3355
+
+
+def test_peak_speed_tie_goes_to_the_first_grain_in_storage_order():
+    # the listing's scan keeps the first grain with the strictly largest v² (rows R, then
+    # columns G); its velocity vector enters the gravity time step through g·v
+    lat, par = box(), LgdParams(nxt=12, nyt=6, igx=5, igy=-7)
+    grain(lat, 2, 0, v=(-400, -300))
+    grain(lat, 1, 9, v=(300, 400))
+    grain(lat, 1, 10, v=(0, 500))
+    grain(lat, 3, 3, v=(0, -499))
+    core.prepare(lat, par)
+    assert lat.pv == (250_000, 300, 400) and lat.ng == 4
 
 
 def quartic_root_ticks(v, g, idy):
@@ -246,6 +290,10 @@ def quartic_root_ticks(v, g, idy):
 def test_time_step_with_gravity_is_the_quartic_root(g):
     rng = np.random.default_rng(1)
     c = derived(igx=g[0], igy=g[1])
+    if g == (0, -8):
+        # itm = 1024·√(2·4096/8) = 32768 ticks (0.5 s); rising at 1 cm/s (256) the grain is
+        # d = 0.866 cm below its start at 4t² − t = 0.866 → t = 0.607 s > itm: capped
+        assert c.itm == 32768 and ref.time_step((256**2, 0, 256), c) == 32768
     vs = [(0, 0), (3000, 0), (0, 2000), (0, -2000)] + [tuple(v) for v in
                                                         rng.integers(-4000, 4000, (40, 2))]
     for vx, vy in vs:
@@ -259,7 +307,7 @@ def test_time_step_with_gravity_is_the_quartic_root(g):
 
 # --------------------------------------------------------------------------- whole runs
 def random_scene(seed, nxt=24, nyt=12, density=0.45, g=(0, -8), jx=(0, 0), extra=0.03,
-                 ntu=3, e=(12, 15, 12, 15), icb=724, speed=2000):
+                 ntu=3, e=(12, 15, 12, 15), icb=724, speed=2000, same_speed=False):
     """Grains at random sites with random velocities and offsets; optional extra walls
     (some moving); icb = 4·√(2·8·4096) = 1024 is the digest's c_b for g = 8, 724 a variant."""
     rng = np.random.default_rng(seed)
@@ -270,6 +318,8 @@ def random_scene(seed, nxt=24, nyt=12, density=0.45, g=(0, -8), jx=(0, 0), extra
     m = lat.mlp == MOVABLE
     k = int(m.sum())
     lat.ivx[m], lat.ivy[m] = rng.integers(-speed, speed + 1, (2, k))
+    if same_speed:  # the thesis's gas start: one speed, half along +x, half along −x
+        lat.ivx[m], lat.ivy[m] = rng.choice([-speed, speed], k), 0
     lat.ipx[m], lat.ipy[m] = rng.integers(-3000, 3001, (2, k))
     lat.nlp[m] = np.arange(1, k + 1)
     w = np.zeros_like(m)
@@ -334,6 +384,8 @@ SCENES = [
     dict(seed=3, g=(0, 0), e=(16, 16, 12, 12), icb=0, extra=0.0),  # elastic gas, no gravity
     dict(seed=4, g=(-8, 0), e=(12, 15, 16, 4), ntu=1, nxt=36, nyt=10),
     dict(seed=5, density=0.8, speed=6000, icb=3000),  # dense and fast
+    dict(seed=6, speed=400_000, icb=100_000, nxt=18),  # products beyond 2^32
+    dict(seed=7, g=(5, -7), same_speed=True, extra=0.0),  # ties for the peak-speed grain
 ]
 
 

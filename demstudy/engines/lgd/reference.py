@@ -34,14 +34,19 @@ Serial replacements and reconstructions (each a documented choice, not thesis te
 * halo exchange → periodic columns (G wraps mod nxt); rows are not periodic: row 1 and row
   nyt are walls, so ``colb`` of row nyt and ``colf`` of row 1 have no partner (the listing's
   ghost rows are empty), and the parallel ghost filter of ``uppo`` has no serial analogue;
-* ``colf``'s missing page (L3062–L3066): the wall-at-m0 branch is reconstructed as the mirror
+* ``colf``'s missing page (L3062–L3066): its header and guard are taken as colb's mirror
+  (partner m1 = (G + 1, R − 1) inside the lattice, columns periodic); the wall-at-m0 branch
+  is reconstructed as the mirror
   of ``colb``'s with the f signs (digest §3.13): wall ``ipx -= ikcx, ipy += ikcy``, grain
   ``ivx += ikcx, ivy -= ikcy``, then the f projection of the grain's offset;
 * the OCR's undeclared ``kyp``/``kyw`` (colb/colf) are read as ``kxp``/``kxw``;
 * ``ix == iy == 0`` with ``id == 0`` falls to the listing's "+y" branch (b on odd rows R, a on
   even rows), as the C ``else`` does;
 * nw (extra wall particles) = walls outside rows 1 and nyt; walls never move or vanish, so
-  it is computed from ``mlp`` rather than stored.
+  it is computed from ``mlp`` rather than stored;
+* nq uses the listing's user column ix = ((G + (R − 1)/2 − 1) mod nxt) + 1 > nxt/2;
+* as in the listing, ``prepare`` does not clear wall accumulators (a wall's input offset is
+  summed in step 1), and a grain given mlp == 2 on input skips the first drift and moves.
 
 Within one move template the sources are ≥ 3 apart in G or R and never compete for a target,
 and within one collision template and direction the pairs are disjoint, so each is one

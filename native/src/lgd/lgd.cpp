@@ -18,6 +18,29 @@ enum Dir { D = 0, B, A, C, E, F };
 constexpr int kDc[6] = {1, 0, -1, -1, 0, 1};
 constexpr int kDr[6] = {0, 1, 1, 0, -1, -1};
 
+// C's truncating division by a positive divisor fixed for the run, without the slow 64-bit
+// idiv: a power of two by shifts; otherwise in doubles, exact for |a| < 2^53 (a correctly
+// rounded a/d never reaches the next integer: that is >= 1/d away, the rounding error
+// <= |a/d|·2^-53 < 1/d), with the integer division kept for larger |a|.
+struct Divider {
+    std::int64_t d = 1;
+    double dd = 1.0;
+    int shift = -1;  // log2(d) when d is a power of two
+    explicit Divider(std::int64_t divisor = 1) : d(divisor), dd(static_cast<double>(divisor)) {
+        if (d > 0 && (d & (d - 1)) == 0) {
+            shift = 0;
+            while ((std::int64_t{1} << shift) != d) ++shift;
+        }
+    }
+    std::int64_t operator()(std::int64_t a) const {
+        if (shift >= 0) return (a + ((a >> 63) & (d - 1))) >> shift;
+        constexpr std::int64_t kExact = std::int64_t{1} << 53;
+        if (a > -kExact && a < kExact)
+            return static_cast<std::int64_t>(static_cast<double>(a) / dd);
+        return a / d;
+    }
+};
+
 inline std::int64_t round_half_away(double x) {
     return static_cast<std::int64_t>(x + (x < 0 ? -0.5 : 0.5));
 }
@@ -76,6 +99,13 @@ void move_template(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0
     }
 }
 
+// the run's fixed divisors
+struct Divs {
+    Divider kq, kqp, kqw, id2, ke, ke1;
+    explicit Divs(const Params& p)
+        : kq(p.kq), kqp(p.kqp), kqw(p.kqw), id2(p.id2), ke(p.ke), ke1(p.ke1) {}
+};
+
 // ikc = ke·(1+e)·kc with the piecewise restitution
 inline std::int64_t impulse(const Params& p, std::int64_t kc1, bool wall) {
     if (kc1 <= p.icb) return (wall ? p.iew1 : p.iep1) * kc1;
@@ -85,14 +115,16 @@ inline std::int64_t impulse(const Params& p, std::int64_t kc1, bool wall) {
 }
 
 // remove the offset component along k = (½, sy·√3/2), keep the perpendicular one
-inline void project(const Params& p, std::int64_t& px, std::int64_t& py, std::int64_t sy) {
-    const std::int64_t ip = (p.idy * px - sy * p.idx * py) / p.id2;
-    px = ip * p.idy / p.id2;
-    py = -sy * ip * p.idx / p.id2;
+inline void project(const Params& p, const Divs& dv, std::int64_t& px, std::int64_t& py,
+                    std::int64_t sy) {
+    const std::int64_t ip = dv.id2(p.idy * px - sy * p.idx * py);
+    px = dv.id2(ip * p.idy);
+    py = dv.id2(-sy * ip * p.idx);
 }
 
 // colb (sy = +1, partner (r+1, c)) or colf (sy = -1, partner (r-1, c+1)) on one template
-void collide_bf(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0, int sy) {
+void collide_bf(const Params& p, const Divs& dv, Lattice& L, std::int64_t r0, std::int64_t c0,
+                int sy) {
     const std::int64_t nxt = L.nxt;
     const std::int64_t r_lo = sy > 0 ? 0 : 1, r_hi = sy > 0 ? L.nyt - 1 : L.nyt;
     std::int64_t r = r0;
@@ -109,22 +141,23 @@ void collide_bf(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0, i
             const std::int64_t m1 = prow + c1;
             const std::int8_t a1 = L.mlp[m1];
             if (a1 == kEmpty || (a0 < 0 && a1 < 0)) continue;
-            const std::int64_t kc1 =
-                (p.kx * (L.ivx[m0] - L.ivx[m1]) + sy * p.ky * (L.ivy[m0] - L.ivy[m1]) + p.kx) /
-                p.kq;
-            if (kc1 <= 0) continue;
+            const std::int64_t num =
+                p.kx * (L.ivx[m0] - L.ivx[m1]) + sy * p.ky * (L.ivy[m0] - L.ivy[m1]) + p.kx;
+            if (num < p.kq) continue;  // kc1 = num/kq (truncated) <= 0: not approaching
+            const std::int64_t kc1 = dv.kq(num);
             const bool wall = a0 < 0 || a1 < 0;
             const std::int64_t ikc = impulse(p, kc1, wall);
-            const std::int64_t add = wall ? p.kxw : p.kxp, den = wall ? p.kqw : p.kqp;
-            const std::int64_t dvx = (p.kx * ikc + add) / den;  // Δv of m1; m0 gets −Δv
-            const std::int64_t dvy = sy * ((p.ky * ikc + add) / den);
+            const std::int64_t add = wall ? p.kxw : p.kxp;
+            const Divider& den = wall ? dv.kqw : dv.kqp;
+            const std::int64_t dvx = den(p.kx * ikc + add);  // Δv of m1; m0 gets −Δv
+            const std::int64_t dvy = sy * den(p.ky * ikc + add);
             if (a0 < 0) {  // wall at m0: it accumulates −Δv(grain)
                 L.ipx[m0] -= dvx;
                 L.ipy[m0] -= dvy;
             } else {
                 L.ivx[m0] -= dvx;
                 L.ivy[m0] -= dvy;
-                project(p, L.ipx[m0], L.ipy[m0], sy);
+                project(p, dv, L.ipx[m0], L.ipy[m0], sy);
             }
             if (a1 < 0) {
                 L.ipx[m1] += dvx;
@@ -132,14 +165,14 @@ void collide_bf(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0, i
             } else {
                 L.ivx[m1] += dvx;
                 L.ivy[m1] += dvy;
-                project(p, L.ipx[m1], L.ipy[m1], sy);
+                project(p, dv, L.ipx[m1], L.ipy[m1], sy);
             }
         }
     }
 }
 
 // colc: partner (r, c-1), k = (-1, 0)
-void collide_c(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0) {
+void collide_c(const Params& p, const Divs& dv, Lattice& L, std::int64_t r0, std::int64_t c0) {
     const std::int64_t nxt = L.nxt;
     for (std::int64_t r = r0; r < L.nyt; r += 2) {
         const std::int64_t row = r * nxt;
@@ -154,7 +187,7 @@ void collide_c(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0) {
             if (kc1 <= 0) continue;
             const bool wall = a0 < 0 || a1 < 0;
             const std::int64_t ikc = impulse(p, kc1, wall);
-            const std::int64_t ikcx = wall ? (ikc + p.ke2) / p.ke : (ikc + p.ke) / p.ke1;
+            const std::int64_t ikcx = wall ? dv.ke(ikc + p.ke2) : dv.ke1(ikc + p.ke);
             if (a0 < 0) {
                 L.ipx[m0] += ikcx;
             } else {
@@ -173,7 +206,7 @@ void collide_c(const Params& p, Lattice& L, std::int64_t r0, std::int64_t c0) {
 
 // the 12 sub-sweeps; template t (1..4) has (G parity, R parity) = (0,0), (1,0), (0,1), (1,1)
 // with G = c + 1, R = r + 1, i.e. first array column 1 - Gpar, first array row 1 - Rpar
-void collide_sweep(const Params& p, Lattice& L, std::int64_t nn) {
+void collide_sweep(const Params& p, const Divs& dv, Lattice& L, std::int64_t nn) {
     static const int kTemplate[12] = {3, 3, 3, 2, 2, 2, 4, 4, 4, 1, 1, 1};
     static const char kBond[12] = {'b', 'c', 'f', 'f', 'c', 'b', 'b', 'c', 'f', 'f', 'c', 'b'};
     static const int kC0[5] = {0, 1, 0, 1, 0}, kR0[5] = {0, 1, 1, 0, 0};
@@ -182,8 +215,8 @@ void collide_sweep(const Params& p, Lattice& L, std::int64_t nn) {
         const int j = odd ? k : 11 - k;
         const int t = kTemplate[j];
         const char bond = kBond[j];
-        if (bond == 'c') collide_c(p, L, kR0[t], kC0[t]);
-        else collide_bf(p, L, kR0[t], kC0[t], bond == 'b' ? 1 : -1);
+        if (bond == 'c') collide_c(p, dv, L, kR0[t], kC0[t]);
+        else collide_bf(p, dv, L, kR0[t], kC0[t], bond == 'b' ? 1 : -1);
     }
 }
 
@@ -212,6 +245,7 @@ std::int64_t time_step(const Params& p, std::int64_t pv2i, std::int64_t pvx, std
 
 void run_steps(const Params& p, State& s, std::int64_t n_steps, std::int64_t* log) {
     Lattice L{s.mlp, s.ipx, s.ipy, s.ivx, s.ivy, s.nlp, s.nxt, s.nyt};
+    const Divs divs(p);
     const std::int64_t nxt = s.nxt, nyt = s.nyt, n = nxt * nyt;
     static const int kMoveA[9] = {0, 2, 1, 2, 1, 0, 1, 0, 2};
     static const int kMoveB[9] = {0, 1, 2, 0, 1, 2, 0, 1, 2};
@@ -231,7 +265,7 @@ void run_steps(const Params& p, State& s, std::int64_t n_steps, std::int64_t* lo
         for (std::int64_t pass = 0; pass < p.ntu; ++pass)
             for (int k = 0; k < 9; ++k)  // template (G ≡ a, R ≡ b mod 3), G = c + 1, R = r + 1
                 move_template(p, L, (kMoveB[k] + 2) % 3, (kMoveA[k] + 2) % 3);
-        collide_sweep(p, L, s.nn);
+        collide_sweep(p, divs, L, s.nn);
         std::int64_t wsum[6] = {0, 0, 0, 0, 0, 0};  // is1 ip1 is2 ip2 is3 ip3
         for (int w = 0; w < 2; ++w) {
             const std::int64_t row = (w == 0 ? 0 : nyt - 1) * nxt;
