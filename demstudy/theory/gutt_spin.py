@@ -94,7 +94,8 @@ class GuttSpinConstants:
       (assumed: about Ch. 2's Delta h/(3h) = 0.108), ``rho`` = 1 (assumed; only S4's p0).
 
     Validated: all finite and positive (gamma_t >= 0), and the thesis's constraints (L463)
-    gamma'_t > gamma'_r, gamma''_r > gamma''_t, gamma'_t gamma''_r - gamma''_t gamma'_r > 0.
+    gamma'_t > gamma'_r and gamma''_r > gamma''_t; its third, gamma'_t gamma''_r -
+    gamma''_t gamma'_r > 0, follows from these two (all gammas > 0).
     """
 
     t: float = 1.0
@@ -133,10 +134,8 @@ class GuttSpinConstants:
             raise ValueError(
                 f"GuttSpinConstants: gamma2_r = {self.gamma2_r!r} must exceed gamma2_t = "
                 f"{self.gamma2_t!r} (thesis L463: gamma''_r > gamma''_t)")
-        if not self.determinant > 0:
-            raise ValueError(
-                f"GuttSpinConstants: gamma1_t*gamma2_r - gamma2_t*gamma1_r = "
-                f"{self.determinant!r} must be > 0 (thesis L463)")
+        # the third constraint of L463, gamma'_t gamma''_r - gamma''_t gamma'_r > 0, follows
+        # from the two above for positive gammas: it needs no check of its own
 
     @classmethod
     def from_restitution(cls, e: float, beta: float, rate: float = 1.0,
