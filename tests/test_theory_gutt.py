@@ -339,3 +339,25 @@ def test_bad_channel_is_refused():
         spin_plates(C, 3.0, 0.0, 1.0)
     with pytest.raises(ValueError, match="too wide"):
         spin_couette(C, 2 * spin_couette_threshold(C), 100.0, 1.0, 0.0)
+
+
+@pytest.mark.parametrize("k2", [0.0625, 0.25])
+def test_normalised_stress_is_the_l775_formula_and_independent_of_the_wall_speed(k2):
+    sol = wall_couette(W, k2=k2)
+    c, ratio = sol.constants, sol.sigma_ratio
+    om = math.sqrt(abs(sol.omega2))
+    trig = (math.sin, math.cos) if sol.omega2 > 0 else (math.sinh, math.cosh)
+    f = c.F * ratio**2
+    bracket = (trig[1](om * c.h / 2) * math.sqrt(f / (c.k2 * (1 - f)))
+               + c.t / c.q * ratio * trig[0](om * c.h / 2) / (om * c.d))
+    printed = (3 / 8 * c.t * ratio * c.h**2 / (c.d * c.delta_h)
+               * (trig[0](om * c.h) / (om * c.d) + c.h / c.d) / bracket**2)
+    assert sol.stress_norm == pytest.approx(printed, rel=1e-12)
+    assert sol.pressure_norm == pytest.approx(printed / ratio, rel=1e-12)
+    faster = wall_couette(W, k2=k2, u_w=3.0)
+    assert faster.stress_norm == pytest.approx(sol.stress_norm, rel=1e-12)
+    np.testing.assert_allclose(faster.v, 3 * sol.v, rtol=1e-12)
+    assert faster.sigma0 == pytest.approx(9 * sol.sigma0, rel=1e-12)  # Bagnold scaling
+    # rho/rho_p multiplies both (the thesis's printed formula has rho = rho_p)
+    half = wall_couette(W, k2=k2, density_ratio=0.5)
+    assert half.stress_norm == pytest.approx(0.5 * sol.stress_norm, rel=1e-12)
