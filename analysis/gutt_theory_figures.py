@@ -8,7 +8,7 @@ fig 2.4 caption's constants, particle units d = 1 and the wall speed u_w = 1.
 
 Writes docs/figures/theory/gutt/*.png and prints the numbers quoted in docs/theory-gutt.md.
 
-    python analysis/gutt_theory_figures.py      # about 5 s
+    python analysis/gutt_theory_figures.py      # about 10 s (4 s of CPU)
 """
 
 from __future__ import annotations

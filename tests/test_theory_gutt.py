@@ -101,6 +101,8 @@ def test_cooling_without_translation_does_nothing():
     sol = spin_cooling(C, 0.0, 2.0, np.linspace(0, 10, 5))
     np.testing.assert_array_equal(sol.W, 2.0)
     np.testing.assert_array_equal(sol.v, 0.0)
+    start = spin_cooling(C, 1.0, 0.5, np.zeros(1))  # only the initial state asked for
+    assert start.v.tolist() == [1.0] and start.W.tolist() == [0.5]
 
 
 # -- S2: vibrating plates ----------------------------------------------------------------------

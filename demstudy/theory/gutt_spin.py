@@ -235,6 +235,9 @@ def spin_cooling(c: GuttSpinConstants, v0: float, W0: float, t: np.ndarray,
                          rate * spin * (c.gamma1_r * x - c.gamma2_r * z2)])
 
     y0 = [v0**2, (c.d * W0 / 2) ** 2]
+    if t[-1] == 0:  # only the initial state asked for
+        t = np.concatenate([t, [1.0]])
+        return _drop_last(spin_cooling(c, v0, W0, t, rtol))
     sol = solve_ivp(rhs, (0.0, float(t[-1])), y0, method="LSODA", t_eval=t, rtol=rtol,
                     atol=1e-14 * max(y0[0] + y0[1], 1e-300))
     if not sol.success:
@@ -246,6 +249,10 @@ def spin_cooling(c: GuttSpinConstants, v0: float, W0: float, t: np.ndarray,
     a2 = _cooling_a2(c)
     return SpinCooling(t, v, 2 * z / c.d, ratio, math.sqrt(a2),
                        (c.loss - c.gamma2_t * a2) / c.s)
+
+
+def _drop_last(sol: SpinCooling) -> SpinCooling:
+    return SpinCooling(sol.t[:-1], sol.v[:-1], sol.W[:-1], sol.ratio[:-1], sol.a, sol.b)
 
 
 # -- S2 and S3: the thermal boundary-value problem ---------------------------------------------
