@@ -394,7 +394,8 @@ def _thermal_bvp(c: GuttSpinConstants, sigma_ratio: float, h: float, v_wall: flo
     return sol, a, k
 
 
-def _profiles(c: GuttSpinConstants, sol, a: float, k: float, n: int):
+def _profiles(sol, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The BVP solution on a wall-crowded mesh of n points: y, v, Z = d W/2, full state."""
     y = _wall_mesh(float(sol.x[-1] - sol.x[0]), n)
     state = sol.sol(y)
     v = state[0]
@@ -411,7 +412,7 @@ def spin_plates(c: GuttSpinConstants, h: float, v_wall: float, W_wall: float,
     (a) W_wall = 2 a v_wall/d (the analytic cosh solution), (b) W_wall = 0, (c) v_wall small."""
     _check_channel(h, v_wall, W_wall)
     sol, a, k = _thermal_bvp(c, 0.0, h, v_wall, W_wall, steps, tol)
-    y, v, z, _ = _profiles(c, sol, a, k, n)
+    y, v, z, _ = _profiles(sol, n)
     return SpinProfiles(y, v, 2 * z / c.d, z / v, a, k)
 
 
@@ -425,7 +426,7 @@ def spin_couette(c: GuttSpinConstants, sigma_ratio: float, h: float, v_wall: flo
     Case 2 (fig 1.8): v_wall very small."""
     _check_channel(h, v_wall, W_wall)
     sol, a, k = _thermal_bvp(c, sigma_ratio, h, v_wall, W_wall, steps, tol)
-    y, v, z, state = _profiles(c, sol, a, k, n)
+    y, v, z, state = _profiles(sol, n)
     return SpinCouette(y, v, 2 * z / c.d, z / v, a, k, u=state[4],
                        omega_z=spin_mean_spin(c, sigma_ratio, v), u_wall=float(state[4][-1]),
                        sigma_ratio=sigma_ratio)
