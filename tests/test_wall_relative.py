@@ -201,3 +201,6 @@ def test_servo_run_bins_between_its_moving_walls(tmp_path):
     again = read_results(out).analyze("profiles", save=False)
     for key in ("solid_fraction", "velocity", "temperature", "edges"):
         np.testing.assert_allclose(again.profiles[key], prof[key], rtol=1e-12, err_msg=key)
+    fixed = read_results(out).analyze("profiles", save=False, wall_relative=False)
+    assert fixed.profile_attrs["wall_relative"] is False  # where production started
+    np.testing.assert_allclose(fixed.profiles["edges"][[0, -1]], walls[0], rtol=1e-12)

@@ -26,14 +26,15 @@ servo's ``/timeseries/wall_position_lower`` / ``_upper`` at the frame's time.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
 
 from ..io.frames import Frame
 
-__all__ = ["CONVENTION", "FIXED", "WALLS", "WallStrips", "frame_walls", "walls_move",
-           "with_walls"]
+__all__ = ["CONVENTION", "FIXED", "WALLS", "WallStrips", "first_walls", "frame_walls",
+           "walls_move", "with_walls"]
 
 #: key of the wall positions (y_lower, y_upper) in ``Frame.extra``
 WALLS = "walls"
@@ -58,6 +59,13 @@ def frame_walls(frame: Frame) -> tuple[float, float] | None:
         return None
     lower, upper = (float(w) for w in walls)
     return lower, upper
+
+
+def first_walls(frames: Callable[[], Iterable[Frame]] | None) -> tuple[float, float] | None:
+    """The wall positions at the first of ``frames`` (a callable giving a fresh iterable):
+    where fixed strips stand when the walls move (``wall_relative = False``)."""
+    first = next(iter(frames()), None) if frames is not None else None
+    return frame_walls(first) if first is not None else None
 
 
 def with_walls(frame: Frame, lower: float, upper: float) -> Frame:

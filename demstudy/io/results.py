@@ -115,8 +115,12 @@ class Results:
 
         scene = self.scene
         names = [w for w in what if isinstance(w, str)]
-        ctx = Context(scene, frames=(lambda: self.iter_frames(start)) if self.frames else None,
-                      results=self, z_cells=z_cells, wall_relative=wall_relative)
+        from ..analysis.walls import first_walls
+
+        frames = (lambda: self.iter_frames(start)) if self.frames else None
+        ctx = Context(scene, frames=frames, results=self, z_cells=z_cells,
+                      wall_relative=wall_relative,
+                      walls=first_walls(frames) if wall_relative is False else None)
         computed = compute_statistics(names, ctx)
         for analysis in (w for w in what if not isinstance(w, str)):
             analysis.run(self.iter_frames(start))
