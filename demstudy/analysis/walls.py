@@ -31,13 +31,11 @@ from typing import Any
 
 import numpy as np
 
-from ..io.frames import Frame
+from ..io.frames import WALLS, Frame
 
 __all__ = ["CONVENTION", "FIXED", "WALLS", "WallStrips", "first_walls", "frame_walls",
            "walls_move", "with_walls"]
 
-#: key of the wall positions (y_lower, y_upper) in ``Frame.extra``
-WALLS = "walls"
 #: the attribute text of wall-relative bins
 CONVENTION = ("wall-relative strips (Campbell's ST = HGT/FND): n strips between the frame's "
               "walls, moving and stretching with them; reported on the grid between the run "

@@ -35,7 +35,7 @@ import numpy as np
 
 from .. import UNITS_NOTE, __version__
 from .fields import field_info, time_unit
-from .frames import Frame
+from .frames import WALLS, Frame
 
 FORMAT_VERSION = 1
 
@@ -442,7 +442,7 @@ def frames_of(results: Results, dim: int) -> Iterator[Frame]:
                       angular_velocity=fr["angular_velocity"][i], radius=fr["radius"][i],
                       tilt=float(fr["tilt"][i]) if "tilt" in fr else 0.0)
         if walls is not None:  # walls that move (servo): where they were at this frame
-            frame.extra["walls"] = (float(walls[i, 0]), float(walls[i, 1]))
+            frame.extra[WALLS] = (float(walls[i, 0]), float(walls[i, 1]))
         yield frame
 
 
