@@ -12,6 +12,9 @@
 namespace demstudy::edmd {
 void bind(nanobind::module_& m);
 }
+namespace demstudy::lgd {
+void bind(nanobind::module_& m);
+}
 
 namespace nb = nanobind;
 using namespace nb::literals;
@@ -104,6 +107,7 @@ void overlaps(In1 coord, In1 radius, double lo, double hi, int dim, Out1 out) {
 
 NB_MODULE(_native, m) {
     demstudy::edmd::bind(m);  // event-driven hard particles (native/src/edmd)
+    demstudy::lgd::bind(m);   // Gutt's lattice grain dynamics (native/src/lgd)
     m.doc() = "Exact disc/sphere overlap volumes with strips/slabs and the volume-weighted "
               "binning kernel (dimensionless particle units: d = 1, m = 1).";
     m.def("disc_strip_area", &demstudy::disc_strip_area, "c"_a, "r"_a, "lo"_a, "hi"_a,
