@@ -114,6 +114,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from .analysis.registry import Context, compute_statistics
+    from .analysis.walls import first_walls, walls_move
     from .io.results import frames_of, read_results, write_results
     from .scene import apply_overrides, parse_scene_text, scene_to_toml, validate_scene
 
@@ -152,8 +153,14 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
             print(f"note: {source}: angular velocity {results.attrs['angular_velocity']}",
                   file=sys.stderr)
         out = Path(args.out or source.with_suffix(".h5"))
+        if walls_move(scene) and not args.fixed_strips:
+            print(f"note: {source}: a dump does not record where the servo walls were: "
+                  "fixed strips between the scene's walls", file=sys.stderr)
+            args.fixed_strips = True
 
-    ctx = Context(scene, frames=frames, results=results, z_cells=args.z_cells)
+    ctx = Context(scene, frames=frames, results=results, z_cells=args.z_cells,
+                  wall_relative=False if args.fixed_strips else None,
+                  walls=first_walls(frames) if args.fixed_strips else None)
     for name, (data, attrs) in compute_statistics(what, ctx).items():
         if name == "profiles":
             results.profiles, results.profile_attrs = data, attrs
@@ -480,6 +487,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="3D: Malik's cells, fluctuations about the means of N z-slabs of each "
                         "y-bin for " + ", ".join(n for n, s in STATISTICS.items() if s.z_cells)
                         + " (default 1: the y-bin means, Campbell's strips)")
+    p.add_argument("--fixed-strips", action="store_true",
+                   help="walls that move (servo): bin profiles and the structure mid-plane in "
+                        "strips fixed where the walls stood at the first stored frame (dumps: "
+                        "the scene's walls) and the vdf between the scene's walls, not in "
+                        "strips that follow the walls (the default, Campbell's ST = HGT/FND)")
     p.add_argument("--dt", type=float, help="dump time step (default: the scene's soft-contact "
                                             "time step)")
     p.add_argument("--start", type=float, default=0.0, help="skip frames before this time")

@@ -50,6 +50,20 @@ leaks into ``temperature`` (u = a z: + a^2 L_z^2 / 12 in T_xx) but into the cell
 only through the cell's own width (+ a^2 (L_z / z_cells)^2 / 12). ``z_cells = 1`` (the
 default) is Campbell's strip convention and adds nothing. ``kinetic_shear`` stays a bin
 (strip) quantity.
+
+Wall-relative strips (``wall_relative=True``; the suite's default when the walls move, i.e.
+servo walls; :mod:`demstudy.analysis.walls`). Campbell's convention ST = HGT/FND: the n strips
+of each frame lie between that frame's walls (``frame.extra["walls"]``) and stretch with the
+gap, strip k covering y_lower(t) + [k, k + 1) H(t)/n. Overlaps stay volume-exact: each
+particle (its true radius) is split over the frame's physical strips, and the solid fraction
+divides by the frame's strip volume H(t)/n × cross-section. This is the same as mapping the
+whole frame (centres and particle shapes) by y' = lo + (y − y_lower(t)) (hi − lo)/H(t) onto
+the mean gap's grid [lo, hi] (the run means of the wall positions; an affine map keeps
+volume ratios), on which the results are reported. n = round(H_0/bin_width) with H_0 the
+first frame's gap (Campbell: FND = INT(HGT/ST) fixed when averaging starts, L3689-3690).
+Campbell divided the run's summed overlaps by the mean strip width (ν_i = π Σ A/(ST WL N_s)
+with ST = AVHGT/LAV, L4095) where this divides each frame by its own strip volume, a
+difference of order (δH/H)^2.
 """
 
 from __future__ import annotations
@@ -62,6 +76,7 @@ from demstudy.analysis.base import AnalysisBase, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, error_figures, jackknife_report
 from demstudy.analysis.box import wrap_periodic
 from demstudy.analysis.volumes import bin_profile_sums, profile_nvalues
+from demstudy.analysis.walls import FIXED, WallStrips
 from demstudy.io.frames import Frame
 
 __all__ = ["ProfileAnalysis"]
@@ -88,6 +103,11 @@ class ProfileAnalysis(AnalysisBase):
         periodic boundary then enter the other end of the grid with that velocity offset.
     z_cells: Malik's cells: > 1 adds the temperatures about the means of ``z_cells`` z-slabs
         of each bin (3D, axis x or y); 1 is Campbell's strip convention.
+    wall_relative: bin in strips between each frame's walls (``frame.extra["walls"]``), which
+        move and stretch with them (Campbell's ST = HGT/FND; axis y, not periodic); ``lo``,
+        ``hi`` and ``edges`` are then not used: the first frame's gap sets the number of
+        strips, the run means of the walls the reported grid.
+    strips: with ``wall_relative``, the number of strips (None: round(first gap/bin_width)).
     """
 
     def __init__(
@@ -103,6 +123,8 @@ class ProfileAnalysis(AnalysisBase):
         edges: ArrayLike | None = None,
         image_velocity_shift: float = 0.0,
         z_cells: int = 1,
+        wall_relative: bool = False,
+        strips: int | None = None,
         verbose: bool = False,
     ) -> None:
         super().__init__(verbose=verbose)
@@ -111,6 +133,12 @@ class ProfileAnalysis(AnalysisBase):
         self.axis = AXES.get(axis, -1) if isinstance(axis, str) else int(axis)
         if not 0 <= self.axis < dim:
             raise ValueError(f"axis {axis!r} does not exist in {dim}D")
+        if wall_relative and (self.axis != 1 or period):
+            raise ValueError(f"wall_relative = True: strips between the walls need the profile "
+                             f"axis y without a period (this analysis: axis {'xyz'[self.axis]}, "
+                             f"period {period!r})")
+        self.walls = WallStrips(bin_width, "ProfileAnalysis", strips) if wall_relative \
+            else None
         if not bin_width > 0:
             raise ValueError(f"bin_width must be positive, got {bin_width!r}")
         if period < 0:
@@ -167,7 +195,11 @@ class ProfileAnalysis(AnalysisBase):
     def _prepare(self) -> None:
         frame = self.first_frame
         assert frame is not None
-        if self._edges is not None:
+        if self.walls is not None:  # the first frame's strips; the grid is set at the end
+            nbins = self.walls.start(frame)
+            lo, width = self.walls.strips(frame, record=False)
+            hi = lo + nbins * width
+        elif self._edges is not None:
             lo, hi, nbins = float(self._edges[0]), float(self._edges[-1]), self._edges.size - 1
         else:
             box_lo = float(np.asarray(frame.box_lo, float)[self.axis])
@@ -199,11 +231,14 @@ class ProfileAnalysis(AnalysisBase):
             coord, radius, vel, *extra = self._lees_edwards_images(coord, radius, vel, *extra)
             period = 0.0
         nb, nc = self.n_bins, self.n_cells
+        # the frame's strips: fixed, or between its walls (Campbell's ST = HGT/FND)
+        lo, width = (self.lo, self.bin_width) if self.walls is None else \
+            self.walls.strips(frame)
         self._sample[:] = 0.0
         vol = self._sample[nc : 2 * nc]
         sums = self._sample[2 * nc :].reshape(nc, self.n_values)
         if zc == 1:
-            self._kernel(coord, radius, vel, extra[0], period, vol, sums)
+            self._kernel(coord, radius, vel, extra[0], period, vol, sums, lo, width)
         else:  # one kernel call per z-slab on the particles centred in it (sorted once)
             slab = extra[1].astype(np.int16 if zc < 2**15 else np.intp)  # int16: radix sort
             order = np.argsort(slab, kind="stable")
@@ -213,11 +248,12 @@ class ProfileAnalysis(AnalysisBase):
             )
             for s in range(zc):
                 p, c = slice(ends[s - 1] if s else 0, ends[s]), slice(s * nb, (s + 1) * nb)
-                self._kernel(coord[p], radius[p], vel[p], omega[p], period, vol[c], sums[c])
+                self._kernel(coord[p], radius[p], vel[p], omega[p], period, vol[c], sums[c],
+                             lo, width)
         section = float(np.prod(np.delete(frame.lengths, self.axis)))
         if not section > 0:
             raise ValueError(f"non-positive box cross-section {section} at t = {frame.time}")
-        np.multiply(vol, 1.0 / (self.bin_width * section), out=self._sample[:nc])
+        np.multiply(vol, 1.0 / (width * section), out=self._sample[:nc])
         self._acc.add(self._sample)
 
     def _kernel(
@@ -229,6 +265,8 @@ class ProfileAnalysis(AnalysisBase):
         period: float,
         vol: np.ndarray,
         sums: np.ndarray,
+        lo: float,
+        width: float,
     ) -> None:
         bin_profile_sums(
             coord,
@@ -236,8 +274,8 @@ class ProfileAnalysis(AnalysisBase):
             vel,
             omega,
             self.inertia_factor,
-            self.lo,
-            self.bin_width,
+            lo,
+            width,
             self.n_bins,
             self.dim,
             period,
@@ -347,6 +385,10 @@ class ProfileAnalysis(AnalysisBase):
         }
 
     def _conclude(self) -> None:
+        if self.walls is not None:  # report on the grid between the mean walls
+            self.edges = self.walls.edges()
+            self.lo, self.hi = float(self.edges[0]), float(self.edges[-1])
+            self.bin_width = (self.hi - self.lo) / self.n_bins
         est, err, report = jackknife_report(self._acc, self._estimate)
         self.results = {"y": 0.5 * (self.edges[1:] + self.edges[:-1]), "edges": self.edges}
         for key in est:
@@ -372,6 +414,8 @@ class ProfileAnalysis(AnalysisBase):
             "image_velocity_shift": self.image_velocity_shift,
             "z_cells": self.z_cells,
             "fluctuations": fluctuations,
+            **({"bins": FIXED, "wall_relative": False} if self.walls is None
+               else self.walls.attrs()),
             "block_length": self._acc.block_length,
             "n_blocks": self._acc.n_blocks,
             "units": UNITS_NOTE,

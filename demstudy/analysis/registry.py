@@ -32,13 +32,16 @@ __all__ = ["STATISTICS", "Context", "Statistic", "compute_statistics", "engine_p
 class Context:
     """What a statistic is computed from: the scene, frames (a callable returning a fresh
     iterable; None when none are stored), the results so far (``Results``; None for a dump),
-    Malik's z cells, and the wall positions when production started (servo walls move)."""
+    Malik's z cells, the wall positions when production started (servo walls move), and
+    whether the y bins follow the walls (``wall_relative``; None: when the walls move, each
+    frame then carrying its walls in ``frame.extra["walls"]``, :mod:`.walls`)."""
 
     scene: Any
     frames: Callable[[], Iterable[Frame]] | None = None
     results: Any = None
     z_cells: int = 1
     walls: tuple[float, float] | None = None
+    wall_relative: bool | None = None
 
 
 @dataclass(frozen=True)
@@ -151,22 +154,25 @@ def compute_statistics(names: Iterable[str], ctx: Context) -> dict[str, tuple[di
 def _profiles(ctx: Context):
     from .suite import profile_analysis
 
-    return profile_analysis(ctx.scene, ctx.walls, z_cells=ctx.z_cells)
+    return profile_analysis(ctx.scene, ctx.walls, z_cells=ctx.z_cells,
+                            wall_relative=ctx.wall_relative)
 
 
 @statistic("vdf", "velocity distributions per bin", "frames", plots=("vdf",), z_cells=True)
 def _vdf(ctx: Context):
     from .base import bin_edges
-    from .suite import image_shift, profile_bounds
+    from .suite import image_shift, profile_bounds, wall_relative_bins
     from .vdf import velocity_distributions
 
     scene = ctx.scene
     lo, hi, period = profile_bounds(scene)
+    relative = wall_relative_bins(scene, ctx.wall_relative)
     ana = velocity_distributions(ctx.frames, dim=scene.dimension,
                                  edges=bin_edges(lo, hi, scene.measure.bin_width),
                                  inertia_factor=scene.inertia_k, period=period,
                                  image_velocity_shift=image_shift(scene, period),
-                                 z_cells=ctx.z_cells)
+                                 z_cells=ctx.z_cells, wall_relative=relative,
+                                 bin_width=scene.measure.bin_width)
     return ana.results, ana.attrs
 
 
@@ -184,16 +190,19 @@ def _gr(ctx: Context):
 
 
 # test particles within a bin width of the mid-plane: the channel's middle (between servo
-# walls: where they stand when production starts), or with an open top the initial bed's
+# walls: of each frame's walls), or with an open top the initial bed's
 @statistic("structure", "Campbell's normal and parallel structure distributions", "stream",
            plots=("structure",))
 def _structure(ctx: Context):
     from .structure import StructureDistributions
-    from .suite import profile_bounds
+    from .suite import profile_bounds, wall_relative_bins
 
     scene = ctx.scene
     lo, hi, _period = profile_bounds(scene)
-    if ctx.walls is not None:  # servo walls: where they stand when production starts
+    # servo walls: the mid-plane of each frame's walls, or of where they stood when
+    # production started (wall_relative = False)
+    relative = wall_relative_bins(scene, ctx.wall_relative)
+    if ctx.walls is not None:
         lo, hi = ctx.walls
     if scene.has_open_top:  # the middle of the bed, not of the empty box above it
         from ..scene.initial import build_initial_state
@@ -203,7 +212,7 @@ def _structure(ctx: Context):
     across = [scene.box.size[i] for i, a in enumerate("xyz"[:scene.dimension]) if a != "y"]
     return StructureDistributions(dim=scene.dimension, r_max=min(4.0, 0.5 * min(across) - 0.05),
                                   dr=0.08, half_width=scene.measure.bin_width,
-                                  y_mid=0.5 * (lo + hi))
+                                  y_mid=0.5 * (lo + hi), wall_relative=relative)
 
 
 @statistic("angles", "collision-angle distributions", "collisions", plots=("angles",),

@@ -36,6 +36,7 @@ from ..io.frames import Frame
 from .base import AnalysisBase
 from .blocking import BlockAccumulator, jackknife
 from .box import Box, NeighbourQuery
+from .walls import WallStrips
 
 __all__ = ["StructureDistributions"]
 
@@ -45,12 +46,14 @@ class StructureDistributions(AnalysisBase):
 
     dim: 2 or 3; r_max, dr: the slices; half_width: the test region and the parallel
     distribution's slab half-width (Campbell: ST ≈ 1 diameter); y_mid: the mid-plane (None:
-    the middle of the frame's y range); max_blocks: bound on the stored time blocks.
+    the middle of the frame's y range); max_blocks: bound on the stored time blocks;
+    wall_relative: the mid-plane is that of each frame's walls (``frame.extra["walls"]``,
+    walls that move: Campbell's |n − HGT/2| < ST with the current gap), ``y_mid`` unused.
     """
 
     def __init__(self, dim: int = 2, r_max: float = 4.0, dr: float = 0.08,
                  half_width: float = 1.0, y_mid: float | None = None, max_blocks: int = 64,
-                 verbose: bool = False) -> None:
+                 wall_relative: bool = False, verbose: bool = False) -> None:
         super().__init__(verbose=verbose)
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
@@ -60,6 +63,8 @@ class StructureDistributions(AnalysisBase):
         self.n_r = max(1, int(round(r_max / dr)))
         self.r_max = self.n_r * self.dr
         self.max_blocks = max_blocks
+        self.walls = WallStrips(half_width, "StructureDistributions") if wall_relative else None
+        self._y_mid_sum = 0.0
 
     def _prepare(self) -> None:
         limit = Box.from_frame(self.first_frame, periodic_y=False).image_limit
@@ -72,8 +77,11 @@ class StructureDistributions(AnalysisBase):
         box = Box.from_frame(frame, periodic_y=False)  # never across y (see the module doc)
         pos = box.wrap(frame.position).position
         lo, hi = box.lo, box.hi
-        y_mid = 0.5 * (lo[1] + hi[1]) if self.y_mid is None else self.y_mid
-        self._y_mid_used = float(y_mid)
+        if self.walls is not None:  # the mid-plane of the frame's walls
+            y_mid = 0.5 * sum(self.walls.walls(frame))
+        else:
+            y_mid = 0.5 * (lo[1] + hi[1]) if self.y_mid is None else self.y_mid
+        self._y_mid_sum += float(y_mid)
         test = np.flatnonzero(np.abs(pos[:, 1] - y_mid) < self.half_width)
         normal = np.zeros(self.n_r)
         # normal: every partner within r_max along y, whatever its x (z): a sorted sweep
@@ -114,7 +122,10 @@ class StructureDistributions(AnalysisBase):
         self.results = {"r": r, "normal": est["normal"], "normal_err": err["normal"],
                         "parallel": est["parallel"], "parallel_err": err["parallel"]}
         self.attrs = {"frames": self.n_frames, "dim": self.dim, "dr": self.dr,
-                      "half_width": self.half_width, "y_mid": self._y_mid_used,
+                      "half_width": self.half_width,
+                      "y_mid": self._y_mid_sum / self.n_frames,  # mean over the frames
+                      "mid_plane": "between each frame's walls (they move)" if self.walls
+                                   else "fixed",
                       "units": "number density (per area in 2D, per volume in 3D), d = 1",
                       "convention": "Campbell (1982): test particles within half_width of "
                                     "the mid-plane; normal vs |dy| over the whole section, "

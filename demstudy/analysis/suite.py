@@ -19,6 +19,7 @@ from ..io.frames import Frame
 from ..scene import Scene
 from .base import bin_edges
 from .profiles import ProfileAnalysis
+from .walls import walls_move
 
 
 def periodic_lengths(scene: Scene) -> list[float]:
@@ -44,17 +45,34 @@ def image_shift(scene: Scene, period: float) -> float:
         else 0.0
 
 
+def wall_relative_bins(scene: Scene, asked: bool | None = None) -> bool:
+    """Whether the y bins follow the walls (:mod:`.walls`): ``asked``, or by default when
+    the scene's walls move (servo walls) and the profile axis is y."""
+    if asked is None:
+        return walls_move(scene) and scene.measure.axis == "y"
+    relative = bool(asked)
+    if relative and (scene.measure.axis != "y" or not walls_move(scene)):
+        raise StatisticUnavailable(
+            f"wall_relative = True: strips that follow the walls need walls that move (a "
+            f"[walls.servo]) and measure.axis = 'y' (this scene: axis "
+            f"{scene.measure.axis!r}, {'servo walls' if walls_move(scene) else 'fixed walls'})")
+    return relative
+
+
 def profile_analysis(scene: Scene, walls: tuple[float, float] | None = None,
-                     z_cells: int = 1) -> ProfileAnalysis:
-    """Profiles along the scene's axis (``walls``: current wall positions when walls move;
-    ``z_cells`` > 1 adds the temperatures in Malik's cell convention)."""
+                     z_cells: int = 1, wall_relative: bool | None = None) -> ProfileAnalysis:
+    """Profiles along the scene's axis (``z_cells`` > 1 adds the temperatures in Malik's cell
+    convention). Walls that move: strips between each frame's walls (``wall_relative``, the
+    default, Campbell's ST = HGT/FND), or fixed strips between ``walls`` (the wall positions
+    when production started; None: the scene's)."""
     lo, hi, period = profile_bounds(scene)
-    if walls is not None and scene.measure.axis == "y":
+    relative = wall_relative_bins(scene, wall_relative)
+    if walls is not None and scene.measure.axis == "y" and not relative:
         lo, hi = walls
     return ProfileAnalysis(axis=scene.measure.axis, bin_width=scene.measure.bin_width, lo=lo,
                            hi=hi, dim=scene.dimension, inertia_factor=scene.inertia_k,
                            period=period, image_velocity_shift=image_shift(scene, period),
-                           z_cells=z_cells)
+                           z_cells=z_cells, wall_relative=relative)
 
 
 def _need_results(results: Any, name: str) -> Any:

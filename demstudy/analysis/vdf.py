@@ -49,6 +49,13 @@ of a y-bin (count-weighted central moments about the cell means), ``mean`` is th
 and ``cell_mean`` / ``cell_variance`` (n_bins · z_cells, n_comp) are kept for the second pass.
 ``z_cells = 1`` is Campbell's strip convention.
 
+Wall-relative strips (``wall_relative=True``, the suite's default when the walls move: servo
+walls; :mod:`demstudy.analysis.walls`): a particle belongs to strip k when its centre lies
+in y_lower(t) + [k, k + 1) H(t)/n, the n strips between the frame's walls
+(``frame.extra["walls"]``), moving and stretching with them (Campbell's ST = HGT/FND); n is
+round(H_0 / bin_width) with H_0 the first frame's gap, and ``edges`` / ``y`` are the grid
+between the run means of the wall positions.
+
 Errors (``*_err``): delete-one-block jackknife over time blocks of the per-frame sums
 (:class:`~demstudy.analysis.blocking.BlockAccumulator`); memory is flat in the number of
 frames. The bin mean includes any mean-velocity gradient across the bin, which widens the
@@ -67,6 +74,7 @@ from scipy.special import erf, gammainc, gammaln
 from demstudy import UNITS_NOTE
 from demstudy.analysis.base import AnalysisBase, default_y_edges, z_slab
 from demstudy.analysis.blocking import BlockAccumulator, jackknife
+from demstudy.analysis.walls import FIXED, WallStrips
 from demstudy.io.frames import Frame
 
 __all__ = ["VelocityDistribution", "folded_maxwellian", "velocity_distributions"]
@@ -106,6 +114,10 @@ class VelocityDistribution(AnalysisBase):
     x_bins, x_width: Campbell's histogram (50 bins of 0.1); Malik's uses 2 x_bins on
         [-x_bins x_width, x_bins x_width].
     max_blocks: bound on the stored time blocks.
+    wall_relative: strips between each frame's walls (``frame.extra["walls"]``) that move and
+        stretch with them (Campbell's ST = HGT/FND; y not periodic); ``edges`` and
+        ``n_bins`` are then not used, ``bin_width`` sets the number of strips.
+    bin_width: the strip width asked for with ``wall_relative``.
     """
 
     def __init__(
@@ -121,11 +133,17 @@ class VelocityDistribution(AnalysisBase):
         x_width: float = 0.1,
         z_cells: int = 1,
         max_blocks: int = 64,
+        wall_relative: bool = False,
+        bin_width: float = 1.0,
         verbose: bool = False,
     ) -> None:
         super().__init__(verbose=verbose)
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        if wall_relative and period:
+            raise ValueError(f"wall_relative = True: strips between the walls need a y "
+                             f"without a period (period = {period!r})")
+        self.walls = WallStrips(bin_width, "VelocityDistribution") if wall_relative else None
         if int(z_cells) < 1 or (dim == 2 and int(z_cells) != 1):
             raise ValueError(f"z_cells = {z_cells!r}: a positive number of cells along z (3D "
                              "only; 1 is Campbell's strip convention)")
@@ -182,16 +200,22 @@ class VelocityDistribution(AnalysisBase):
         assert frame is not None
         if frame.dim != self.dim:
             raise ValueError(f"frame is {frame.dim}D, analysis is {self.dim}D")
-        if self._edges is None:
-            self._edges = default_y_edges(frame, self.period, self._n_bins)
-        self.edges = self._edges
+        if self.walls is not None:  # the first frame's strips; the grid is set at the end
+            n_bins = self.walls.start(frame)
+            lower, width = self.walls.strips(frame, record=False)
+            self.edges = lower + width * np.arange(n_bins + 1)
+        else:
+            if self._edges is None:
+                self._edges = default_y_edges(frame, self.period, self._n_bins)
+            self.edges = self._edges
         self.n_bins = self.edges.size - 1
         self.n_cells = self.n_bins * self.z_cells
         if self.reference is not None:
             ref_edges = self.reference["edges"]
-            if ref_edges.shape != self.edges.shape or not np.allclose(
-                ref_edges, self.edges, rtol=0, atol=1e-12
-            ):
+            # wall-relative strips: their number must agree (the grid is the mean walls')
+            same = ref_edges.shape == self.edges.shape and (
+                self.walls is not None or np.allclose(ref_edges, self.edges, rtol=0, atol=1e-12))
+            if not same:
                 raise ValueError("the reference was computed on other bin edges")
             if self.reference["mean"].shape[0] != self.n_cells:
                 raise ValueError("the reference was computed with other z cells")
@@ -203,16 +227,16 @@ class VelocityDistribution(AnalysisBase):
                 self._ref_inv_var5 = 1.0 / var[:, self._total].sum(1)
         self._layout()
         self._acc = BlockAccumulator(self.n_cells * self.n_values, self.max_blocks)
-        bins, comps = self._assign(frame)
+        bins, comps = self._assign(frame, record=False)
         counts = np.bincount(bins, minlength=self.n_cells).astype(float)
         sums = np.zeros((self.n_cells, self.n_comp))
         np.add.at(sums, bins, comps)
         with np.errstate(invalid="ignore"):
             self._shift = np.where(counts[:, None] > 0, sums / counts[:, None], 0.0)
 
-    def _assign(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+    def _assign(self, frame: Frame, record: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Cell index (y-bin · z_cells + z-cell) and component matrix of the particles whose
-        centre lies in a bin."""
+        centre lies in a bin (``record``: count the frame's walls into the run means)."""
         pos = np.asarray(frame.position, float)
         vel = np.array(frame.velocity, float)
         omega = np.asarray(frame.angular_velocity, float)
@@ -224,7 +248,10 @@ class VelocityDistribution(AnalysisBase):
             y = y - turns * self.period
             if self.image_velocity_shift:
                 vel[:, 0] -= turns * self.image_velocity_shift
-        bins = np.searchsorted(self.edges, y, side="right") - 1
+        if self.walls is None:
+            bins = np.searchsorted(self.edges, y, side="right") - 1
+        else:
+            bins = self.walls.bin_of(frame, y, record)
         keep = (bins >= 0) & (bins < self.n_bins)
         if self.z_cells > 1:  # Malik's cells: y-bin × z-slab
             bins = bins * self.z_cells + z_slab(frame, pos[:, 2], self.z_cells)
@@ -307,6 +334,8 @@ class VelocityDistribution(AnalysisBase):
         return out
 
     def _conclude(self) -> None:
+        if self.walls is not None:  # report on the grid between the mean walls
+            self.edges = self.walls.edges()
         est, err = jackknife(self._acc, self._estimate)
         self.results = {"edges": self.edges, "y": 0.5 * (self.edges[1:] + self.edges[:-1])}
         for key in est:
@@ -317,6 +346,8 @@ class VelocityDistribution(AnalysisBase):
             "components": ",".join(self.components),
             "inertia_factor": self.inertia_factor,
             "binning": "strip of the particle centre, number-weighted, pooled over the run",
+            **({"bins": FIXED, "wall_relative": False} if self.walls is None
+               else self.walls.attrs()),
             "z_cells": self.z_cells,
             "fluctuations": ("relative to the strip (bin) mean: Campbell" if self.z_cells == 1
                              else f"relative to the means of {self.z_cells} z-cells per bin: "

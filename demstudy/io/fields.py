@@ -128,6 +128,8 @@ _FRAMES = {
     "box_lo": (LENGTH, "lower box corner"),
     "box_hi": (LENGTH, "upper box corner"),
     "tilt": (LENGTH, "Lees–Edwards x offset of the upper periodic image"),
+    "walls": (LENGTH, "walls that move (servo): y of the lower and upper wall planes at the "
+                      "frame"),
 }
 
 _STRESS = {

@@ -16,6 +16,10 @@ if TYPE_CHECKING:
     from demstudy.analysis.box import Box
 
 
+#: key of the wall positions (y_lower, y_upper) in ``Frame.extra`` (walls that move)
+WALLS = "walls"
+
+
 @dataclass
 class Frame:
     """Particle state at one time.
@@ -29,7 +33,9 @@ class Frame:
     angular_velocity: (N, n_rot) with n_rot = 1 in 2D (the z component) and 3 in 3D.
     radius: (N,).
     tilt: Lees-Edwards shift of the upper periodic image along x (0 without shear).
-    extra: engine-specific additions.
+    extra: additions: ``extra[WALLS]`` = (y_lower, y_upper), where walls that move (servo)
+        stand at this frame (set by the simulation loop and by ``frames_of``;
+        :mod:`demstudy.analysis.walls`); otherwise engine-specific.
     periodic_y: y is periodic (Lees-Edwards and homogeneous boxes); False: bounded (walls).
         x and z are always periodic. Engines and readers leave the default; the analyses
         take the periodicity from their own arguments (``periodic_y``, ``period``), which

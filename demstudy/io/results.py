@@ -35,7 +35,7 @@ import numpy as np
 
 from .. import UNITS_NOTE, __version__
 from .fields import field_info, time_unit
-from .frames import Frame
+from .frames import WALLS, Frame
 
 FORMAT_VERSION = 1
 
@@ -103,18 +103,24 @@ class Results:
                        f".analyze({name!r})")
 
     def analyze(self, *what: Any, z_cells: int = 1, start: float = 0.0,
-                save: bool = True) -> Results:
+                save: bool = True, wall_relative: bool | None = None) -> Results:
         """Compute statistics from this run's frames, collision log or results: registered
         names (``"vdf"``, ``"gr"``, …; :data:`demstudy.analysis.registry.STATISTICS`) or
         analysis objects (an ``AnalysisBase`` run over the frames, stored under its
         ``name`` attribute or its class name). The results go into ``groups`` (profiles into
-        ``profiles``) and, with ``save`` and a ``path``, into the file. Returns ``self``."""
+        ``profiles``) and, with ``save`` and a ``path``, into the file. ``wall_relative``:
+        walls that move (servo): y bins that follow the walls (None: yes, Campbell's
+        ST = HGT/FND; False: fixed strips). Returns ``self``."""
         from ..analysis.registry import Context, compute_statistics
 
         scene = self.scene
         names = [w for w in what if isinstance(w, str)]
-        ctx = Context(scene, frames=(lambda: self.iter_frames(start)) if self.frames else None,
-                      results=self, z_cells=z_cells)
+        from ..analysis.walls import first_walls
+
+        frames = (lambda: self.iter_frames(start)) if self.frames else None
+        ctx = Context(scene, frames=frames, results=self, z_cells=z_cells,
+                      wall_relative=wall_relative,
+                      walls=first_walls(frames) if wall_relative is False else None)
         computed = compute_statistics(names, ctx)
         for analysis in (w for w in what if not isinstance(w, str)):
             analysis.run(self.iter_frames(start))
@@ -429,8 +435,28 @@ def frames_of(results: Results, dim: int) -> Iterator[Frame]:
 
         raise StatisticUnavailable("the results file holds no frames with their box: run "
                                    "with --keep-frames (or measure.keep_frames = true)")
+    walls = _frame_walls(results)
     for i, t in enumerate(fr["time"]):
-        yield Frame(time=float(t), box_lo=fr["box_lo"][i], box_hi=fr["box_hi"][i],
-                    position=fr["position"][i][:, :dim], velocity=fr["velocity"][i][:, :dim],
-                    angular_velocity=fr["angular_velocity"][i], radius=fr["radius"][i],
-                    tilt=float(fr["tilt"][i]) if "tilt" in fr else 0.0)
+        frame = Frame(time=float(t), box_lo=fr["box_lo"][i], box_hi=fr["box_hi"][i],
+                      position=fr["position"][i][:, :dim], velocity=fr["velocity"][i][:, :dim],
+                      angular_velocity=fr["angular_velocity"][i], radius=fr["radius"][i],
+                      tilt=float(fr["tilt"][i]) if "tilt" in fr else 0.0)
+        if walls is not None:  # walls that move (servo): where they were at this frame
+            frame.extra[WALLS] = (float(walls[i, 0]), float(walls[i, 1]))
+        yield frame
+
+
+def _frame_walls(results: Results) -> np.ndarray | None:
+    """(n_frames, 2) wall positions (lower, upper) at the stored frames: ``/frames/walls``,
+    or for files written before it the servo's ``/timeseries/wall_position_*`` at the frame
+    times (the frames are samples of the time series); None when the walls do not move."""
+    fr, ts = results.frames, results.timeseries
+    if "walls" in fr:
+        return np.asarray(fr["walls"], float).reshape(-1, 2)
+    if not {"wall_position_lower", "wall_position_upper", "time"} <= set(ts):
+        return None
+    t = np.asarray(ts["time"], float)
+    frame_t = np.asarray(fr["time"], float)
+    return np.column_stack([np.interp(frame_t, t, np.asarray(ts[f"wall_position_{side}"],
+                                                             float))
+                            for side in ("lower", "upper")])

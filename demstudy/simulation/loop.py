@@ -34,6 +34,7 @@ from ..analysis.base import bin_edges
 from ..analysis.registry import STATISTICS, Context
 from ..analysis.stress import CollisionalSums, ContactStress, momentum_snapshot
 from ..analysis.suite import profile_bounds
+from ..analysis.walls import frame_walls, with_walls
 from ..contact.health import warning_text
 from ..effects.servo import ServoController, has_servo, servo_samples, servo_settings
 from ..engines.backend import LOG_CAPACITY, BackendBase, Needs, frame_mass
@@ -271,7 +272,8 @@ class Simulation:
 
     def _begin_production(self, state: RunState) -> bool:
         """Production starts: lay what is binned from now on; True when the interaction
-        stress got new bins here (servo walls: between the walls where they stand now)."""
+        stress got new bins here (servo walls: between the walls where they stand now; the
+        profiles and the other binned statistics follow the walls frame by frame)."""
         state.in_production = True
         walls = None
         if state.servo is not None:
@@ -291,6 +293,9 @@ class Simulation:
     def _production_frame(self, state: RunState, frame: Frame) -> None:
         if self.backend.rank != 0:
             return
+        if state.servo is not None:  # walls that move: where they are at this frame
+            walls = state.servo.walls  # (the engine's positions, set in ``_sample``)
+            with_walls(frame, walls["lower"].y, walls["upper"].y)
         state.profiles.feed(frame)
         for analysis in state.streams.values():
             analysis.feed(frame)
@@ -299,6 +304,9 @@ class Simulation:
                 state.frames.setdefault(key, []).append(np.array(getattr(frame, key)))
             state.frames.setdefault("time", []).append(frame.time)
             state.frames.setdefault("tilt", []).append(frame.tilt)
+            walls = frame_walls(frame)
+            if walls is not None:
+                state.frames.setdefault("walls", []).append(walls)
 
     def _lay_stress_bins(self, state: RunState, edges: np.ndarray) -> None:
         """Accumulate the interaction stress in ``edges`` from now on."""

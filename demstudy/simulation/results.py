@@ -116,4 +116,10 @@ def _stress(sim: Any, state: RunState, results: Results, start: float) -> tuple[
                                  **parts)
     if sim.backend.capabilities.stress == "contact":
         attrs["contact_samples"] = stress.samples if isinstance(stress, ContactStress) else 0
+    if results.profile_attrs.get("wall_relative") and edges is not None:
+        # walls that move: the engine's bins stay where production started (same count as
+        # the profiles' wall-relative strips, which the kinetic part and `edges` follow)
+        attrs["interaction_bins"] = (f"fixed strips between the walls where production "
+                                     f"started, [{edges[0]:.6g}, {edges[-1]:.6g}]; kinetic: "
+                                     "the profiles' wall-relative strips")
     return data, attrs

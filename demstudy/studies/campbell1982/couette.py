@@ -183,7 +183,8 @@ def servo_notes(s: dict[str, RunSummary]) -> str:
         "discs would overlap (edmd scale_width), so a dense cell that compresses keeps its "
         "width: width/gap then exceeds 0.4. The lower wall wanders by the amount in the last "
         "column during production; the profiles of servo cells are therefore taken in "
-        "wall-relative strips (module couette_measure).", "",
+        "wall-relative strips, Campbell's ST = HGT/FND (demstudy.analysis.walls; here with "
+        "the strips of the mean gap, module couette_measure).", "",
         "| run | gap H | width | width/H | lower-wall wander (max−min) |",
         "|---|---|---|---|---|", *rows])
 

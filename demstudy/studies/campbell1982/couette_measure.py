@@ -11,20 +11,22 @@ Everything comes from the package's analyses stored in the results file (``/prof
 their error is the bins' errors propagated as independent, or the scatter of the bins about
 their mean divided by √n when that is larger.
 
-Servo cells: the package's profiles use strips fixed where the walls stood when production
-started, but the servo walls wander by 1-2 d during production, which smears the wall strips
-(an empty strip behind a wall half the time). As Campbell did (strips referred to the lower
-wall and rescaled with the gap, ST = HGT/FND, L3689-3690, L3950), the profiles of servo runs
-are recomputed here from the stored frames in wall-relative coordinates
-y' = (y − y_lower(t)) H̄ / H(t) (:func:`wall_relative_profiles`); their f_s, f_N and χ then
-use the walls' measured stresses (Campbell's Couette stress, integrated from the lower wall's:
-uniform without gravity, L4337-4348), not the engine's strips.
+Servo cells: the servo walls wander by 0.4-3 d during production. The package bins their
+profiles in wall-relative strips, as Campbell did (n strips between the current walls,
+ST = HGT/FND, L3689-3690, L3950; :mod:`demstudy.analysis.walls`). Its runs fix n from the gap
+when production starts (Campbell's FND); this study recomputes the profiles of servo runs
+from the stored frames with the package's wall-relative :class:`ProfileAnalysis` and
+n = round(H̄ / bin_width) strips of the mean gap H̄ (:func:`wall_relative_profiles`), the
+convention its numbers were first made with. Their f_s, f_N and χ then use the walls'
+measured stresses (Campbell's Couette stress, integrated from the lower wall's: uniform
+without gravity, L4337-4348), not the engine's strips (fixed where the walls stood when
+production started).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -164,23 +166,13 @@ def summarise(name: str, path: Path) -> RunSummary:
 
 
 def wall_relative_profiles(res: Any, scene: Any, start: float, gap: float) -> dict:
-    """Profiles over the production frames with y' = (y − y_lower(t)) gap / H(t): strips
-    that follow the servo walls (Campbell's ST = HGT/FND), on [0, gap]."""
-    ts = res.timeseries
-    t = np.asarray(ts["time"], float)
-    lower = np.asarray(ts["wall_position_lower"], float)
-    upper = np.asarray(ts["wall_position_upper"], float)
-    ana = ProfileAnalysis(axis="y", bin_width=scene.measure.bin_width, lo=0.0, hi=gap, dim=2,
-                          inertia_factor=scene.inertia_k)
-    for frame in res.iter_frames(start + 1e-9):
-        lo, hi = np.interp(frame.time, t, lower), np.interp(frame.time, t, upper)
-        pos = np.array(frame.position, float)
-        pos[:, 1] = (pos[:, 1] - lo) * gap / (hi - lo)
-        box_lo, box_hi = np.array(frame.box_lo, float), np.array(frame.box_hi, float)
-        box_lo[1], box_hi[1] = 0.0, gap
-        ana.feed(replace(frame, position=pos, box_lo=box_lo, box_hi=box_hi))
-    ana.finish()
-    return dict(ana.results)
+    """Profiles over the production frames in strips that follow the servo walls (the
+    package's wall-relative bins, Campbell's ST = HGT/FND): round(gap / bin_width) strips,
+    reported on the grid between the mean wall positions."""
+    ana = ProfileAnalysis(axis="y", bin_width=scene.measure.bin_width, dim=2,
+                          inertia_factor=scene.inertia_k, wall_relative=True,
+                          strips=max(1, round(gap / scene.measure.bin_width)))
+    return dict(ana.run(res.iter_frames(start + 1e-9)).results)
 
 
 def _servo_derived(res: Any, scene: Any, start: float, gap: float,
@@ -212,7 +204,8 @@ def _servo_derived(res: Any, scene: Any, start: float, gap: float,
 
     nu = np.nan_to_num(np.asarray(prof["solid_fraction"], float))
     der["chi_theory"] = np.asarray(campbell_chi(nu, 2, scene.contact.restitution), float)
-    for side, wall, speed in (("lower", 0.0, 0.0), ("upper", gap, u_t)):
+    edges = np.asarray(prof["edges"], float)  # the mean walls
+    for side, wall, speed in (("lower", edges[0], 0.0), ("upper", edges[-1], u_t)):
         der[f"slip_{side}"], der[f"slip_{side}_err"] = dv.wall_slip(prof, wall, side, speed,
                                                                     "extrapolate", 2)
     return prof, der
