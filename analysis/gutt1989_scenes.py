@@ -87,7 +87,7 @@ def gas_box() -> str:
         'figs 3.16-3.17"\n',
         "[contact]   # elastic (L1037)\nrestitution = 1.0\n" + walls(1.0, "assumed: not "
                                                                        "stated for the box"),
-        "nxt = 258\nnyt = 130\n", lines, run_table(1024, 64))
+        "nxt = 258\nnyt = 130\n", lines, run_table(1024, 32))
 
 
 def explosion() -> str:
@@ -167,7 +167,7 @@ def hourglass() -> str:
         GRANULAR + walls(0.75, "e_pw below c_b (assumed = e_pp)") +
         "\n[gravity]   # along +x: the channel axis\ndirection = [1.0, 0.0]\n",
         "nxt = 240\nnyt = 122\nwall_e2 = 0.9375   # e_pw above c_b (assumed = e_pp)\n",
-        lines, run_table(2048, 64))
+        lines, run_table(2048, 32))
 
 
 OBSTACLES = {
@@ -216,7 +216,7 @@ def obstacle(kind: str) -> str:
         GRANULAR + walls(0.75, "e_pw below c_b (assumed = e_pp)") +
         "\n[gravity]   # along +x: down the channel\ndirection = [1.0, 0.0]\n",
         "nxt = 288\nnyt = 130\nwall_e2 = 0.9375   # e_pw above c_b (assumed = e_pp)\n",
-        lines, run_table(1536, 64))
+        lines, run_table(1536, 32))
 
 
 def incline() -> str:
@@ -239,7 +239,7 @@ def incline() -> str:
         f"\n[gravity]   # normal to the diagonal: 23.41° from −y towards +x\n"
         f"direction = [{math.sin(alpha)!r}, {-math.cos(alpha)!r}]\n",
         "nxt = 432\nnyt = 218\nwall_e2 = 0.9375   # e_pw above c_b (assumed = e_pp)\n",
-        lines, run_table(6144, 256))
+        lines, run_table(6144, 48))
 
 
 def poiseuille(nxt: int, name: str, note: str) -> str:
@@ -260,7 +260,7 @@ def poiseuille(nxt: int, name: str, note: str) -> str:
         walls(0.75, "e_pw") + "\n[gravity]   # g = 8 along +x (L1119): gravity_scale\n"
                               "direction = [1.0, 0.0]\n",
         f"nxt = {nxt}\nnyt = 128\ngravity_scale = 8.0   # the thesis's g = 8 (L1119)\n",
-        lines, run_table(18432, 256))
+        lines, run_table(18432, 48))
 
 
 def main() -> None:
