@@ -84,7 +84,7 @@ def profiles(runs: Sequence[CouetteRun], out: Path, dim: int) -> Figure:
         label = f"⟨k_τ²⟩ = {r.v('k2'):.3f} ({r.name.split('-')[2]})"
         for ax, key in zip(axes, ("v", "u", "phi"), strict=True):
             ax.errorbar(y, r.arrays[key], yerr=r.arrays[f"{key}_err"], fmt="o", ms=3,
-                        color=colour, label=label if key == "v" else None)
+                        color=colour, label=label if key == "phi" else None)
         for fitted, style in ((False, "-"), (True, "--")):
             sol = theory(r, fitted=fitted)
             if sol is None:
@@ -96,8 +96,8 @@ def profiles(runs: Sequence[CouetteRun], out: Path, dim: int) -> Figure:
                 ylim=(0, None))
     axes[1].set(xlabel="y' [d]", ylabel="u/u_w", title="(b) mean velocity (walls at ±1)")
     axes[2].set(xlabel="y' [d]", ylabel="φ/φ_cp (theory: 1 − 3s/d)",
-                title="(c) solid fraction", ylim=(0, 1.1))
-    axes[0].legend(loc="lower center", fontsize=7.5,
+                title="(c) solid fraction", ylim=(-0.45, 1.1))
+    axes[2].legend(loc="lower center", fontsize=7.5,
                    title="runs (dots); theory: thesis (—), fitted (--)", title_fontsize=7.5)
     kind = "3D spheres" if dim == 3 else "2D discs"
     fig.suptitle(f"Profiles across the channel, {kind}, e_w = 0.84 (as Gutt's fig 2.10)")
