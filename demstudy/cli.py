@@ -612,7 +612,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("study", help="a seed study end to end: runs, analysis, figures in the "
                        "thesis's forms and a report checking its statements (docs/studies/)")
-    p.add_argument("name", help="campbell1982 or malik2008")
+    p.add_argument("name", help="campbell1982, gutt1989 or malik2008")
     p.add_argument("--quick", action="store_true",
                    help="a reduced study in minutes (short runs, fewer cases) into "
                         "results/studies/NAME-quick/")

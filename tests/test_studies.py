@@ -155,7 +155,7 @@ def test_cli_refuses_an_unknown_study_and_bad_workers_with_exit_2():
                               capture_output=True, text=True, timeout=120)
         assert proc.returncode == 2, proc.stderr
         assert "Traceback" not in proc.stderr
-    assert "campbell1982, malik2008" in subprocess.run(
+    assert "campbell1982, gutt1989, malik2008" in subprocess.run(
         [sys.executable, "-m", "demstudy.cli", "study", "nope"], capture_output=True,
         text=True, timeout=120).stderr
 

@@ -1,4 +1,4 @@
-"""The seed studies, one command each: ``demstudy study campbell1982 | malik2008``
+"""The seed studies, one command each: ``demstudy study campbell1982 | malik2008 | gutt1989``
 (docs/studies/). A study runs its cases, analyses them, writes figures in the thesis's forms
 and a report with one row per statement of the thesis and its verdict.
 
@@ -13,7 +13,8 @@ from importlib import import_module
 from .base import Analysis, Case, Check, Figure, Study, pm, within
 
 #: study name → module that defines ``STUDY``
-_MODULES = {"campbell1982": ".campbell1982", "malik2008": ".malik2008"}
+_MODULES = {"campbell1982": ".campbell1982", "gutt1989": ".gutt1989",
+            "malik2008": ".malik2008"}
 
 __all__ = ["Analysis", "Case", "Check", "Figure", "Study", "get_study", "pm", "run_study",
            "study", "study_names", "within"]
@@ -28,8 +29,7 @@ def get_study(name: str) -> Study:
     from ..errors import BadOption
 
     if name not in _MODULES:
-        raise BadOption("study", name, f"the studies {', '.join(study_names())} are allowed "
-                        "(Gutt's follows in its own issue)")
+        raise BadOption("study", name, f"the studies {', '.join(study_names())} are allowed")
     return import_module(_MODULES[name], __name__).STUDY
 
 
