@@ -129,7 +129,7 @@ def forecast(tasks: Sequence[StudyTask], workers: int
     from ..api import run
     from ..errors import UnsupportedByEngine
 
-    seconds, lines, unknown, refused = {}, [], False, {}
+    seconds, lines, unknown, refused, lower = {}, [], False, {}, False
     for task in tasks:
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
@@ -145,8 +145,14 @@ def forecast(tasks: Sequence[StudyTask], workers: int
                          f"({plan.get('forecast', 'not measured')})")
             continue
         seconds[task.case.name] = float(s)
-        lines.append(f"  {task.case.name} ({task.case.engine}): {_duration(s)}")
+        bound = plan.get("forecast_kind") == "lower bound"
+        lower = lower or bound
+        lines.append(f"  {task.case.name} ({task.case.engine}): "
+                     f"{'at least ' if bound else ''}{_duration(s)}")
     total = makespan(list(seconds.values()), workers) if seconds else 0.0
+    if lower:  # the runs' lower bounds: the study takes longer, by how much is unknown
+        lines.append("  (at least: a flow that gravity accelerates outruns its pilot; "
+                     "docs/forecast.md)")
     return (None if unknown else total), lines, refused, seconds
 
 
