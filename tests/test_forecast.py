@@ -397,3 +397,22 @@ def test_a_finished_run_of_the_family_scales_the_forecast(tmp_path):
     dense = channel(240)
     assert fc.forecast_run(dense, get_backend("edmd"), costs=EVENT_COSTS,
                            options=RunOptions(out=tmp_path / "dense.h5")).lower_bound
+
+
+def test_the_pilots_own_counts_then_its_last_windows_rates():
+    """What the pilot counted from t = 0 (its whole run: the slow start of an accelerating
+    flow included), then its last window's rates for the rest of the run; a run shorter
+    than the pilot gets the pilot's counts scaled down."""
+    pilot = PilotResult(True, pair_collisions=100, events=1000, simulated_time=2.0,
+                        n_particles=100, window_collisions=100, window_crossings=300,
+                        window_time=1.0, total_collisions=150)
+    scene = gas()  # 4 τ
+    n = scene.n_particles
+    f = fc.forecast_run(scene, get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
+    collisions = (1.5 + 1.0 * 2.0) * n
+    crossings = (8.5 + 3.0 * 2.0) * n
+    assert f.seconds == pytest.approx(collisions * 2e-6 + crossings * 3e-7, rel=1e-12)
+    short = scene.model_copy(update={"run": scene.run.model_copy(
+        update={"equilibration": 0.0, "production": 1.0})})
+    f = fc.forecast_run(short, get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
+    assert f.seconds == pytest.approx((1.5 * 2e-6 + 8.5 * 3e-7) * n / 2, rel=1e-12)

@@ -8,9 +8,11 @@ impacts per particle per τ, τ_flight its inverse.
 
 :func:`run_pilot` runs the scene in the event-driven core (in this process, no results file)
 with every collision logged, in windows of ``PILOT_COLLISIONS`` pair collisions per
-particle, until two successive windows agree after ``MIN_TIME`` (the start-up transient is
-over: ``SETTLED``), the scene's own duration (equilibration + production), ``MAX_WINDOWS``
-windows or ``PILOT_SECONDS`` of wall time; the last window is the measurement. It adds the
+particle, until two successive windows agree after ``MIN_TIME`` (impact rates, q0.99 impact
+speeds and event rates: the start-up transient is over: ``SETTLED``), the scene's own
+duration (equilibration + production), ``MAX_WINDOWS`` windows or ``PILOT_SECONDS`` of wall
+time; the last window is the measurement (its collisions and cell crossings, and the whole
+pilot's, also go to the wall-time forecast). It adds the
 initial state's own impacts as a floor (the DESIGN_QUANTILE of the normal approach speeds of
 approaching neighbours and of particles towards a wall; a wall's own speed is tangential and
 does not count), so particles fired at each other are seen even when the pilot stops first.
@@ -60,7 +62,7 @@ SETTLED = 0.25
 MIN_TIME = 1.0
 #: at most this many windows (the wall-time cap usually comes first in large scenes)
 MAX_WINDOWS = 200
-PILOT_VERSION = 4  # part of the cache key: a changed pilot measures again
+PILOT_VERSION = 5  # part of the cache key: a changed pilot measures again
 
 
 class PilotWarning(UserWarning):
@@ -98,6 +100,9 @@ class PilotResult:
     window_crossings: int = 0
     window_time: float = 0.0
     rate_growth: float = 1.0
+    #: collisions (pair + wall) over the whole pilot, t = 0 … simulated_time (the rest of
+    #: ``events`` are cell crossings)
+    total_collisions: int = 0
 
     @property
     def tau_flight(self) -> float:
@@ -295,6 +300,7 @@ def _advance(scene: Scene, backend, seconds: float, collisions: float) -> PilotR
         window_collisions=int(last["pair_count"] + last["wall_count"]),
         window_crossings=int(last["events"] - last["pair_count"] - last["wall_count"]),
         window_time=float(last["duration"]),
+        total_collisions=int(core.collisions) + int(core.wall_collisions),
         rate_growth=(last["events_rate"] / windows[0]["events_rate"]
                      if windows[0]["events_rate"] > 0 else 1.0))
 

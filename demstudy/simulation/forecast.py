@@ -396,8 +396,8 @@ def expected_events(scene: Scene, pilot: PilotResult | None = None,
                                        f"{rates.crossing / max(rates.collision, 1e-300):.3g} "
                                        f"cell crossings each ({rates.source})"), \
             rates.lower_bound
-    return (rates.collision * n * duration, rates.crossing * n * duration,
-            f"{rates.source} × {n} × {duration:g} τ", rates.lower_bound)
+    collisions, crossings = rates.counts(n, duration)
+    return collisions, crossings, f"{rates.source}; × {n} × {duration:g} τ", rates.lower_bound
 
 
 def accelerates(scene: Scene) -> bool:

@@ -8,7 +8,8 @@ Where the rates come from, best first:
 
 1. a finished run of the same scene family in the results file's folder
    (:func:`reference_rates`): the flow's own rates over a whole run, transient included;
-2. the pilot's last window (:func:`pilot_rates`); in a flow that gravity accelerates along a
+2. the pilot: what it counted over its whole run, then its last window's rates
+   (:func:`pilot_rates`); in a flow that gravity accelerates along a
    periodic axis (a channel, a chute), or when the pilot stopped on its wall-time cap while
    its event rate still rose, the pilot has seen only the flow's start and the forecast
    from it is a lower bound (``lower_bound`` says why);
@@ -28,8 +29,8 @@ from pathlib import Path
 
 from ..scene import Scene
 
-__all__ = ["EventRates", "cell_widths", "crossing_rate", "estimated_rates", "pilot_rates",
-           "reference_rates", "same_family"]
+__all__ = ["EventRates", "cell_widths", "crossing_rate", "estimated_rates", "mean_flow_speed",
+           "pilot_rates", "reference_rates", "same_family"]
 
 #: a run whose pilot's event rate grew by more than this fraction over its last windows has
 #: not reached its steady rate (as ``pilot.SETTLED``)
@@ -47,6 +48,23 @@ class EventRates:
     crossing: float
     source: str
     lower_bound: str = ""
+    #: what was counted from t = 0 to ``seen`` τ (the pilot's whole run): collisions and
+    #: crossings per particle; the rates hold after it
+    seen: float = 0.0
+    seen_collisions: float = 0.0
+    seen_crossings: float = 0.0
+
+    def counts(self, n: int, duration: float) -> tuple[float, float]:
+        """Collisions and crossings of ``n`` particles over ``duration`` τ from t = 0: what
+        was seen up to ``seen`` (scaled down for a shorter run), the rates after it."""
+        if self.seen <= 0:
+            return self.collision * n * duration, self.crossing * n * duration
+        if duration <= self.seen:
+            part = duration / self.seen
+            return self.seen_collisions * n * part, self.seen_crossings * n * part
+        rest = duration - self.seen
+        return ((self.seen_collisions + self.collision * rest) * n,
+                (self.seen_crossings + self.crossing * rest) * n)
 
 
 def cell_widths(scene: Scene) -> list[float]:
@@ -77,14 +95,25 @@ def crossing_rate(scene: Scene, temperature: float, mean_speed: float = 0.0) -> 
                for a, w in enumerate(widths))
 
 
+def mean_flow_speed(scene: Scene) -> float:
+    """The mean |u_x| of an imposed linear profile: γ̇ L_y / 4 under Lees–Edwards shear,
+    |ΔU| / 4 between walls moving apart (0 otherwise: a flow gravity drives is unknown)."""
+    if scene.shear is not None:
+        return abs(scene.shear.rate) * scene.box.size[1] / 4
+    if len(scene.walls) == 2:
+        speeds = [w.velocity for w in scene.walls]
+        return abs(max(speeds) - min(speeds)) / 4
+    return 0.0
+
+
 def estimated_rates(scene: Scene, temperature: float) -> EventRates:
-    """Enskog's pair collisions (ω/2 per particle: each involves two) plus the thermal cell
-    crossings, at ``temperature``."""
+    """Enskog's pair collisions (ω/2 per particle: each involves two) plus the cell
+    crossings at ``temperature`` and the imposed mean flow (:func:`mean_flow_speed`)."""
     from ..theory import collision_frequency
 
     omega = float(collision_frequency(min(scene.solid_fraction, 0.6), temperature,
                                       scene.dimension))
-    crossings = crossing_rate(scene, temperature)
+    crossings = crossing_rate(scene, temperature, mean_flow_speed(scene))
     return EventRates(omega / 2, crossings,
                       f"Enskog ω = {omega:.3g} and {crossings:.3g} cell crossings per "
                       f"particle per τ at T = {temperature:.3g}")
@@ -112,9 +141,17 @@ def pilot_rates(pilot, accelerating: bool = False) -> EventRates | None:
         why = (f"the pilot stopped on its wall-time cap at t = {pilot.simulated_time:.3g} τ "
                f"while its event rate still grew (×{pilot.rate_growth:.3g} over its "
                "windows)")
+    n = pilot.n_particles
+    seen = pilot.total_collisions / n, (pilot.events - pilot.total_collisions) / n
+    if pilot.total_collisions <= 0:  # without the pilot's totals: its last window's rates
+        return EventRates(collisions, crossings,
+                          f"the pilot's last window: {collisions:.3g} collisions and "
+                          f"{crossings:.3g} cell crossings per particle per τ", why)
     return EventRates(collisions, crossings,
-                      f"the pilot's last window: {collisions:.3g} collisions and "
-                      f"{crossings:.3g} cell crossings per particle per τ", why)
+                      f"the pilot's first {pilot.simulated_time:.3g} τ ({seen[0]:.3g} "
+                      f"collisions and {seen[1]:.3g} crossings per particle), then its last "
+                      f"window's {collisions:.3g} and {crossings:.3g} per particle per τ",
+                      why, pilot.simulated_time, *seen)
 
 
 # -- finished runs of the same scene family -------------------------------------------------
@@ -131,11 +168,22 @@ def same_family(scene: Scene, other: Scene) -> bool:
             and abs(other.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI)
 
 
+def _distance(scene: Scene, other: Scene) -> float:
+    """How far a finished run of the family is: N (by ratio) first, then e and β (the
+    collision rate of a channel grows as e → 1: ×1.8 from e = 0.8 to 0.99 at φ = 0.01)."""
+    def beta(s: Scene) -> float:
+        return float(getattr(s.contact.tangential, "beta", -1.0))
+    return (abs(math.log(other.n_particles / scene.n_particles))
+            + abs(other.contact.restitution - scene.contact.restitution)
+            + abs(beta(other) - beta(scene)) / 4)
+
+
 def reference_rates(scene: Scene, folder: Path, engine: str = "edmd",
                     exclude: Path | None = None) -> EventRates | None:
     """The event rates of the finished ``engine`` run of ``scene``'s family in ``folder``
-    (results files' root attributes) whose N is closest, the cell crossings scaled by the
-    cells' widths (Σ 1/w, :func:`cell_widths`); None when there is none."""
+    (results files' root attributes) closest in N, e and β (:func:`_distance`), the cell
+    crossings scaled by the cells' widths (Σ 1/w, :func:`cell_widths`); None when there is
+    none."""
     import h5py
 
     from ..scene import parse_scene_text, validate_scene
@@ -157,7 +205,7 @@ def reference_rates(scene: Scene, folder: Path, engine: str = "edmd",
             continue
         if other.run.unit != "time" or not same_family(scene, other):
             continue
-        distance = abs(math.log(other.n_particles / scene.n_particles))
+        distance = _distance(scene, other)
         if best is None or distance < best[0]:
             best = (distance, path, other, a)
     if best is None:
