@@ -16,8 +16,8 @@ Where the rates come from, best first:
 3. Enskog's collision frequency and the thermal speed's cell crossings at the flow's typical
    temperature (:func:`estimated_rates`).
 
-Why cell crossings matter: in a dilute flow they are most of the events (97 % in Malik's
-φ = 0.01 Poiseuille runs, 31 per pair collision), and a mean flow crosses cells at |u|/w
+Why cell crossings matter: in a dilute flow they are most of the events (94–98 % in
+Malik's φ = 0.01 Poiseuille runs, 14–39 per collision), and a mean flow crosses cells at |u|/w
 per particle without colliding more.
 """
 
