@@ -148,6 +148,23 @@ def cpu_model() -> str:
     return f"{name} ({os.cpu_count()} logical cores)"
 
 
+def _load() -> float | None:
+    """The 1-minute load average (None where the OS has none): a run's costs scale with the
+    share of a core it gets on a shared machine (docs/forecast.md, "Accuracy and limits")."""
+    try:
+        return round(os.getloadavg()[0], 2)
+    except OSError:
+        return None
+
+
+def _load_note(key: str) -> str:
+    """The load when ``key``'s costs were measured and now, for the basis."""
+    then, now = load_rates().get(key, {}).get("load"), _load()
+    if then is None or now is None:
+        return ""
+    return f" (measured at load {then:.2g}, now {now:.2g}, on {os.cpu_count()} cores)"
+
+
 def rates_path() -> Path:
     return cache_dir() / RATES_FILE
 
@@ -196,7 +213,8 @@ def measure_costs(engine: str, dim: int, model: str | None = None, *,
           f"{rates_path()})", file=sys.stderr, flush=True)
     costs, what = _benchmark(engine, dim, model)
     _store_rate(key, {"model": COST_MODEL, "costs": costs, "what": what,
-                      "measured": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())})
+                      "measured": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+                      "load": _load()})
     return costs
 
 
@@ -459,6 +477,8 @@ def forecast_run(scene: Scene, backend: Any, timestep: float | None = None,
                  f"{_samples(scene)} samples")
     extra_costs, extra_counts, extra_basis = scene_costs(scene, options)
     seconds = predict(costs, counts) + predict(extra_costs, extra_counts)
+    if where == key:
+        where += _load_note(key)
     return Forecast(seconds, f"{basis}{extra_basis}; costs of {where}",
                     lower_bound=lower_bound)
 
