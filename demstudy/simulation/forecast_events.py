@@ -169,11 +169,16 @@ def same_family(scene: Scene, other: Scene) -> bool:
 
 
 def _distance(scene: Scene, other: Scene) -> float:
-    """How far a finished run of the family is: N (by ratio) first, then e and β (the
-    collision rate of a channel grows as e → 1: ×1.8 from e = 0.8 to 0.99 at φ = 0.01)."""
+    """How far a finished run of the family is: N and the run's length (by ratio: a short
+    run's rates are more of its start-up's), then e and β (the collision rate of a channel
+    grows as e → 1: ×1.8 from e = 0.8 to 0.99 at φ = 0.01)."""
     def beta(s: Scene) -> float:
         return float(getattr(s.contact.tangential, "beta", -1.0))
+
+    def length(s: Scene) -> float:
+        return s.run.equilibration + s.run.production
     return (abs(math.log(other.n_particles / scene.n_particles))
+            + abs(math.log(length(other) / length(scene)))
             + abs(other.contact.restitution - scene.contact.restitution)
             + abs(beta(other) - beta(scene)) / 4)
 
