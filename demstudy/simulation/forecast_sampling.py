@@ -83,9 +83,9 @@ def _time_analyses(scene: Scene, names: list[str], keep_frames: bool
     for name in names:
         try:
             analysis = STATISTICS[name].build(Context(scene))
+            seconds = _median_feed(lambda a=analysis: a.feed(frame))
         except Exception:  # noqa: BLE001 - the run itself reports an unusable statistic
             continue
-        seconds = _median_feed(lambda a=analysis: a.feed(frame))
         total += seconds
         parts.append(f"{name} {seconds * 1e3:.3g} ms")
     if keep_frames:
