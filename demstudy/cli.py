@@ -222,7 +222,8 @@ def _cmd_forecast(args: argparse.Namespace) -> int:
     print(f"machine rates ({cpu_model()}), cached in {rates_path()}:")
     for key, entry in sorted(rates.items()):
         costs = ", ".join(f"{k} {v:.3g} s" for k, v in entry["costs"].items())
-        print(f"  {key} ({entry['measured']}): {costs}\n    benchmarks: {entry['what']}")
+        load = f", load {entry['load']:.2g}" if entry.get("load") is not None else ""
+        print(f"  {key} ({entry['measured']}{load}): {costs}\n    benchmarks: {entry['what']}")
     return 0
 
 

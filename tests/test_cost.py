@@ -241,7 +241,8 @@ def test_cli_refuses_bad_input_naming_the_option(argv, named, capsys, tmp_path):
 
 FAKE_COSTS = {"step": 2e-6, "atom_step": 1e-7, "contact_step": 1e-7, "atom_sample": 1e-7,
               "sample": 1e-3, "shear_atom_step": 5e-8, "history_atom_step": 5e-8,
-              "wall_step": 1e-6, "event": 1e-6}
+              "wall_step": 1e-6, "collision": 1e-6, "crossing": 1e-6, "large_event": 0.0,
+              "run": 0.0}
 
 
 def test_dry_run_forecasts_the_whole_ladder_measuring_the_machine_once(tmp_path, monkeypatch,

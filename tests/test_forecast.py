@@ -58,32 +58,45 @@ def test_soft_forecast_is_the_sum_of_costs_times_counts():
     assert half == pytest.approx(2 * expected - n * samples * 5e-7 - samples * 1e-3, rel=1e-12)
 
 
+EVENT_COSTS = {"collision": 2e-6, "crossing": 3e-7, "large_event": 0.0, "atom_sample": 0.0,
+               "sample": 0.0, "run": 0.0}
+
+
 def test_event_forecast_from_the_pilot_and_from_enskog():
-    """Event-driven: the pilot's events per particle per τ × N × duration; with no pilot the
-    Enskog collision frequency at T = v_ref² (T0 = 1 here) × 3 events per collision."""
+    """Event-driven: collisions and cell crossings apart, at the pilot's last window's rates
+    per particle per τ × N × duration; with no pilot Enskog's pair collisions (ω/2 per
+    particle) and the Maxwellian crossings Σ_a √(2T/π)/w_a at T = 1 (T0 here)."""
     scene = gas()
-    n, costs = scene.n_particles, {"event": 1e-6, "atom_sample": 0.0, "sample": 0.0}
+    n = scene.n_particles
     pilot = PilotResult(True, pair_collisions=1000, events=5000, simulated_time=2.0,
-                        n_particles=100)
-    f = fc.forecast_run(scene, get_backend("edmd"), pilot=pilot, costs=costs)
-    assert f.seconds == pytest.approx(5000 / (100 * 2.0) * n * 4.0 * 1e-6, rel=1e-12)
+                        n_particles=100, window_collisions=300, window_crossings=900,
+                        window_time=1.5)
+    f = fc.forecast_run(scene, get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
+    per = 100 * 1.5
+    assert f.seconds == pytest.approx((300 / per * 2e-6 + 900 / per * 3e-7) * n * 4.0,
+                                      rel=1e-12)
+    assert not f.lower_bound and "at least" not in f.line()
+    from demstudy.simulation.forecast_events import cell_widths
     from demstudy.theory import collision_frequency
 
     omega = float(collision_frequency(scene.solid_fraction, 1.0, 2))
-    enskog = fc.forecast_run(scene, get_backend("edmd"), costs=costs)
-    assert enskog.seconds == pytest.approx(omega * n * 4.0 / 2 * 3.0 * 1e-6, rel=1e-12)
+    crossings = sum(math.sqrt(2 / math.pi) / w for w in cell_widths(scene))
+    enskog = fc.forecast_run(scene, get_backend("edmd"), costs=EVENT_COSTS)
+    assert enskog.seconds == pytest.approx((omega / 2 * 2e-6 + crossings * 3e-7) * n * 4.0,
+                                           rel=1e-12)
     assert "Enskog" in enskog.basis
 
 
 def test_collision_counted_runs_know_their_events():
-    """run.unit = 'collisions': (equilibration + production) × N pair collisions, × the
-    pilot's events per collision."""
+    """run.unit = 'collisions': (equilibration + production) × N pair collisions, with the
+    pilot's cell crossings per collision."""
     scene = gas().model_copy(update={"run": gas().run.model_copy(update={"unit": "collisions"})})
     pilot = PilotResult(True, pair_collisions=100, events=250, simulated_time=1.0,
-                        n_particles=10)
-    costs = {"event": 1.0, "atom_sample": 0.0, "sample": 0.0}
+                        n_particles=10, window_collisions=100, window_crossings=150,
+                        window_time=1.0)
+    costs = dict(EVENT_COSTS, collision=1.0, crossing=0.5)
     f = fc.forecast_run(scene, get_backend("edmd"), pilot=pilot, costs=costs)
-    assert f.seconds == pytest.approx(4.0 * scene.n_particles * 2.5, rel=1e-12)
+    assert f.seconds == pytest.approx(4.0 * scene.n_particles * (1.0 + 1.5 * 0.5), rel=1e-12)
 
 
 def test_missing_cost_is_a_clear_error():
@@ -135,7 +148,7 @@ def fake_benchmark(monkeypatch, capsys=None) -> list:
     def bench(engine, dim, model):
         calls.append(capsys.readouterr().err if capsys else "")
         return ((SOFT_COSTS if engine == "lammps" else
-                 {"event": 1e-6, "atom_sample": 1e-7, "sample": 1e-4}), "fake")
+                 dict(EVENT_COSTS, atom_sample=1e-7, sample=1e-4)), "fake")
 
     monkeypatch.setattr(fc, "_benchmark", bench)
     monkeypatch.setenv(fc.MEASURE_ENV, "1")  # measuring allowed: only a dry run refrains
@@ -199,8 +212,8 @@ def test_rates_are_updated_under_a_lock(monkeypatch):
 
 def fake_costs(monkeypatch):
     monkeypatch.setattr(fc, "measure_costs", lambda engine, dim, model=None, **_: (
-        SOFT_COSTS if engine == "lammps" else {"event": 1e-6, "atom_sample": 1e-7,
-                                                "sample": 1e-4}))
+        SOFT_COSTS if engine == "lammps" else dict(EVENT_COSTS, atom_sample=1e-7,
+                                                   sample=1e-4)))
 
 
 def test_dry_run_runs_nothing_and_prints_the_settings(tmp_path, monkeypatch, capsys):
@@ -236,5 +249,170 @@ def test_a_run_stores_its_forecast_next_to_the_wall_time(tmp_path, monkeypatch):
     scene = gas().model_copy(update={"run": gas().run.model_copy(
         update={"equilibration": 0.0, "production": 1.0})})
     res = ds.run(scene, engine="edmd", out=tmp_path / "r.h5", isolate=False, progress=False)
-    assert res.attrs["forecast_seconds"] > 0 and "events" in res.attrs["forecast_basis"]
-    assert res.attrs["wall_seconds"] > 0
+    assert res.attrs["forecast_seconds"] > 0 and "crossings" in res.attrs["forecast_basis"]
+    assert res.attrs["wall_seconds"] > 0 and res.attrs["forecast_kind"] == "estimate"
+
+
+# -- the event-driven model's parts (docs/forecast.md, "Why the Malik runs were missed") ----
+def gas3d(n: int = 300, side: float = 30.0, **extra) -> object:
+    data = {"dimension": 3, "box": {"size": [side] * 3}, "particles": {"count": n},
+            "contact": {"restitution": 1.0},
+            "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+            "run": {"equilibration": 0.0, "production": 20.0, "sample_interval": 5.0}}
+    data.update(extra)
+    return validate_scene(data)
+
+
+def channel(n: int = 120, length: float = 24.0, restitution: float = 0.8) -> object:
+    """A 2D channel between walls at y = 0 and 10, driven by gravity along periodic x."""
+    return validate_scene({
+        "dimension": 2, "box": {"size": [length, 10.0]}, "particles": {"count": n},
+        "contact": {"restitution": restitution},
+        "walls": [{"side": "lower", "restitution": 1.0}, {"side": "upper", "restitution": 1.0}],
+        "gravity": {"direction": [1.0, 0.0]},
+        "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+        "run": {"equilibration": 0.0, "production": 5.0, "sample_interval": 1.0}})
+
+
+def test_cell_widths_are_the_engines(tmp_path):
+    """forecast_events.cell_widths reproduces the event-driven engine's grid: one diameter
+    in a dense box, coarsened to ≤ 8 cells per particle in a dilute one (walls: y bounded)."""
+    from demstudy.engines.backend import Needs
+    from demstudy.engines.edmd import EdmdBackend
+    from demstudy.simulation import RunOptions
+    from demstudy.simulation.forecast_events import cell_widths
+
+    dilute = gas3d(walls=[{"side": "lower", "restitution": 1.0},
+                         {"side": "upper", "restitution": 1.0}])
+    for scene in (gas(), dilute, channel()):
+        backend = EdmdBackend(scene, RunOptions(out=tmp_path / "r.h5"), tmp_path)
+        backend.setup(Needs(), None, None)
+        cells = backend.core.cells[:scene.dimension]
+        backend.close()
+        assert cell_widths(scene) == pytest.approx(
+            [length / c for length, c in zip(scene.box.size, cells, strict=True)], rel=1e-9)
+    assert min(cell_widths(dilute)) > 1.0  # 30³ cells for 300 particles: coarsened
+
+
+def test_cell_crossings_of_a_maxwellian_gas(tmp_path):
+    """An elastic dilute gas keeps T = 1: its cell crossings per particle per τ are the
+    Maxwellian flux Σ_a √(2T/π)/w_a (within 10 %, ~2·10⁴ crossings counted)."""
+    from demstudy.simulation.forecast_events import crossing_rate
+
+    scene = gas3d()
+    res = ds.run(scene, engine="edmd", out=tmp_path / "r.h5", isolate=False, progress=False)
+    measured = res.attrs["cell_crossings"] / (scene.n_particles * 20.0)
+    assert measured == pytest.approx(crossing_rate(scene, 1.0), rel=0.1)
+
+
+def test_pilot_keeps_its_last_windows_counts():
+    """The pilot's last window: pair + wall collisions, cell crossings, its duration; in a
+    wall-less gas its impact rate counts each pair collision twice."""
+    from demstudy.contact.pilot import run_pilot
+
+    pilot = run_pilot(gas3d(), cache=False)
+    assert pilot.window_time > 0 and pilot.window_crossings > pilot.window_collisions > 0
+    assert pilot.rate == pytest.approx(
+        2 * pilot.window_collisions / (pilot.n_particles * pilot.window_time), rel=0.02)
+
+
+def test_heavy_analyses_are_in_the_forecast(tmp_path, monkeypatch):
+    """A run sampling g(r) often spends most of its loop in the analysis: the forecast times
+    the scene's own streaming statistics (on a synthetic frame) and comes within ×2 of the
+    run's own wall time, the engine's costs aside (given as nearly nothing here)."""
+    monkeypatch.setattr(fc, "measure_costs", lambda *a, **k: dict(EVENT_COSTS,
+                                                                  collision=1e-9,
+                                                                  crossing=1e-9))
+    scene = validate_scene({
+        "dimension": 2, "box": {"size": [80.0, 80.0]}, "particles": {"count": 2400},
+        "contact": {"restitution": 1.0},
+        "initial": {"placement": "random", "velocity": {"temperature": 1.0}},
+        "run": {"equilibration": 0.0, "production": 0.6, "sample_interval": 0.01},
+        "measure": {"statistics": ["profiles", "gr"]}})
+    res = ds.run(scene, engine="edmd", out=tmp_path / "r.h5", isolate=False, progress=False)
+    forecast, actual = res.attrs["forecast_seconds"], res.attrs["wall_seconds"]
+    assert "gr " in res.attrs["forecast_basis"]
+    assert 0.5 < forecast / actual < 2.0, (forecast, actual)
+
+
+def test_checkpoints_write_the_frames_kept_so_far():
+    """Checkpoints every 2 τ of a 6 τ run (none at its end): at samples 2 and 4, with 0 and
+    2 production frames kept (equilibration 2 τ), each with the engine's state."""
+    from demstudy.simulation import forecast_sampling as fs
+
+    scene = gas3d(run={"equilibration": 2.0, "production": 4.0, "sample_interval": 1.0})
+    n = scene.n_particles
+    count, written = fs.checkpoint_bytes(scene, True, 2.0)
+    assert count == 2
+    assert written == 2 * fs.ENGINE_BYTES_PER_PARTICLE * n + 2 * fs.frame_bytes(3) * n
+    assert fs.checkpoint_bytes(scene, False, 2.0)[1] == 2 * fs.ENGINE_BYTES_PER_PARTICLE * n
+    assert fs.checkpoint_bytes(scene, True, None) == (0, 0.0)
+
+
+def test_a_flow_gravity_accelerates_gets_a_lower_bound():
+    """Gravity along periodic x between walls: the pilot sees the flow's start, so the
+    forecast is a lower bound and says so; a gas without gravity gets an estimate."""
+    pilot = PilotResult(True, pair_collisions=100, events=400, simulated_time=3.0,
+                        n_particles=120, window_collisions=100, window_crossings=300,
+                        window_time=1.0, rate_growth=2.0, stopped_by="5 s wall-time cap")
+    f = fc.forecast_run(channel(), get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
+    assert f.kind == "lower bound" and "gravity accelerates" in f.lower_bound
+    assert f.line().startswith("forecast: at least ") and "measured accuracy" not in f.line()
+    assert f.attrs()["forecast_kind"] == "lower bound"
+    assert fc.forecast_run(channel(), get_backend("edmd"), costs=EVENT_COSTS).lower_bound
+    # without gravity: a pilot capped while its rate still rose is a lower bound, a
+    # settled one an estimate
+    assert "wall-time cap" in fc.forecast_run(gas(), get_backend("edmd"), pilot=pilot,
+                                              costs=EVENT_COSTS).lower_bound
+    import dataclasses
+
+    settled = dataclasses.replace(pilot, stopped_by="settled after 3 windows", rate_growth=1.1)
+    assert not fc.forecast_run(gas(), get_backend("edmd"), pilot=settled,
+                               costs=EVENT_COSTS).lower_bound
+
+
+def test_a_finished_run_of_the_family_scales_the_forecast(tmp_path):
+    """A finished run of the same channel (another e, half the length and N) next to the
+    results file gives the rates: its collisions and cell crossings per particle per τ × N ×
+    duration (crossings × the ratio of Σ 1/w); no longer a lower bound."""
+    from demstudy.simulation import RunOptions
+    from demstudy.simulation.forecast_events import cell_widths
+
+    short = channel(60, 12.0, restitution=0.9)
+    ref = ds.run(short, engine="edmd", out=tmp_path / "short.h5", isolate=False,
+                 progress=False)
+    a = ref.attrs
+    scene = channel()
+    f = fc.forecast_run(scene, get_backend("edmd"), costs=EVENT_COSTS,
+                        options=RunOptions(out=tmp_path / "long.h5"))
+    assert not f.lower_bound and "short.h5" in f.basis
+    per = 60 * 5.0
+    collisions = (a["pair_collisions"] + a["wall_collisions"]) / per
+    widths = (sum(1 / w for w in cell_widths(scene))
+              / sum(1 / w for w in cell_widths(short)))
+    crossings = (a["events"] / per - collisions) * widths
+    n = scene.n_particles * 5.0
+    assert f.seconds == pytest.approx((collisions * 2e-6 + crossings * 3e-7) * n, rel=1e-9)
+    # a denser channel is another family: no reference, the start-only lower bound again
+    dense = channel(240)
+    assert fc.forecast_run(dense, get_backend("edmd"), costs=EVENT_COSTS,
+                           options=RunOptions(out=tmp_path / "dense.h5")).lower_bound
+
+
+def test_the_pilots_own_counts_then_its_last_windows_rates():
+    """What the pilot counted from t = 0 (its whole run: the slow start of an accelerating
+    flow included), then its last window's rates for the rest of the run; a run shorter
+    than the pilot gets the pilot's counts scaled down."""
+    pilot = PilotResult(True, pair_collisions=100, events=1000, simulated_time=2.0,
+                        n_particles=100, window_collisions=100, window_crossings=300,
+                        window_time=1.0, total_collisions=150)
+    scene = gas()  # 4 τ
+    n = scene.n_particles
+    f = fc.forecast_run(scene, get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
+    collisions = (1.5 + 1.0 * 2.0) * n
+    crossings = (8.5 + 3.0 * 2.0) * n
+    assert f.seconds == pytest.approx(collisions * 2e-6 + crossings * 3e-7, rel=1e-12)
+    short = scene.model_copy(update={"run": scene.run.model_copy(
+        update={"equilibration": 0.0, "production": 1.0})})
+    f = fc.forecast_run(short, get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
+    assert f.seconds == pytest.approx((1.5 * 2e-6 + 8.5 * 3e-7) * n / 2, rel=1e-12)

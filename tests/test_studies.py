@@ -116,6 +116,26 @@ def test_dry_run_forecasts_and_writes_nothing(toy, tmp_path):
     assert any("cell-b (edmd):" in s for s in lines)
 
 
+def test_a_lower_bound_makes_the_study_forecast_one(toy, tmp_path, monkeypatch):
+    """A run whose forecast is a lower bound (a flow gravity accelerates) is listed with "at
+    least", and so is the study's total, with the note why."""
+    import demstudy.api as api
+    from demstudy.studies.runner import LOWER_BOUND_NOTE
+
+    def plan(scene, **kw):
+        bound = scene.contact.restitution == 0.9  # cell-b
+        return {"forecast_seconds": 30.0 if bound else 10.0,
+                "forecast_kind": "lower bound" if bound else "estimate"}
+
+    monkeypatch.setattr(api, "run", plan)
+    lines: list[str] = []
+    run_study("toy", out=tmp_path, dry_run=True, workers=1, echo=lines.append)
+    assert lines[1].startswith("forecast: at least 40 s on 1 worker(s)")
+    assert any(s.endswith("cell-b (edmd): at least 30 s") for s in lines)
+    assert any(s.endswith("cell-a (edmd): 10 s") for s in lines)
+    assert LOWER_BOUND_NOTE in lines
+
+
 def test_a_failed_case_does_not_stop_the_others_nor_the_analysis(toy, tmp_path, monkeypatch):
     bad = Study("toy", TOY.title, TOY.reference, TOY.summary,
                 lambda q: [Case("cell-a", "campbell1982/couette-rough", sections=SHORT),

@@ -8,9 +8,11 @@ impacts per particle per τ, τ_flight its inverse.
 
 :func:`run_pilot` runs the scene in the event-driven core (in this process, no results file)
 with every collision logged, in windows of ``PILOT_COLLISIONS`` pair collisions per
-particle, until two successive windows agree after ``MIN_TIME`` (the start-up transient is
-over: ``SETTLED``), the scene's own duration (equilibration + production), ``MAX_WINDOWS``
-windows or ``PILOT_SECONDS`` of wall time; the last window is the measurement. It adds the
+particle, until two successive windows agree after ``MIN_TIME`` (impact rates, q0.99 impact
+speeds and event rates: the start-up transient is over: ``SETTLED``), the scene's own
+duration (equilibration + production), ``MAX_WINDOWS`` windows or ``PILOT_SECONDS`` of wall
+time; the last window is the measurement (its collisions and cell crossings, and the whole
+pilot's, also go to the wall-time forecast). It adds the
 initial state's own impacts as a floor (the DESIGN_QUANTILE of the normal approach speeds of
 approaching neighbours and of particles towards a wall; a wall's own speed is tangential and
 does not count), so particles fired at each other are seen even when the pilot stops first.
@@ -60,7 +62,7 @@ SETTLED = 0.25
 MIN_TIME = 1.0
 #: at most this many windows (the wall-time cap usually comes first in large scenes)
 MAX_WINDOWS = 200
-PILOT_VERSION = 3  # part of the cache key: a changed pilot measures again
+PILOT_VERSION = 5  # part of the cache key: a changed pilot measures again
 
 
 class PilotWarning(UserWarning):
@@ -91,6 +93,16 @@ class PilotResult:
     events: int = 0
     stopped_by: str = ""
     n_particles: int = 0
+    # the last window's counts, for the forecast (forecast_events.pilot_rates): collisions
+    # (pair + wall), cell crossings, its duration (τ), and its event rate over the first
+    # window's (> 1: the flow sped up during the pilot)
+    window_collisions: int = 0
+    window_crossings: int = 0
+    window_time: float = 0.0
+    rate_growth: float = 1.0
+    #: collisions (pair + wall) over the whole pilot, t = 0 … simulated_time (the rest of
+    #: ``events`` are cell crossings)
+    total_collisions: int = 0
 
     @property
     def tau_flight(self) -> float:
@@ -243,6 +255,7 @@ def _advance(scene: Scene, backend, seconds: float, collisions: float) -> PilotR
     stopped_by = "the scene's duration"
     while True:
         t0, target = core.time, core.collisions + per_window
+        counts0 = _counts(core)
         pair, wall, reached = [], [], False
         while True:
             reached = backend.advance(t_end, min(core.collisions + chunk, target), over_time)
@@ -254,6 +267,9 @@ def _advance(scene: Scene, backend, seconds: float, collisions: float) -> PilotR
             if reached or core.collisions >= target or over_time():
                 break
         windows.append(_window(pair, wall, core.time - t0, n))
+        windows[-1].update({k: v - counts0[k] for k, v in _counts(core).items()})
+        windows[-1]["events_rate"] = (windows[-1]["events"] / (n * windows[-1]["duration"])
+                                      if windows[-1]["duration"] > 0 else 0.0)
         if reached:
             break
         if over_time():
@@ -280,7 +296,19 @@ def _advance(scene: Scene, backend, seconds: float, collisions: float) -> PilotR
         rate=impacts / (n * last["duration"]) if last["duration"] > 0 else 0.0,
         pair_collisions=len(pair_speeds), wall_collisions=len(wall_speeds),
         simulated_time=core.time, wall_seconds=time.perf_counter() - started,
-        events=int(core.events), stopped_by=stopped_by, n_particles=n)
+        events=int(core.events), stopped_by=stopped_by, n_particles=n,
+        window_collisions=int(last["pair_count"] + last["wall_count"]),
+        window_crossings=int(last["events"] - last["pair_count"] - last["wall_count"]),
+        window_time=float(last["duration"]),
+        total_collisions=int(core.collisions) + int(core.wall_collisions),
+        rate_growth=(last["events_rate"] / windows[0]["events_rate"]
+                     if windows[0]["events_rate"] > 0 else 1.0))
+
+
+def _counts(core) -> dict[str, int]:
+    """The core's cumulative event counters: every event, pair and wall collisions."""
+    return {"events": int(core.events), "pair_count": int(core.collisions),
+            "wall_count": int(core.wall_collisions)}
 
 
 def _window(pair: list, wall: list, duration: float, n: int) -> dict:
@@ -292,10 +320,14 @@ def _window(pair: list, wall: list, duration: float, n: int) -> dict:
 
 
 def _settled(a: dict, b: dict) -> bool:
-    """Two windows with impact rates and q0.99 impact speeds within ``SETTLED``."""
+    """Two windows with impact rates, q0.99 impact speeds and event rates within
+    ``SETTLED``."""
     def close(x: float, y: float) -> bool:
         return abs(x - y) <= SETTLED * max(abs(x), abs(y))
-    return close(a["rate"], b["rate"]) and close(a["speed"], b["speed"])
+    # the event rate too: a flow accelerating under gravity keeps its collision rate and
+    # impact speeds while its mean flow (and its cell crossings) still grow
+    return (close(a["rate"], b["rate"]) and close(a["speed"], b["speed"])
+            and close(a.get("events_rate", 0.0), b.get("events_rate", 0.0)))
 
 
 def _quantile(speeds: np.ndarray, q: float) -> float:

@@ -109,7 +109,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
     if backend.name in FORECAST_ENGINES:
         try:
             forecast = forecast_run(scene, backend, setup.timestep if setup else None,
-                                    pilot, costs, measure=not dry_run)
+                                    pilot, costs, measure=not dry_run, options=options)
         except RatesNotMeasured:
             pass  # said by describe(): no forecast
         except (RunStopped, RunAborted):  # Ctrl-C stopped a benchmark run: never a warning
@@ -118,11 +118,16 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     if (forecast is not None and pilot is None and not backend.capabilities.soft_contact
             and backend.name == "edmd" and scene.run.unit == "time"
-            and forecast.seconds > PILOT_WORTH):
-        # a long event-driven run: a pilot of ≤ 10 % of it measures the real collision rate
-        pilot = run_pilot(scene, seconds=min(PILOT_SECONDS, 0.1 * forecast.seconds))
+            and "finished run" not in forecast.basis
+            and (forecast.seconds > PILOT_WORTH or forecast.lower_bound)):
+        # a long event-driven run: a pilot of ≤ 10 % of it measures the real collision rate;
+        # a flow that gravity accelerates: Enskog knows nothing of its speed, a whole pilot
+        seconds = PILOT_SECONDS if forecast.lower_bound else min(PILOT_SECONDS,
+                                                                 0.1 * forecast.seconds)
+        pilot = run_pilot(scene, seconds=seconds)
         try:
-            forecast = forecast_run(scene, backend, None, pilot, costs, measure=not dry_run)
+            forecast = forecast_run(scene, backend, None, pilot, costs, measure=not dry_run,
+                                    options=options)
         except (RunStopped, RunAborted):
             raise _interrupted(backend.name) from None
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run

@@ -129,7 +129,7 @@ def forecast(tasks: Sequence[StudyTask], workers: int
     from ..api import run
     from ..errors import UnsupportedByEngine
 
-    seconds, lines, unknown, refused = {}, [], False, {}
+    seconds, lines, unknown, refused, lower = {}, [], False, {}, False
     for task in tasks:
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
@@ -145,9 +145,19 @@ def forecast(tasks: Sequence[StudyTask], workers: int
                          f"({plan.get('forecast', 'not measured')})")
             continue
         seconds[task.case.name] = float(s)
-        lines.append(f"  {task.case.name} ({task.case.engine}): {_duration(s)}")
+        bound = plan.get("forecast_kind") == "lower bound"
+        lower = lower or bound
+        lines.append(f"  {task.case.name} ({task.case.engine}): "
+                     f"{'at least ' if bound else ''}{_duration(s)}")
     total = makespan(list(seconds.values()), workers) if seconds else 0.0
+    if lower:  # the runs' lower bounds: the study takes longer, by how much is unknown
+        lines.append(LOWER_BOUND_NOTE)
     return (None if unknown else total), lines, refused, seconds
+
+
+#: under the list of runs when some forecast is a lower bound (the total then is one too)
+LOWER_BOUND_NOTE = ("  (at least: a flow that gravity accelerates outruns its pilot; "
+                    "docs/forecast.md)")
 
 
 def _duration(seconds: float) -> str:
@@ -190,7 +200,8 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         result.failed = list(refused)
         todo = [t for t in todo if t.case.name not in refused]
         where = "a Dask cluster" if dask is not None else f"{workers} worker(s)"
-        head = (f"forecast: {_duration(seconds)} on {where}" if seconds is not None
+        bound = "at least " if LOWER_BOUND_NOTE in lines else ""
+        head = (f"forecast: {bound}{_duration(seconds)} on {where}" if seconds is not None
                 else "forecast: unknown for some runs (listed)")
         echo(head + (" (measured speed of this machine; docs/forecast.md)"))
         for line in lines:
