@@ -90,6 +90,10 @@ RATES_FILE = "machine-rates.json"
 MEASURE_ENV = "DEMSTUDY_MEASURE_RATES"
 
 
+class NoForecast(ValueError):
+    """The run's cost cannot be known before it starts (the reason is the message)."""
+
+
 class RatesNotMeasured(LookupError):
     """The machine's costs are not cached and measuring them now is forbidden."""
 
@@ -108,6 +112,8 @@ class Forecast:
     factor: float = ACCURACY["factor"]
     #: why the run will take longer than ``seconds`` ('' : an estimate within ``factor``)
     lower_bound: str = ""
+    #: the runs ``factor`` was measured on
+    accuracy_met: str = ACCURACY["met"]
 
     @property
     def kind(self) -> str:
@@ -118,7 +124,7 @@ class Forecast:
             return (f"forecast: at least {_duration(self.seconds)} (a lower bound: "
                     f"{self.lower_bound}) from {self.basis}")
         return (f"forecast: {_duration(self.seconds)} (measured accuracy: within "
-                f"×{self.factor:g} in {ACCURACY['met']}) from {self.basis}")
+                f"×{self.factor:g} in {self.accuracy_met}) from {self.basis}")
 
     def attrs(self) -> dict[str, Any]:
         return {"forecast_seconds": self.seconds, "forecast_basis": self.basis,
@@ -267,6 +273,10 @@ def _benchmark_scene(dim: int, n: int, phi: float, duration: float, interval: fl
 def _benchmark(engine: str, dim: int, model: str | None) -> tuple[dict[str, float], str]:
     """Run the benchmark cases and fit the costs (non-negative least squares, relative
     residuals: every case weighs the same)."""
+    if engine == "lgd":  # lattice runs: node-updates and samples (its own benchmark)
+        from ..engines.lgd.forecast import benchmark
+
+        return benchmark()
     import numpy as np
     from scipy.optimize import nnls
 
@@ -456,6 +466,8 @@ def forecast_run(scene: Scene, backend: Any, timestep: float | None = None,
     (measured now if not cached, unless ``measure`` is False: ``RatesNotMeasured``).
     ``options`` (``RunOptions``): the kept frames, the checkpoints and the results file,
     whose folder may hold a finished run of the same scene family."""
+    if backend.name == "lgd":
+        return _lattice_forecast(scene, costs, measure)
     model = scene.soft.model if backend.capabilities.soft_contact else None
     key = rate_key(backend.name, scene.dimension, model)
     where = key if costs is None else "given costs"
@@ -481,6 +493,27 @@ def forecast_run(scene: Scene, backend: Any, timestep: float | None = None,
         where += _load_note(key)
     return Forecast(seconds, f"{basis}{extra_basis}; costs of {where}",
                     lower_bound=lower_bound)
+
+
+def _lattice_forecast(scene: Scene, costs: dict[str, float] | None,
+                      measure: bool) -> Forecast:
+    """A lattice run's forecast (:mod:`demstudy.engines.lgd.forecast`): its node-updates and
+    samples at this machine's measured costs; ``NoForecast`` for a run counted in time."""
+    from ..engines.lgd import forecast as lattice
+
+    count = lattice.counts(scene)
+    if count is None:
+        raise NoForecast("a lattice run counted in time takes as many steps as its peak "
+                         "speed dictates (unknown in advance): count it in steps "
+                         "(run.unit = \"steps\") for a forecast")
+    key = rate_key("lgd", scene.dimension)
+    where = key if costs is None else "given costs"
+    if costs is None:
+        costs = measure_costs("lgd", scene.dimension, measure=measure)
+        where += _load_note(key)
+    return Forecast(lattice.seconds(costs, count),
+                    f"{lattice.forecast_basis(scene)}; costs of {where}",
+                    factor=lattice.ACCURACY["factor"], accuracy_met=lattice.ACCURACY["met"])
 
 
 def scene_costs(scene: Scene, options: Any = None

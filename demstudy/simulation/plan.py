@@ -18,7 +18,7 @@ from ..contact.pilot import PILOT_SECONDS, PilotResult, run_pilot
 from ..contact.stiffness import ContactSetup, contact_setup
 from ..errors import RunAborted, RunStopped
 from ..scene import Scene
-from .forecast import Forecast, RatesNotMeasured, forecast_run
+from .forecast import Forecast, NoForecast, RatesNotMeasured, forecast_run
 from .options import RunOptions
 
 __all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
@@ -28,7 +28,7 @@ __all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
 PILOT_WORTH = 20.0
 
 #: engines with a benchmark (``forecast.measure_rate``): the others get no forecast
-FORECAST_ENGINES = ("lammps", "edmd", "liggghts")
+FORECAST_ENGINES = ("lammps", "edmd", "liggghts", "lgd")
 
 
 @dataclass(frozen=True)
@@ -41,6 +41,7 @@ class RunPlan:
     setup: ContactSetup | None
     pilot: PilotResult | None
     forecast: Forecast | None
+    no_forecast: str = ""  # why there is none, when the run's cost is unknowable in advance
 
     def as_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"engine": self.engine, "n_particles": self.n_particles}
@@ -62,6 +63,8 @@ class RunPlan:
         return out
 
     def _no_forecast(self) -> str:
+        if self.no_forecast:
+            return f"none: {self.no_forecast}"
         if self.engine in FORECAST_ENGINES:
             return "none (this machine's speed is not measured yet: demstudy forecast)"
         return f"none for the {self.engine} engine"
@@ -105,13 +108,15 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
     setup = None
     if backend.capabilities.soft_contact:
         setup = contact_setup(scene, backend.name, pilot)
-    forecast = None
+    forecast, no_forecast = None, ""
     if backend.name in FORECAST_ENGINES:
         try:
             forecast = forecast_run(scene, backend, setup.timestep if setup else None,
                                     pilot, costs, measure=not dry_run, options=options)
         except RatesNotMeasured:
             pass  # said by describe(): no forecast
+        except NoForecast as exc:
+            no_forecast = str(exc)
         except (RunStopped, RunAborted):  # Ctrl-C stopped a benchmark run: never a warning
             raise _interrupted(backend.name) from None
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
@@ -133,7 +138,7 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     n = scene.n_particles
-    return RunPlan(backend.name, n, setup, pilot, forecast)
+    return RunPlan(backend.name, n, setup, pilot, forecast, no_forecast)
 
 
 def _interrupted(engine: str) -> RunAborted:
