@@ -11,6 +11,7 @@ array column c = G − 1 (Gutt's 1-based global row R and storage column G).
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from demstudy.engines.lgd import core
@@ -103,3 +104,36 @@ def test_discharge_count_uses_the_user_column_and_needs_extra_walls(impl):
     lat.mlp[3, 0] = WALL  # one extra wall particle at (G, R) = (1, 4), touching no grain
     log = core.run_steps(lat, par, 1, impl=impl)
     assert log["nq"][0] == len(counted)
+
+
+@pytest.mark.parametrize("impl", core.IMPLEMENTATIONS)
+def test_step_commutes_with_a_shift_by_six_columns_only(impl):
+    """Move templates repeat every 3 columns and collision templates every 2, and columns
+    are periodic: shifting a state by 6 columns shifts its whole future by 6 (so a layout
+    uniform along x stays 6-column periodic for ever: docs/lgd-review.md). A shift by 2 or 3
+    changes which template a grain is in, and the future with it."""
+    rng = np.random.default_rng(3)
+    lat, _ = box(24, 10)
+    inner = lat.mlp[1:-1]
+    inner[rng.random(inner.shape) < 0.45] = MOVABLE
+    inner[rng.random(inner.shape) < 0.03] = WALL
+    m = lat.mlp == MOVABLE
+    lat.ivx[m], lat.ivy[m] = rng.integers(-2000, 2001, (2, int(m.sum())))
+    lat.ipx[m], lat.ipy[m] = rng.integers(-3000, 3001, (2, int(m.sum())))
+    lat.ivx[0], lat.ivx[-1] = -500, 700
+    par = LgdParams(nxt=24, nyt=10, jx1=-500, jx2=700, iep1=12, iep2=15, iew1=12, iew2=15,
+                    icb=724)
+    fields = ("mlp", "ipx", "ipy", "ivx", "ivy")
+
+    def run(shift: int) -> tuple[Lattice, dict]:
+        moved = Lattice(**{k: np.roll(getattr(lat, k), shift, axis=1) for k in
+                           (*fields, "nlp")})
+        return moved, core.run_steps(core.prepare(moved, par), par, 200, impl=impl)
+
+    (a, la), (b, lb) = run(0), run(6)
+    for k in fields:
+        assert (np.roll(getattr(a, k), 6, axis=1) == getattr(b, k)).all(), k
+    assert all((la[k] == lb[k]).all() for k in la if k != "nq")  # nq: user columns move
+    for shift in (2, 3):
+        c, _ = run(shift)
+        assert not (np.roll(a.ivx, shift, axis=1) == c.ivx).all()
