@@ -15,9 +15,9 @@ from __future__ import annotations
 
 from ..base import Study
 from ..parts import combined_analysis, combined_cases
-from . import couette, theory
+from . import couette, lgd, theory
 
-PARTS = (theory, couette)
+PARTS = (theory, couette, lgd)
 
 STUDY = Study(
     name="gutt1989",

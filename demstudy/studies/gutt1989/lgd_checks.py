@@ -1,0 +1,4 @@
+"""placeholder"""
+from ..base import Analysis
+def analyse(runs, out, quick):
+    return Analysis()
