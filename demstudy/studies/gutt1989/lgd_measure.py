@@ -281,3 +281,20 @@ def interval_mean(t: np.ndarray, y: np.ndarray, t0: float, blocks: int = 8
     parts = np.array_split(v, blocks)
     means = np.array([q.mean() for q in parts])
     return float(v.mean()), float(means.std(ddof=1) / math.sqrt(blocks))
+
+
+def nodes_of(pos: np.ndarray, nxt: int) -> np.ndarray:
+    """The storage node (row·nxt + column) of each grain (offsets < ½ spacing)."""
+    r = rows_of(pos[:, 1])
+    c = np.rint(pos[:, 0] - 1 - r / 2).astype(int) % nxt
+    return r * nxt + c
+
+
+def occupancy_overlap(pos_a: np.ndarray, pos_b: np.ndarray, nxt: int) -> float:
+    """Share of the nodes occupied in either frame that are occupied in both (Jaccard): 1
+    for a pile whose grains stay on their nodes; the LGD grains keep velocities where a
+    full neighbour site blocks their move (static load is carried by repeated gravity
+    kicks, digest §5.8), so resting is read from the nodes, not from the velocities."""
+    a, b = set(nodes_of(pos_a, nxt).tolist()), set(nodes_of(pos_b, nxt).tolist())
+    union = a | b
+    return len(a & b) / len(union) if union else math.nan
