@@ -284,8 +284,9 @@ def _thermal_peak(ref: str, profs: Mapping[str, dict], runs: Mapping[str, m.LgdR
         REPRODUCED if peaked else PARTLY,
         "" if peaked else "higher at the centre but within 2σ: only the grain rows touching "
         "the walls are clearly cooler; " + "; ".join(why) + f". A single frame's row values "
-        f"have a standard error of ±{scatter:.3f} U (median), enough to show a dip by chance; the assumed layout (every other row "
-        "full) is dilute, which flattens the profile")
+        f"have a standard error of ±{scatter:.3f} U (median), enough to show a dip by "
+        "chance; the assumed layout (every other row full) is dilute, which flattens the "
+        "profile")
 
 
 def _scaling(ref: str, a: m.LgdRun, b: m.LgdRun) -> Check:
