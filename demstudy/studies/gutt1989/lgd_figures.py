@@ -22,18 +22,25 @@ import numpy as np  # noqa: E402
 from ..base import Figure  # noqa: E402
 from .lgd_measure import ROW, LgdRun  # noqa: E402
 
-NOTE = ("LGD (--engine lgd); d = 1 (lattice spacing), m = 1; g = 1 with gravity, otherwise "
+NOTE = ("LGD (--engine lgd); d = 1 (lattice spacing), m = 1;\ng = 1 with gravity, otherwise "
         "the scene's speed unit (wall or initial speed) = 1")
 
 
 def _save(fig, out: Path, name: str, caption: str) -> Figure:
     fig.text(0.5, 0.005, NOTE, ha="center", va="bottom", fontsize=7)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
     out.mkdir(parents=True, exist_ok=True)
     path = out / name
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return Figure(path, caption)
+
+
+def _legend_room(ax) -> None:
+    """Room above the data for a one-row legend (legends stay off the curves)."""
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 0.3 * (hi - lo))
+    ax.legend(fontsize=7, loc="upper center", ncol=3)
 
 
 def _positions(ax, run: LgdRun, frame: int, walls: np.ndarray | None, title: str) -> None:
@@ -64,8 +71,12 @@ def positions(runs: Sequence[tuple[LgdRun, int, np.ndarray | None, str]], out: P
 def profiles(panels: Sequence[tuple[dict, str]], out: Path, name: str, caption: str,
              speed_label: str = "velocity (speed unit)") -> Figure:
     """Row profiles: v̄x red, v̄y green, thermal velocity blue, against y; error bars."""
-    fig, axes = plt.subplots(1, len(panels), figsize=(4.3 * len(panels), 3.6), squeeze=False)
-    for ax, (p, title) in zip(axes[0], panels, strict=False):
+    cols = min(3, len(panels))
+    rows = -(-len(panels) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.6 * rows), squeeze=False)
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    for ax, (p, title) in zip(axes.flat, panels, strict=False):
         for key, colour, label in (("vx", "r", "v̄x"), ("vy", "g", "v̄y"),
                                    ("thermal", "b", "thermal")):
             ok = np.isfinite(p[key])
@@ -76,13 +87,13 @@ def profiles(panels: Sequence[tuple[dict, str]], out: Path, name: str, caption: 
         ax.set_xlabel("y (d)")
         ax.set_ylabel(speed_label)
         ax.set_title(title, fontsize=9)
-        ax.legend(fontsize=7, loc="best")
+        _legend_room(ax)
     return _save(fig, out, name, caption)
 
 
 def wall_stress(panels: Sequence[tuple[LgdRun, str]], out: Path, name: str, caption: str,
-                scale: Sequence[float] | None = None, ylabel: str = "per wall particle"
-                ) -> Figure:
+                scale: Sequence[float] | None = None, ylabel: str = "per wall particle",
+                xlabel: str = "time (d/U)") -> Figure:
     """Curves 1-4: bottom shear, bottom pressure, top shear, top pressure per wall particle
     per unit time against time (the thesis's fig 3.22 / 3.36)."""
     fig, axes = plt.subplots(1, len(panels), figsize=(4.6 * len(panels), 3.5), squeeze=False)
@@ -94,10 +105,12 @@ def wall_stress(panels: Sequence[tuple[LgdRun, str]], out: Path, name: str, capt
                                     ("wall_shear_upper", 1, "3 top shear"),
                                     ("wall_normal_upper", 1, "4 top pressure")):
             ax.plot(t, sign * ts[series] * f, lw=0.9, label=label)
-        ax.set_xlabel("time (time units)")
+        ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
         ax.set_title(title, fontsize=9)
-        ax.legend(fontsize=7, loc="best")
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + 0.35 * (hi - lo))
+        ax.legend(fontsize=7, loc="upper center", ncol=2)
     return _save(fig, out, name, caption)
 
 
@@ -139,7 +152,9 @@ def arrows(blocks: dict, run: LgdRun, out: Path, name: str, caption: str,
         th = np.where(ok, blocks["thermal"], np.nan)
         mesh = ax.pcolormesh(blocks["x"], blocks["y"], th, shading="nearest", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label="thermal velocity (√(g d))", shrink=0.8)
-    ax.quiver(gx[ok], gy[ok], blocks["vx"][ok], blocks["vy"][ok], angles="xy",
+    # on a stretched channel (background) the arrows keep the velocity's own direction on
+    # screen ("uv"); on an equal-aspect map that is the same as the data's direction
+    ax.quiver(gx[ok], gy[ok], blocks["vx"][ok], blocks["vy"][ok], angles="uv",
               color="w" if background else "k", width=0.002)
     if centre is not None:
         ax.plot(*centre, "r+", ms=10)
