@@ -13,6 +13,7 @@ y = r·√3/2, a grain's offset is less than half a spacing, so its row is round
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -115,6 +116,13 @@ def mean_profiles(run: LgdRun, frames: np.ndarray) -> dict[str, np.ndarray]:
     when there are several (frames are correlated: a lower bound), else the single frame's."""
     profs = [row_profiles(run.position[i], run.velocity[i], run.nyt) for i in frames]
     out = {"y": profs[0]["y"]}
+    with warnings.catch_warnings():  # rows without grains (the wall rows) stay NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        _average(profs, out)
+    return out
+
+
+def _average(profs: list[dict], out: dict) -> None:
     for key in ("n", "vx", "vy", "thermal", "density"):
         stack = np.array([p[key] for p in profs])
         out[key] = np.nanmean(stack, axis=0) if len(profs) > 1 else stack[0]
@@ -123,7 +131,6 @@ def mean_profiles(run: LgdRun, frames: np.ndarray) -> dict[str, np.ndarray]:
                 out[key + "_err"] = np.nanstd(stack, axis=0, ddof=1) / math.sqrt(len(profs))
             elif key + "_err" in profs[0]:
                 out[key + "_err"] = profs[0][key + "_err"]
-    return out
 
 
 def block_average(pos: np.ndarray, vel: np.ndarray, nxt: int, nyt: int, mvx: int,
@@ -145,7 +152,7 @@ def block_average(pos: np.ndarray, vel: np.ndarray, nxt: int, nyt: int, mvx: int
         v2 = np.bincount(flat, (v ** 2).sum(1), size) / n
         th = np.sqrt(np.maximum(v2 - vx ** 2 - vy ** 2, 0))
     cx = (np.arange(nbx) + 0.5) * mvx
-    cy = (1 + (np.arange(nby) + 0.5) * mvy) * ROW
+    cy = (1 + np.arange(nby) * mvy + (mvy - 1) / 2) * ROW  # the block's middle row
     shape = (nby, nbx)
     return {"n": n.reshape(shape), "vx": vx.reshape(shape), "vy": vy.reshape(shape),
             "thermal": th.reshape(shape), "x": cx, "y": cy}
