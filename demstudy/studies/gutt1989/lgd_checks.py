@@ -285,7 +285,8 @@ def _thermal_peak(ref: str, profs: Mapping[str, dict], runs: Mapping[str, m.LgdR
         "diagnostics — " + "; ".join(diag),
         REPRODUCED if peaked else PARTLY,
         "" if peaked else "higher at the centre but within 2σ: only the grain rows touching "
-        "the walls are clearly cooler; " + "; ".join(why) + f". One frame's interior rows scatter "
+        "the walls are clearly cooler" + "".join("; " + w for w in why) + f". One frame's "
+        f"interior rows scatter "
         f"by ±{scatter:.3f} U (r.m.s.), enough to show a dip by chance; the assumed "
         "layout (every other row full) is dilute, which flattens the "
         "profile")
