@@ -134,7 +134,11 @@ def explosion(run: m.LgdRun | None, out: Path, an: Analysis) -> None:
         f"front radius (98th percentile of the moving grains' distance, 72 sectors) "
         f"{front['mean']:.1f} d, r.m.s. over angle {100 * front['rel_rms']:.1f} % "
         f"(threshold {100 * CIRCULAR:.0f} %); Fourier |a4|/a0 = {front['a4']:.3f} (square "
-        f"block), |a6|/a0 = {front['a6']:.4f} (lattice directions)",
+        f"block), |a6|/a0 = {front['a6']:.4f} (lattice directions); the largest is "
+        f"|a2|/a0 = {front['a2']:.3f}, longest along {front['a2_angle']:.0f}° (the box is "
+        f"{run.nxt} × {(run.nyt - 1) * m.ROW:.0f} d, the front "
+        f"{min(centre[1], (run.nyt - 1) * m.ROW - centre[1]) - front['mean']:.0f} d from the "
+        "top and bottom walls)",
         REPRODUCED if circ else NOT_REPRODUCED,
         "" if circ else "the front is not round within the threshold"))
     radial = align["within30"] >= RADIAL

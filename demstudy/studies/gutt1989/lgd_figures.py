@@ -60,7 +60,10 @@ def positions(runs: Sequence[tuple[LgdRun, int, np.ndarray | None, str]], out: P
               name: str, caption: str, cols: int = 2) -> Figure:
     """A panel of grain positions per (run, frame index, wall nodes, title); walls red."""
     rows = -(-len(runs) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 3.0 * rows), squeeze=False)
+    first = runs[0][0]
+    aspect = (first.nyt - 1) * ROW / first.nxt  # panels as tall as the lattice, plus labels
+    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, (5.2 * aspect + 1.2) * rows),
+                             squeeze=False)
     for ax, (run, frame, walls, title) in zip(axes.flat, runs, strict=False):
         _positions(ax, run, frame, walls, title)
     for ax in list(axes.flat)[len(runs):]:
@@ -93,7 +96,8 @@ def profiles(panels: Sequence[tuple[dict, str]], out: Path, name: str, caption: 
 
 def wall_stress(panels: Sequence[tuple[LgdRun, str]], out: Path, name: str, caption: str,
                 scale: Sequence[float] | None = None, ylabel: str = "per wall particle",
-                xlabel: str = "time (d/U)") -> Figure:
+                xlabel: str = "time (d/U)", reference: float | None = None,
+                reference_label: str = "") -> Figure:
     """Curves 1-4: bottom shear, bottom pressure, top shear, top pressure per wall particle
     per unit time against time (the thesis's fig 3.22 / 3.36)."""
     fig, axes = plt.subplots(1, len(panels), figsize=(4.6 * len(panels), 3.5), squeeze=False)
@@ -105,6 +109,8 @@ def wall_stress(panels: Sequence[tuple[LgdRun, str]], out: Path, name: str, capt
                                     ("wall_shear_upper", 1, "3 top shear"),
                                     ("wall_normal_upper", 1, "4 top pressure")):
             ax.plot(t, sign * ts[series] * f, lw=0.9, label=label)
+        if reference is not None:
+            ax.axhline(reference, color="k", ls="--", lw=1, label=reference_label)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
         ax.set_title(title, fontsize=9)

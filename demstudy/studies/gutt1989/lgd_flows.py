@@ -388,5 +388,6 @@ def _poiseuille_run(run: m.LgdRun, label: str, ref: str, sts, out: Path, an: Ana
     an.figures.append(figs.wall_stress(
         [(run, f"Poiseuille {label}")], out, f"lgd_poiseuille_{tag}_wall_stress.png",
         f"Poiseuille {label} (fig 3.36): shear (1, 3) and pressure (2, 4) per wall particle per "
-        "unit time against time, in m g", ylabel="per wall particle (m g)",
-        xlabel="time (√(d/g))"))
+        "unit time against time, in m g; dashed: the steady wall shear g·N/N_wall",
+        ylabel="per wall particle (m g)", xlabel="time (√(d/g))", reference=expected,
+        reference_label=f"g·N/N_wall = {expected:.1f}"))

@@ -192,8 +192,8 @@ def explosion_front(pos: np.ndarray, vel: np.ndarray, centre: tuple[float, float
                     sectors: int = 72, quantile: float = 0.98) -> dict[str, np.ndarray | float]:
     """The front radius per angular sector: the ``quantile`` of the distances of the moving
     grains (the background starts at rest, so a moving grain has been reached by the blast).
-    Anisotropy: relative r.m.s. of R(θ) and the Fourier amplitudes |a_k|/a_0 for k = 4 (the
-    square block) and 6 (the lattice's directions)."""
+    Anisotropy: relative r.m.s. of R(θ) and the Fourier amplitudes |a_k|/a_0 for k = 2 (an
+    elongation), 4 (the square block) and 6 (the lattice's directions)."""
     moving = np.hypot(vel[:, 0], vel[:, 1]) > 0
     d = pos[moving] - np.asarray(centre)
     radius = np.hypot(d[:, 0], d[:, 1])
@@ -204,9 +204,13 @@ def explosion_front(pos: np.ndarray, vel: np.ndarray, centre: tuple[float, float
     angles = -math.pi + (np.arange(sectors) + 0.5) * 2 * math.pi / sectors
     ok = np.isfinite(front)
     a0 = front[ok].mean()
-    amp = {k: abs(np.mean(front[ok] * np.exp(-1j * k * angles[ok]))) * 2 / a0 for k in (4, 6)}
+    coef = {k: np.mean(front[ok] * np.exp(-1j * k * angles[ok])) for k in (2, 4, 6)}
+    amp = {k: abs(c) * 2 / a0 for k, c in coef.items()}
     return {"theta": angles, "front": front, "mean": float(a0),
-            "rel_rms": float(front[ok].std() / a0), "a4": float(amp[4]), "a6": float(amp[6])}
+            "rel_rms": float(front[ok].std() / a0), "a2": float(amp[2]), "a4": float(amp[4]),
+            "a6": float(amp[6]),
+            # direction of the longest axis of the k = 2 (elliptic) part, in degrees
+            "a2_angle": float(np.degrees(np.angle(coef[2]) / 2))}
 
 
 def radial_alignment(blocks: dict[str, np.ndarray], centre: tuple[float, float],
