@@ -143,3 +143,18 @@ def test_tiny_lgd_couette_balances_momentum_and_analyses(tmp_path):
     assert an.checks[0].verdict == REPRODUCED  # the code test
     assert NOT_RUN in verdicts.values()  # the gas, explosion, ... were not run
     assert all(f.path.exists() for f in an.figures)
+
+
+def _fake_run(pos: np.ndarray, vel: np.ndarray, nxt: int) -> m.LgdRun:
+    return m.LgdRun("fake", {}, {}, pos[None], vel[None], np.array([100]), nxt, 12)
+
+
+def test_periodic_copy_is_recognised_and_a_perturbed_copy_is_not():
+    pos = _lattice_grains(12, 12, every=2)
+    vel = RNG.normal(size=pos.shape)
+    tiled = np.concatenate([pos + [12.0 * k, 0.0] for k in range(4)])
+    tiled_v = np.tile(vel, (4, 1))
+    small, full = _fake_run(pos, vel, 12), _fake_run(tiled, tiled_v, 48)
+    assert m.same_as_periodic_copy(small, full, 100) == 0.0
+    tiled_v[3] += 0.5  # a grain in the first period moves differently
+    assert m.same_as_periodic_copy(small, _fake_run(tiled, tiled_v, 48), 100) == 0.5

@@ -83,8 +83,8 @@ def all_cases() -> list[Case]:
         _case("incline", "incline", INCLINE_STEPS, 96, window=768, quick=(1536, 96, 768)),
         _case("poiseuille-small", "poiseuille-small", POISEUILLE_STEPS, 48, window=480,
               quick=(1536, 48, 480), group="poiseuille"),
-        # the thesis's 508 032 grains (≈ 1.9e10 node-updates: ~10 min at the native core's
-        # measured 4e7 node-updates/s, docs/benchmarks.md); full study only
+        # the thesis's 508 032 grains (≈ 1.9e10 node-updates; the engine has no forecast:
+        # 334 s on the 2-core VM, 2026-12-02, ≈ 5.7e7 node-updates/s); full study only
         _case("poiseuille-thesis", "poiseuille-thesis", POISEUILLE_STEPS, 96, window=192,
               group="poiseuille"),
     ]

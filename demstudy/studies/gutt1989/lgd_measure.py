@@ -309,3 +309,19 @@ def occupancy_overlap(pos_a: np.ndarray, pos_b: np.ndarray, nxt: int) -> float:
     a, b = set(nodes_of(pos_a, nxt).tolist()), set(nodes_of(pos_b, nxt).tolist())
     union = a | b
     return len(a & b) / len(union) if union else math.nan
+
+
+def same_as_periodic_copy(small: LgdRun, full: LgdRun, step: int) -> float:
+    """Largest difference in position or velocity between ``small``'s frame at ``step`` and
+    ``full``'s grains in its first ``small.nxt`` columns (NaN if their counts differ): 0 when
+    the long channel is an exact periodic copy of the short one (a uniform start and the
+    deterministic, translation-invariant integer step keep every period of the templates
+    identical)."""
+    pa, va = small.position[small.frame_at(step)], small.velocity[small.frame_at(step)]
+    ib = full.frame_at(step)
+    sel = full.position[ib][:, 0] < small.nxt
+    pb, vb = full.position[ib][sel], full.velocity[ib][sel]
+    if len(pa) != len(pb):
+        return math.nan
+    ka, kb = np.lexsort((pa[:, 0], pa[:, 1])), np.lexsort((pb[:, 0], pb[:, 1]))
+    return float(max(np.abs(pa[ka] - pb[kb]).max(), np.abs(va[ka] - vb[kb]).max()))
