@@ -277,7 +277,7 @@ def _thermal_peak(ref: str, profs: Mapping[str, dict], runs: Mapping[str, m.LgdR
                            f"{dc:.2f}), so the wall COR sets the level, not the shape")
             if name.endswith("dense"):
                 n_dense = runs[name].position.shape[1]
-                why.append(f"a denser channel (¾ of the rows full: {n_dense} grains instead "
+                why.append(f"a denser channel (random fill at density ¾: {n_dense} grains instead "
                            f"of the thesis's 5760) gives {dsig:+.1f}σ" + (
                                ": the mid-channel peak appears once the channel is more "
                                "collisional than N = 5760 makes it with the assumed layout"
