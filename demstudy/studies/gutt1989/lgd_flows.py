@@ -322,7 +322,7 @@ def poiseuille(small: m.LgdRun | None, full: m.LgdRun | None, out: Path, an: Ana
                  "times as many independent grains")
         what = (f"differ from the 504-column run's by at most {diff:.3g} (positions in d, "
                 "velocities in √(gd))" if math.isfinite(diff) else
-                "are not even as many as the 504-column run's")
+                "hold a different number of grains than the 504-column run")
         text = (f"At step {last} the 8064-column run's grains in its first 504 columns {what}: "
                 + (same if diff == 0 else other) + ".")
         an.sections.append(("LGD Poiseuille: the thesis size and the 1/16 channel", text))
