@@ -43,16 +43,24 @@ def walls(e: float, e_name: str, velocities=(0.0, 0.0)) -> str:
     return out
 
 
+def fill(x1, y1, x2, y2, density) -> str:
+    """A ``[[lattice.fill]]`` table: a seeded random fill at ``density`` of the rectangle,
+    at rest, seeded by run.seed (demstudy's extension of Gutt's md lines)."""
+    return (f"\n[[lattice.fill]]   # seeded random fill (run.seed): density {density} of "
+            f"rows {y1}-{y2}, columns {x1}-{x2}\nx1 = {x1}\ny1 = {y1}\nx2 = {x2}\ny2 = {y2}\n"
+            f"density = {density}\n")
+
+
 def scene(name: str, header: str, meta: str, body: str, lattice: str, lines: list[str],
-          run: str) -> str:
+          run: str, fills: str = "") -> str:
     nxt, nyt = (int(v.split("=")[1].split("#")[0]) for v in lattice.splitlines()[:2])
     box = (f"\n[box]   # the lattice: [nxt, (nyt − 1)·√3/2], wall-row centre to centre\n"
            f"size = [{float(nxt)!r}, {(nyt - 1) * ROW!r}]\n")
     return (header + "\ndimension = 2\n\n[meta]\n" + f'name = "gutt1989-{name}"\n' + meta +
             box + "\n[particles]   # the grains are the lattice's (md lines)\n\n" + body +
             "\n" + run + '\n[measure]\nbin_width = 0.8660254037844386   # one lattice row '
-                         '(√3/2) per bin\n\n[lattice]\n' + lattice + "initial = [\n" +
-            "\n".join(lines) + "\n]\n")
+                         '(√3/2) per bin\n\n[lattice]\n' + lattice +
+            ("initial = [\n" + "\n".join(lines) + "\n]\n" if lines else "") + fills)
 
 
 def run_table(steps: int, every: int) -> str:
@@ -125,8 +133,11 @@ def explosion() -> str:
         "speed unit\n", lines, run_table(128, 16))
 
 
+# Why random fills (Couette, Poiseuille): a layout uniform along x (e.g. every other row
+# full) stays 6-column periodic for ever under the deterministic integer step (the templates
+# repeat every 6 columns: tests/test_lgd_listing_order.py), so a long lattice would only be
+# copies of a 6-column one; a seeded random fill at the same density breaks that.
 def couette(name: str, e_pp: float, e_pw: float, speed: int, what: str) -> str:
-    lines = [line(2, 1, iy, 192, iy) for iy in range(2, 62, 2)]  # every other row full
     return scene(
         name,
         "# Gutt (1989) §3 (L1069–L1079, figs 3.20–3.23): gravity-free Couette flow between "
@@ -134,13 +145,14 @@ def couette(name: str, e_pp: float, e_pw: float, speed: int, what: str) -> str:
         "(5760 = ½·60·192, so\n# nyt = 62: 60 open rows + 2 wall rows, derived), 1024 "
         "steps.\n# " + what + "\n" + HEADER_UNITS["wall"],
         f'description = "Couette flow, e_pp = {e_pp}, e_pw = {e_pw}, walls at -+{speed} '
-        '(the listing\'s integers; +-1 in particle units); ASSUMED layout: grains at rest on '
-        'every other row (density 1/2; figure 3.20 missing)"\n'
+        '(the listing\'s integers; +-1 in particle units); ASSUMED layout: seeded random fill '
+        '(figure missing): 5760 grains at rest on half the nodes of the 60 open rows '
+        '(density 1/2, figure 3.20), drawn with run.seed"\n'
         'reference = "Gutt (1989), Ch. 3, L1069-L1079, figs 3.20-3.23"\n',
         f"[contact]\nrestitution = {e_pp}\n" +
         walls(e_pw, "e_pw", (-1.0, 1.0)),
         f"nxt = 192\nnyt = 62\nspeed_scale = {float(speed)}   # the wall speed in the "
-        "listing's integers\n", lines, run_table(1024, 32))
+        "listing's integers\n", [], run_table(1024, 32), fill(1, 2, 192, 61, 0.5))
 
 
 def hourglass() -> str:
@@ -243,8 +255,7 @@ def incline() -> str:
 
 
 def poiseuille(nxt: int, name: str, note: str) -> str:
-    lines = [line(2, 1, iy, nxt, iy) for iy in range(2, 127, 2)]  # density ½: 63 full rows
-    grains = 63 * nxt
+    grains = 63 * nxt  # density ½ of the 126 open rows
     return scene(
         name,
         "# Gutt (1989) §3 (L1117–L1127, figs 3.35–3.36): gravity-driven Poiseuille flow "
@@ -254,13 +265,14 @@ def poiseuille(nxt: int, name: str, note: str) -> str:
         "g·N/N_wall (= 252 for the full run), ≈150 reached.\n" + note +
         HEADER_UNITS["gravity"],
         f'description = "Poiseuille flow, nxt = {nxt}, {grains} grains; ASSUMED layout: '
-        'every other row full (density 1/2), at rest (figure missing)"\n'
+        'seeded random fill (figure missing): half the nodes of the 126 open rows '
+        '(density 1/2), at rest, drawn with run.seed"\n'
         'reference = "Gutt (1989), Ch. 3, L1117-L1127, figs 3.35-3.36"\n',
         "[contact]   # velocity-independent (L1119)\nrestitution = 0.9375\n" +
         walls(0.75, "e_pw") + "\n[gravity]   # g = 8 along +x (L1119): gravity_scale\n"
                               "direction = [1.0, 0.0]\n",
         f"nxt = {nxt}\nnyt = 128\ngravity_scale = 8.0   # the thesis's g = 8 (L1119)\n",
-        lines, run_table(18432, 48))
+        [], run_table(18432, 48), fill(1, 2, nxt, 127, 0.5))
 
 
 def main() -> None:

@@ -14,10 +14,11 @@ peak. This script separates the three things that matter:
 * the definition: "pooled" is the profiles analysis's (each row's fluctuations about the
   window's mean of that row, i.e. √(2T)); "instant" is Gutt's av3 per row and per sample,
   √(⟨v²⟩ − ⟨vx⟩² − ⟨vy⟩²) over the grains of the row, averaged over the window's samples;
-* the layout: the preset's grains fill every other row uniformly along x, so the lattice is
-  periodic with period 6 columns and stays so (tests/test_lgd_listing_order.py): 32 copies of
-  a 6-column system, whose rows hold a few independent grains. "random" puts the same number
-  of grains at rest on random open nodes (seeded; an assumption, like the preset's layout).
+* the layout: "uniform" is the presets' former layout, every other row full uniformly along
+  x, so the lattice is periodic with period 6 columns and stays so
+  (tests/test_lgd_listing_order.py): 32 copies of a 6-column system, whose rows hold a few
+  independent grains. "random" is the preset's layout since: the same number of grains at
+  rest on open nodes drawn by its seeded random fill ([[lattice.fill]]; an assumption too).
 
 Run: ``python analysis/lgd_couette_rows.py [--png docs/figures/lgd-couette-rows.png]``
 (about 15 s); it prints the profiles in 10 bins of 6 rows, bottom to top.
@@ -43,16 +44,16 @@ WINDOWS = {"32-1024 (preset)": (32, 1024), "544-1024": (544, 1024),
 BIN = 6  # rows per printed bin
 
 
-def couette(layout: str, seed: int = 1):
-    """The preset's lattice and parameters; ``layout`` 'as-given' or 'random'."""
-    setup = lattice_setup(load_scene(SCENE))
+def couette(layout: str):
+    """The preset's lattice and parameters; ``layout`` 'uniform' (every other row full) or
+    'random' (the preset's seeded fill)."""
+    sections = {}
+    if layout == "uniform":
+        sections = {"lattice": {"fill": None, "initial": [
+            {"md": 2, "x1": 1, "y1": iy, "x2": 192, "y2": iy} for iy in range(2, 62, 2)]}}
+    setup = lattice_setup(load_scene(SCENE, **sections))
     par = dataclasses.replace(setup.params)
     lat = build_lattice(par, setup.lines)
-    if layout == "random":
-        n = int((lat.mlp > 0).sum())
-        inner = lat.mlp[1:-1]
-        inner[...] = 0
-        inner.reshape(-1)[np.random.default_rng(seed).choice(inner.size, n, replace=False)] = 1
     core.prepare(lat, par)
     return lat, par, setup.units.speed
 
@@ -101,7 +102,7 @@ def main() -> None:
     ap.add_argument("--png", help="also plot the thermal and mean velocity profiles here")
     args = ap.parse_args()
     np.set_printoptions(precision=3, suppress=True, linewidth=120)
-    results = {layout: study(layout) for layout in ("as-given", "random")}
+    results = {layout: study(layout) for layout in ("uniform", "random")}
     for layout, res in results.items():
         print(f"== layout {layout}: 6-column periodic after {STEPS} steps: {res['periodic6']}")
         for name in WINDOWS:
@@ -123,7 +124,7 @@ def plot(results: dict, path: str) -> None:
     fig, (ax_t, ax_v) = plt.subplots(1, 2, figsize=(10, 4.6), sharey=True)
     nyt = len(next(iter(results.values()))[next(iter(WINDOWS))]["vx"])
     yb = bins((np.arange(1, nyt + 1) - 1) * np.sqrt(3) / 2)  # row R at (R − 1)·√3/2
-    styles = {"as-given": "-", "random": "--"}
+    styles = {"uniform": "-", "random": "--"}
     colours = dict(zip(WINDOWS, ("tab:red", "tab:orange", "tab:blue"), strict=True))
     for layout, res in results.items():
         for name in WINDOWS:

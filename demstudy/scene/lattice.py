@@ -11,7 +11,13 @@ A lattice scene is 2D, its box is the lattice (``[nxt, (nyt − 1)·√3/2]``: x
 the centres of the bottom wall row to those of the top one; filled in when ``[box]`` is left
 out), its two walls are the wall rows 1 and nyt (both ``[[walls]]`` are required: the listing
 always builds them), and its grains come from md lines (``initial`` and/or ``initial_file``)
-rather than ``[initial]``/``[particles]``.
+and seeded random fills (``fill``) rather than ``[initial]``/``[particles]``.
+
+``[[lattice.fill]]`` is demstudy's extension of Gutt's format (the listing has no random
+fill): ``count`` grains (or round(``density`` × nodes)) drawn without replacement from the
+empty nodes of a user rectangle, seeded by the fill's ``seed`` or else the scene's
+``run.seed``. Fills apply after every md line, in their order (:mod:`demstudy.engines.lgd.fill`),
+and become md ±1 lines, so a problem file written from the scene holds the same lattice.
 """
 
 from __future__ import annotations
@@ -19,12 +25,14 @@ from __future__ import annotations
 import functools
 import math
 from pathlib import Path
+from typing import Literal
 
 from pydantic import Field, model_validator
 
 from .base import Float, Int, PosFloat, PosInt, StrictModel
 
-__all__ = ["ROW_HEIGHT", "LatticeLine", "LatticeSpec", "lattice_box", "lattice_grains"]
+__all__ = ["ROW_HEIGHT", "LatticeFill", "LatticeLine", "LatticeSpec", "lattice_box",
+           "lattice_grains"]
 
 #: y distance between two lattice rows, in spacings
 ROW_HEIGHT = math.sqrt(3.0) / 2.0
@@ -52,6 +60,40 @@ class LatticeLine(StrictModel):
         if problem:
             raise ValueError(problem)
         return self
+
+
+class LatticeFill(StrictModel):
+    """A seeded random fill (demstudy's extension of Gutt's md lines; module docstring):
+    ``count`` grains, or ``density`` × the rectangle's nodes (rounded), on empty nodes of the
+    user rectangle [x1, x2] × [y1, y2], each with offset 0 and velocity (vx, vy) in the
+    listing's integers; md 1 movable grains, md −1 wall particles."""
+
+    x1: Int
+    y1: Int
+    x2: Int
+    y2: Int
+    density: Float | None = Field(default=None, gt=0.0, le=1.0)
+    count: PosInt | None = None
+    md: Literal[1, -1] = 1
+    vx: Int = 0
+    vy: Int = 0
+    #: None: the scene's run.seed
+    seed: Int | None = Field(default=None, ge=0, lt=2**63)
+
+    @model_validator(mode="after")
+    def _one_amount(self) -> LatticeFill:
+        if (self.density is None) == (self.count is None):
+            raise ValueError(f"density = {self.density}, count = {self.count}: give exactly "
+                             "one (density in (0, 1] of the rectangle's nodes, or a count)")
+        if self.x1 > self.x2 or self.y1 > self.y2:
+            raise ValueError(f"rectangle x1 = {self.x1}, x2 = {self.x2}, y1 = {self.y1}, "
+                             f"y2 = {self.y2}: allowed: x1 <= x2 and y1 <= y2")
+        return self
+
+    def amount(self) -> int:
+        from ..engines.lgd.fill import fill_count  # noqa: PLC0415 (numpy)
+
+        return fill_count(self.x1, self.y1, self.x2, self.y2, self.density, self.count)
 
 
 class LatticeSpec(StrictModel):
@@ -82,6 +124,9 @@ class LatticeSpec(StrictModel):
     #: Gutt's initial-data file (``nl = N`` + md lines), applied before ``initial``; a
     #: relative path is relative to the working directory
     initial_file: str | None = None
+    #: seeded random fills, applied after the md lines in order (an extension of Gutt's
+    #: format; module docstring); None (not []) keeps older scenes' dumps unchanged
+    fill: list[LatticeFill] | None = None
 
     @model_validator(mode="after")
     def _sizes(self) -> LatticeSpec:
@@ -95,20 +140,48 @@ class LatticeSpec(StrictModel):
         if self.nxt * self.nyt > 50_000_000:
             problems.append(f"lattice: nxt × nyt = {self.nxt * self.nyt} nodes; allowed: at "
                             "most 5e7")
-        if not self.initial and self.initial_file is None:
-            problems.append("lattice: give the grains as md lines (initial) or Gutt's "
-                            "initial-data file (initial_file)")
+        if not self.initial and self.initial_file is None and not self.fill:
+            problems.append("lattice: give the grains as md lines (initial), Gutt's "
+                            "initial-data file (initial_file) or random fills (fill)")
+        for k, f in enumerate(self.fill or []):
+            if not (1 <= f.x1 and f.x2 <= self.nxt and 1 <= f.y1 and f.y2 <= self.nyt):
+                problems.append(f"lattice.fill[{k}]: rectangle x {f.x1}..{f.x2}, y {f.y1}.."
+                                f"{f.y2}; allowed: inside the lattice, x in 1..{self.nxt} "
+                                f"(user columns), y in 1..{self.nyt} (rows)")
+                continue
+            nodes = (f.x2 - f.x1 + 1) * (f.y2 - f.y1 + 1)
+            if not 1 <= f.amount() <= nodes:
+                what = f"count = {f.count}" if f.count is not None else \
+                    f"density = {f.density} gives {f.amount()} grains"
+                problems.append(f"lattice.fill[{k}]: {what}; allowed: 1..{nodes} (the "
+                                "rectangle's nodes)")
         if problems:
             raise ValueError("; ".join(problems))
         return self
 
-    def lines(self) -> list:
-        """Every md line (``initial_file``'s, then ``initial``) as ``problem.MdLine``."""
-        from ..engines.lgd.problem import MdLine, read_initial_data  # noqa: PLC0415
+    def lines(self, seed: int) -> list:
+        """Every md line as ``problem.MdLine``: ``initial_file``'s, then ``initial``, then
+        each fill's ±1 lines (drawn with the fill's seed or else ``seed``, the scene's
+        run.seed). ValueError naming the fill when its rectangle lacks empty nodes."""
+        from ..engines.lgd.fill import fill_lines  # noqa: PLC0415 (numpy)
+        from ..engines.lgd.lattice import LgdParams  # noqa: PLC0415
+        from ..engines.lgd.problem import MdLine, build_lattice, read_initial_data  # noqa: PLC0415
 
         out = list(read_initial_data(Path(self.initial_file))) if self.initial_file else []
-        return out + [MdLine(*(getattr(ln, k) for k in ("md", "x1", "y1", "x2", "y2", "vx",
-                                                         "vy"))) for ln in self.initial]
+        out += [MdLine(*(getattr(ln, k) for k in ("md", "x1", "y1", "x2", "y2", "vx", "vy")))
+                for ln in self.initial]
+        if not self.fill:
+            return out
+        par = LgdParams(nxt=self.nxt, nyt=self.nyt)
+        lat = build_lattice(par, out)  # the empty nodes the first fill draws from
+        for k, f in enumerate(self.fill):  # not None here
+            new = fill_lines(lat, x1=f.x1, y1=f.y1, x2=f.x2, y2=f.y2, count=f.amount(),
+                             md=f.md, vx=f.vx, vy=f.vy, seed=seed if f.seed is None else
+                             f.seed, index=k, where=f"lattice.fill[{k}]")
+            out += new
+            if k + 1 < len(self.fill):
+                lat = build_lattice(par, out)
+        return out
 
 
 def lattice_box(spec: LatticeSpec) -> list[float]:
@@ -117,21 +190,22 @@ def lattice_box(spec: LatticeSpec) -> list[float]:
 
 
 @functools.lru_cache(maxsize=32)
-def _grain_count(spec_json: str, _file_stamp: int) -> tuple[int, float]:
+def _grain_count(spec_json: str, seed: int, _file_stamp: int) -> tuple[int, float]:
     spec = LatticeSpec.model_validate_json(spec_json)
     from ..engines.lgd.lattice import LgdParams  # noqa: PLC0415
     from ..engines.lgd.problem import build_lattice, speed_rms  # noqa: PLC0415
 
-    lat = build_lattice(LgdParams(nxt=spec.nxt, nyt=spec.nyt), spec.lines())
+    lat = build_lattice(LgdParams(nxt=spec.nxt, nyt=spec.nyt), spec.lines(seed))
     return lat.ng, speed_rms(lat)
 
 
-def lattice_grains(spec: LatticeSpec) -> tuple[int, float]:
-    """Movable grains of the initial lattice and their r.m.s. speed (integer units)."""
+def lattice_grains(spec: LatticeSpec, seed: int) -> tuple[int, float]:
+    """Movable grains of the initial lattice and their r.m.s. speed (integer units);
+    ``seed``: the scene's run.seed (for fills without their own)."""
     stamp = 0
     if spec.initial_file is not None:  # an edited file is read again
         try:
             stamp = Path(spec.initial_file).stat().st_mtime_ns
         except OSError:
             stamp = -1
-    return _grain_count(spec.model_dump_json(), stamp)
+    return _grain_count(spec.model_dump_json(), seed, stamp)

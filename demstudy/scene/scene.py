@@ -102,7 +102,7 @@ class Scene(StrictModel):
     def n_particles(self) -> int:
         p, init = self.particles, self.initial
         if self.lattice is not None:  # the movable grains of the initial lattice
-            return lattice_grains(self.lattice)[0]
+            return lattice_grains(self.lattice, self.run.seed)[0]
         if init.placement == "lattice":
             layers = (init.layers or 1) if self.dimension == 3 else 1
             return init.rows * init.columns * layers
@@ -245,13 +245,16 @@ class Scene(StrictModel):
                                 "position out")
         if self.initial != Initial():
             problems.append("initial: a lattice scene's grains come from lattice.initial / "
-                            "lattice.initial_file (Gutt's md lines); leave [initial] out")
+                            "lattice.initial_file (Gutt's md lines) / lattice.fill; leave "
+                            "[initial] out")
         if self.particles.solid_fraction is not None:
             problems.append(f"particles.solid_fraction = {self.particles.solid_fraction:g}: "
                             "a lattice scene's grains come from its md lines; leave it out")
         try:
-            count = lattice_grains(spec)[0]
-        except (ValueError, OSError) as exc:  # the initial-data file
+            count = lattice_grains(spec, self.run.seed)[0]
+        except (ValueError, OSError) as exc:  # the initial-data file, or a fill
+            if str(exc).startswith("lattice.fill["):
+                return problems + [str(exc)]
             return problems + [f"lattice.initial_file = {spec.initial_file!r}: {exc}"]
         if count == 0:
             problems.append("lattice: the md lines place no movable grain")

@@ -195,7 +195,7 @@ def speed_unit(scene: Scene) -> LgdUnits:
                       "moving walls without gravity: give the listing's integer speed of "
                       "particle speed 1 (e.g. Gutt's Couette wall speed 4096), the walls' "
                       "velocities in units of it")
-    rms = lattice_grains(spec)[1]
+    rms = lattice_grains(spec, scene.run.seed)[1]
     if rms <= 0.0:
         raise _refuse("lattice.speed_scale", None,
                       "no gravity, walls at rest and every grain at rest: nothing sets a "
@@ -223,5 +223,5 @@ def lattice_setup(scene: Scene) -> LatticeSetup:
     draft.values["ke"] = scene.lattice.ke
     _pair_rule(scene, draft)  # the pair rule is always there (constant or piecewise)
     apply_effects(scene, ENGINE, TRANSLATIONS, draft)
-    return LatticeSetup(LgdParams(**draft.values), draft.units, scene.lattice.lines(),
-                        draft.notes)
+    return LatticeSetup(LgdParams(**draft.values), draft.units,
+                        scene.lattice.lines(scene.run.seed), draft.notes)

@@ -331,10 +331,20 @@ def build_lattice(par: LgdParams, lines: list[MdLine], notes: list[str] | None =
     lat = Lattice.empty(nxt, nyt)
     wall_rows(lat, par)
     skipped, marked = 0, 0
-    for line in lines:
+    k = 0
+    while k < len(lines):
+        line = lines[k]
         problem = md_problem(line.md)
         if problem:
             raise ProblemError(problem)
+        if line.md in (-1, 0, 1):  # a run of single-node lines at once (fills: 1e5+ lines)
+            end = k
+            while end < len(lines) and lines[end].md in (-1, 0, 1):
+                end += 1
+            skipped += _single_nodes(lat, lines[k:end])
+            k = end
+            continue
+        k += 1
         if line.md > 10:
             marked += 1  # numbered by its line, placed or not (L1986)
         if abs(line.md) in (2, 3, 6):
@@ -352,15 +362,29 @@ def build_lattice(par: LgdParams, lines: list[MdLine], notes: list[str] | None =
         r, c = line.y1 - 1, int(storage_column(line.x1, line.y1, nxt))
         lat.ipx[r, c], lat.ipy[r, c] = line.x2, line.y2
         lat.ivx[r, c], lat.ivy[r, c] = line.vx, line.vy
-        if line.md > 10:
-            lat.nlp[r, c] = marked
-            lat.mlp[r, c] = MOVABLE
-        else:
-            lat.mlp[r, c] = line.md
+        lat.nlp[r, c] = marked
+        lat.mlp[r, c] = MOVABLE
     if skipped and notes is not None:
         notes.append(f"{skipped} points outside rows 1..{nyt} skipped (as the listing does)")
     lat.ng = int(np.count_nonzero(lat.mlp > 0))
     return lat
+
+
+def _single_nodes(lat: Lattice, lines: list[MdLine]) -> int:
+    """Apply md ±1 / 0 lines in order (a later line on the same node wins); returns the
+    number skipped for lying outside rows 1..nyt."""
+    nyt, nxt = lat.mlp.shape
+    v = np.array([ln.values() for ln in lines], dtype=np.int64).reshape(-1, 7)
+    inside = (v[:, 2] >= 1) & (v[:, 2] <= nyt)
+    v = v[inside]
+    flat = (v[:, 2] - 1) * nxt + storage_column(v[:, 1], v[:, 2], nxt)
+    # the last line on each node: unique over the reversed order keeps first occurrences
+    _, first = np.unique(flat[::-1], return_index=True)
+    last = len(flat) - 1 - first
+    v, flat = v[last], flat[last]
+    for name, col in (("ipx", 3), ("ipy", 4), ("ivx", 5), ("ivy", 6), ("mlp", 0)):
+        np.put(getattr(lat, name), flat, v[:, col])
+    return int(np.count_nonzero(~inside))
 
 
 # -- writing -------------------------------------------------------------------------------

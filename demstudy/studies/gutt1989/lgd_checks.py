@@ -277,7 +277,7 @@ def _thermal_peak(ref: str, profs: Mapping[str, dict], runs: Mapping[str, m.LgdR
                            f"{dc:.2f}), so the wall COR sets the level, not the shape")
             if name.endswith("dense"):
                 n_dense = runs[name].position.shape[1]
-                why.append(f"a denser channel (¾ of the rows full: {n_dense} grains instead "
+                why.append(f"a denser channel (random fill at density ¾: {n_dense} grains instead "
                            f"of the thesis's 5760) gives {dsig:+.1f}σ" + (
                                ": the mid-channel peak appears once the channel is more "
                                "collisional than N = 5760 makes it with the assumed layout"
@@ -287,7 +287,8 @@ def _thermal_peak(ref: str, profs: Mapping[str, dict], runs: Mapping[str, m.LgdR
     run = runs["lgd-couette-elastic-u4096"]
     one = m.row_profiles(run.position[-1], run.velocity[-1], run.nyt)
     # row-to-row scatter of one frame's interior rows: far above the rows' own standard
-    # errors (the grains of a row move together), the noise a single snapshot shows
+    # errors (with the former uniform layout a row held a few grains copied 32 times), the
+    # noise a single snapshot shows
     scatter = float(np.nanstd(one["thermal"][ok[1:-1]]))
     wall_rows = f"{p['thermal'][ok[0]]:.3f}, {p['thermal'][ok[-1]]:.3f}"
     return Check(
