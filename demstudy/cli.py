@@ -114,7 +114,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from .analysis.registry import Context, compute_statistics
-    from .analysis.walls import first_walls, walls_move
+    from .analysis.walls import first_walls, strips_for, walls_move
     from .io.results import frames_of, read_results, write_results
     from .scene import apply_overrides, parse_scene_text, scene_to_toml, validate_scene
 
@@ -158,9 +158,10 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
                   "fixed strips between the scene's walls", file=sys.stderr)
             args.fixed_strips = True
 
+    relative = strips_for(scene, frames, False if args.fixed_strips else None, str(source))
     ctx = Context(scene, frames=frames, results=results, z_cells=args.z_cells,
-                  wall_relative=False if args.fixed_strips else None,
-                  walls=first_walls(frames) if args.fixed_strips else None)
+                  wall_relative=relative,
+                  walls=first_walls(frames) if relative is False else None)
     for name, (data, attrs) in compute_statistics(what, ctx).items():
         if name == "profiles":
             results.profiles, results.profile_attrs = data, attrs

@@ -204,3 +204,21 @@ def test_servo_run_bins_between_its_moving_walls(tmp_path):
     fixed = read_results(out).analyze("profiles", save=False, wall_relative=False)
     assert fixed.profile_attrs["wall_relative"] is False  # where production started
     np.testing.assert_allclose(fixed.profiles["edges"][[0, -1]], walls[0], rtol=1e-12)
+
+
+def test_frames_without_walls_fall_back_to_fixed_strips_with_a_warning():
+    """A servo scene's frames written without wall positions (older or hand-made files):
+    re-analysis warns and uses fixed strips at the scene's walls instead of failing; frames
+    that carry walls keep the wall-relative default."""
+    from demstudy.analysis.walls import strips_for
+    from demstudy.scene import load_scene
+
+    scene = load_scene("campbell1982/couette-noslip")  # servo walls
+    bare = Frame(time=0.0, box_lo=np.zeros(2), box_hi=np.array([4.8, 12.0]),
+                 position=np.array([[1.0, 6.0]]), velocity=np.zeros((1, 2)),
+                 angular_velocity=np.zeros((1, 1)), radius=np.array([0.5]))
+    with pytest.warns(UserWarning, match="no wall positions"):
+        assert strips_for(scene, lambda: [bare], None) is False
+    walled = with_walls(bare, 0.0, 12.0)
+    assert strips_for(scene, lambda: [walled], None) is None
+    assert strips_for(scene, lambda: [bare], True) is True  # asked: the error comes later

@@ -26,6 +26,7 @@ servo's ``/timeseries/wall_position_lower`` / ``_upper`` at the frame's time.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -64,6 +65,20 @@ def first_walls(frames: Callable[[], Iterable[Frame]] | None) -> tuple[float, fl
     where fixed strips stand when the walls move (``wall_relative = False``)."""
     first = next(iter(frames()), None) if frames is not None else None
     return frame_walls(first) if first is not None else None
+
+
+def strips_for(scene: Any, frames: Callable[[], Iterable[Frame]] | None,
+               asked: bool | None, source: str = "these results") -> bool | None:
+    """The ``wall_relative`` choice for re-analysing ``frames``: ``asked``, except that by
+    default (None) frames carrying no wall positions (older or hand-made files) give fixed
+    strips at the scene's walls, with a warning, instead of an error."""
+    if asked is None and frames is not None and walls_move(scene) \
+            and first_walls(frames) is None:
+        warnings.warn(f"{source}: the frames carry no wall positions, so the y bins are "
+                      "fixed strips at the scene's walls, not wall-relative ones",
+                      stacklevel=3)
+        return False
+    return asked
 
 
 def with_walls(frame: Frame, lower: float, upper: float) -> Frame:

@@ -115,9 +115,10 @@ class Results:
 
         scene = self.scene
         names = [w for w in what if isinstance(w, str)]
-        from ..analysis.walls import first_walls
+        from ..analysis.walls import first_walls, strips_for
 
         frames = (lambda: self.iter_frames(start)) if self.frames else None
+        wall_relative = strips_for(scene, frames, wall_relative, str(self.path or "these results"))
         ctx = Context(scene, frames=frames, results=self, z_cells=z_cells,
                       wall_relative=wall_relative,
                       walls=first_walls(frames) if wall_relative is False else None)
