@@ -111,7 +111,7 @@ def test_part_measures_the_drive_and_gives_verdicts(tiny_runs, tmp_path):
     # the mean flow follows the walls: negative at the bottom, positive at the top
     assert meas.profile["u"][0] < 0 < meas.profile["u"][-1]
     an = lgd_theory.analyse(tiny_runs, tmp_path, quick=True)
-    assert len(an.checks) == 7 and all(ch.verdict in VERDICTS for ch in an.checks)
+    assert len(an.checks) == 8 and all(ch.verdict in VERDICTS for ch in an.checks)
     assert an.checks[0].verdict == "reproduced"  # ⟨k_τ²⟩ = 1/4 and R under the bound
     assert an.figures and an.figures[0].path.exists()
 
