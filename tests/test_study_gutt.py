@@ -18,7 +18,15 @@ import demstudy as ds
 from demstudy import studies
 from demstudy.scene import load_scene
 from demstudy.studies.base import NOT_RUN, PARTLY, REPRODUCED
-from demstudy.studies.gutt1989 import PARTS, STUDY, couette, couette_cases, lgd, theory
+from demstudy.studies.gutt1989 import (
+    PARTS,
+    STUDY,
+    couette,
+    couette_cases,
+    lgd,
+    lgd_theory,
+    theory,
+)
 from demstudy.studies.gutt1989.couette_measure import (
     fit_curvature,
     layer_mean,
@@ -31,7 +39,8 @@ from demstudy.studies.gutt1989.couette_measure import theory as couette_theory
 def test_registered_with_theory_and_couette_parts():
     assert "gutt1989" in studies.study_names()
     assert studies.get_study("gutt1989") is STUDY
-    assert PARTS == (theory, couette, lgd)  # the lgd part: tests/test_study_gutt_lgd.py
+    # the lgd part: tests/test_study_gutt_lgd.py; lgd_theory: tests/test_gutt1989_lgd_theory.py
+    assert PARTS == (theory, couette, lgd, lgd_theory)
     assert theory.cases(False) == [] and theory.cases(True) == []
     full, quick = couette.cases(False), couette.cases(True)
     assert {c.name for c in quick} < {c.name for c in full}

@@ -22,7 +22,9 @@ def combined_analysis(parts: Sequence[ModuleType]):
     def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
         total = Analysis()
         for part in parts:
-            names = {c.name for c in part.cases(quick)}
+            # a part may also analyse other parts' runs (``reads(quick)``: their names)
+            names = {c.name for c in part.cases(quick)} | set(
+                getattr(part, "reads", lambda _quick: ())(quick))
             ana = part.analyse({n: p for n, p in runs.items() if n in names}, out, quick)
             total.checks += ana.checks
             total.figures += ana.figures

@@ -5,7 +5,8 @@ wall boundary conditions and Couette flow (Ch. 2), Lattice Grain Dynamics (Ch. 3
 Parts, in order (``PARTS``): ``theory`` solves Chapters 1 and 2 with
 demstudy.theory.gutt_spin / gutt_walls (no runs); ``couette`` overlays Gutt's Ch. 2 Couette
 solution on event-driven 2D and 3D runs with his wall rule; ``lgd`` reruns his Ch. 3 lattice
-scenes on the lattice engine (``--engine lgd``; cases named ``lgd-*``).
+scenes on the lattice engine (``--engine lgd``; cases named ``lgd-*``); ``lgd_theory``
+overlays the Ch. 2 Couette solution on the ``lgd`` part's Couette runs (no runs of its own).
 
 Units: Ch. 1 in arbitrary units as the thesis (d = 1); elsewhere dimensionless particle
 units d = 1, m = 1, no gravity, the wall speed u_w = 1 sets the time scale.
@@ -15,9 +16,9 @@ from __future__ import annotations
 
 from ..base import Study
 from ..parts import combined_analysis, combined_cases
-from . import couette, lgd, theory
+from . import couette, lgd, lgd_theory, theory
 
-PARTS = (theory, couette, lgd)
+PARTS = (theory, couette, lgd, lgd_theory)
 
 STUDY = Study(
     name="gutt1989",
