@@ -234,7 +234,7 @@ def obstacle(kind: str) -> str:
 def incline() -> str:
     alpha = math.atan(math.sqrt(3) / 4)  # the user diagonal Δiy/Δix = ½ is level
     lines = [line(3, 1, 2, 144, 109), line(-2, 217, 2, 217 + 2 * 215, 217),
-             line(11, 144, 2)]
+             line(11, 144, 109)]
     return scene(
         "incline",
         "# Gutt (1989) §3 (L1109–L1115, figs 3.33–3.34): a block of 144 × 108 grains (15552) "
@@ -244,7 +244,8 @@ def incline() -> str:
         "slope and the diagonal the run-out; 6144 steps.\n" + HEADER_UNITS["gravity"],
         'description = "Incline with run-out, 15552 grains; ASSUMED layout: the block at '
         'x = 1-144, rows 2-109, at rest; the run-out a diagonal wall from (217, 2) wrapping '
-        'once round x to row 217; one marked grain at the block front (figure 3.33 '
+        'once round x to row 217; one marked grain at the block\'s top front corner '
+        '(x = 144, row 109: a surface grain, the thesis\'s marker saltates; figure 3.33 '
         'missing); grain-wall e assumed equal to grain-grain e"\n'
         'reference = "Gutt (1989), Ch. 3, L1109-L1115, figs 3.33-3.34"\n',
         GRANULAR + walls(0.75, "e_pw below c_b (assumed = e_pp)") +

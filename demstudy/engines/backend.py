@@ -201,6 +201,13 @@ class BackendBase:
     def take_collision_log(self) -> dict[str, np.ndarray] | None:
         return None
 
+    def marked(self) -> dict[str, Any] | None:
+        """The scene's marked grains now, for their paths (``/tracks``,
+        :mod:`demstudy.simulation.tracks`): ``mark`` (n,) numbers, ``position`` and
+        ``velocity`` (n, dim), ``period`` (the periodic length along x, 0: none); None when
+        the scene has no marked grains (the default)."""
+        return None
+
     # -- MPI, checkpoints, end ----------------------------------------------------------
     def agree(self, flag: bool) -> bool:
         """True on every rank if ``flag`` is true on any rank (collective on MPI ranks; the

@@ -349,7 +349,16 @@ _HEALTH = {  # soft-contact engines, one value per production sample (demstudy.c
     "max_impact_speed": (SPEED, "largest reconstructed normal impact speed of the pairs"),
 }
 
+_TRACKS = {
+    "mark": (COUNT, "marked-grain numbers (the scene's marker numbers, ascending)"),
+    "time": (TIME, "sample times (every sample from t = 0)"),
+    "position": (LENGTH, "marked grains' centres (samples, markers, dim), x unwrapped across "
+                         "the periodic boundary (continuous paths); NaN: absent"),
+    "velocity": (SPEED, "marked grains' velocities (samples, markers, dim); NaN: absent"),
+}
+
 FIELDS: dict[str, dict[str, tuple[str, str]]] = {
+    "tracks": _TRACKS,
     "timeseries": _TIMESERIES,
     "profiles": _PROFILES,
     "frames": _FRAMES,

@@ -54,10 +54,12 @@ from .options import RunOptions, check_run, frames_on_resume, work_folder
 from .results import run_results
 from .schedule import Schedule, StopInInterval, StopRequest
 from .state import RunState
+from .tracks import MarkedTracks
 
 __all__ = ["Simulation"]
 
-LOOP_VERSION = f"demstudy {__version__} (simulation loop 2)"  # 2: RunState.health
+# 2: RunState.health, 3: RunState.tracks
+LOOP_VERSION = f"demstudy {__version__} (simulation loop 3)"
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 
 
@@ -241,6 +243,7 @@ class Simulation:
                                  self._section() if production else 0.0)
         if self.log_every:
             self._keep_log(state, backend.take_collision_log(), production)
+        self._keep_marked(state, t)
         state.last_time = t
         snapshot = scene.gravity is not None and state.samples in (self.schedule.n_eq,
                                                                    self.schedule.n_total)
@@ -257,6 +260,15 @@ class Simulation:
         if production:
             self._production_frame(state, frame)
             self._health(state, t)
+
+    def _keep_marked(self, state: RunState, t: float) -> None:
+        """The marked grains at every sample, equilibration included (their paths)."""
+        record = self.backend.marked()
+        if record is None or self.backend.rank != 0:
+            return
+        if state.tracks is None:
+            state.tracks = MarkedTracks.start(record)
+        state.tracks.add(t, record)
 
     def _health(self, state: RunState, t: float) -> None:
         """The contact health of a soft-contact engine (those with ``health_sample``; a

@@ -74,6 +74,8 @@ def run_results(sim: Any, state: RunState, extra: dict[str, Any]) -> Results:
                      "2 upper wall; normal from i to j (or to the wall); branch r_j - r_i "
                      "(contact point - r_i for walls); impulse on i; velocity v_i - v_j "
                      "and spin_velocity (contact-point relative velocity) before"}
+    if state.tracks is not None:  # marked grains' paths
+        results.groups["tracks"], results.group_attrs["tracks"] = state.tracks.results()
     for name, analysis in state.streams.items():
         analysis.finish()
         results.groups[f"statistics/{name}"] = analysis.results

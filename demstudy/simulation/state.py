@@ -12,6 +12,7 @@ import numpy as np
 from ..analysis.base import AnalysisBase
 from ..analysis.stress import CollisionalSums, ContactStress
 from ..effects.servo import ServoController
+from .tracks import MarkedTracks
 
 __all__ = ["RunState"]
 
@@ -44,6 +45,8 @@ class RunState:
     in_production: bool = False
     # soft-contact engines: the contact health at each production sample (contact.health)
     health: dict[str, list] = field(default_factory=dict)
+    # marked grains' paths, every sample from t = 0 (engines with ``marked``), else None
+    tracks: MarkedTracks | None = None
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)

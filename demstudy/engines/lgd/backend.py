@@ -100,6 +100,8 @@ class LgdBackend(BackendBase):
             # a stop inside a sample interval: its sums so far carry over
             self.last = (dict(saved["last_total"]), float(saved["last_time"]))
         self.n_particles = self.lat.ng
+        # fixed when the run starts (a resumed run's lattice still holds them)
+        self.has_marks = bool(np.any((self.lat.mlp > 0) & (self.lat.nlp > 0)))
         # wall particles per group (the listing's nxt, nxt and nw)
         nyt, nxt = self.lat.mlp.shape
         self.n_wall = {"lower": nxt, "upper": nxt,
@@ -153,18 +155,35 @@ class LgdBackend(BackendBase):
         """Grain centres x = (c + 1 + r/2 + ipx/idl) mod nxt, y = r·√3/2 + ipy/idl (row r and
         storage column c from 0; offsets included), velocities in particle units, the
         marked-grain numbers in ``extra['mark']`` (0: unmarked)."""
-        lat, idl = self.lat, self.params.idl
+        lat = self.lat
         nyt, nxt = lat.mlp.shape
         r, c = self._grains()
-        x = np.mod(c + 1 + r / 2 + lat.ipx[r, c] / idl, nxt)
-        y = r * ROW_HEIGHT + lat.ipy[r, c] / idl
-        v = np.column_stack([lat.ivx[r, c], lat.ivy[r, c]]) / self.units.speed
+        position, v = self._place(r, c)
         n = len(r)
         return Frame(time=self.time, box_lo=np.zeros(2),
                      box_hi=np.array([float(nxt), (nyt - 1) * ROW_HEIGHT]),
-                     position=np.column_stack([x, y]), velocity=v,
+                     position=position, velocity=v,
                      angular_velocity=np.zeros((n, 1)), radius=np.full(n, 0.5),
                      extra={"mark": lat.nlp[r, c].copy()})
+
+    def _place(self, r: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities (particle units) of the grains at rows ``r``, storage
+        columns ``c``."""
+        lat, idl, nxt = self.lat, self.params.idl, self.lat.mlp.shape[1]
+        x = np.mod(c + 1 + r / 2 + lat.ipx[r, c] / idl, nxt)
+        y = r * ROW_HEIGHT + lat.ipy[r, c] / idl
+        v = np.column_stack([lat.ivx[r, c], lat.ivy[r, c]]) / self.units.speed
+        return np.column_stack([x, y]), v
+
+    def marked(self) -> dict | None:
+        """The marked grains (``nlp`` > 0) as :meth:`frame` places them; None without any."""
+        if not self.has_marks:
+            return None
+        lat = self.lat
+        r, c = np.nonzero((lat.mlp > 0) & (lat.nlp > 0))
+        position, velocity = self._place(r, c)
+        return {"mark": lat.nlp[r, c].astype(np.int64), "position": position,
+                "velocity": velocity, "period": float(lat.mlp.shape[1])}
 
     def observe(self, production: bool) -> dict:
         lat = self.lat

@@ -52,6 +52,9 @@ GAS_STEPS, EXPLOSION_STEPS, COUETTE_STEPS = 1024, 128, 1024
 HOURGLASS_STEPS, OBSTACLE_STEPS, OBSTACLE_PATH_STEPS = 2048, 512, 1536
 INCLINE_STEPS, POISEUILLE_STEPS = 6144, 18432
 OBSTACLES = ("circle", "square", "triangle-up", "triangle-down")
+#: steps between the samples of the marker-path runs (their /tracks; a grain moves at most
+#: one spacing per step, so a path is resolved to 2 d)
+PATH_INTERVAL = 2
 #: the diagnostic Couette runs (the shape of the thermal profile): 8× longer, elastic walls
 #: (e_pw = 1 instead of the thesis's 0.75), and a denser random fill (density ¾ instead of ½)
 COUETTE_LONG_STEPS = 8192
@@ -88,8 +91,16 @@ def all_cases() -> list[Case]:
     ]
     out += [_case(f"obstacle-{shape}", f"obstacle-{shape}", OBSTACLE_PATH_STEPS, 64,
                   quick=(OBSTACLE_STEPS, 64, None), group="obstacle") for shape in OBSTACLES]
+    # the marked grains' paths (figs 3.29b-3.32b, 3.34b): the same scenes sampled every
+    # PATH_INTERVAL steps (the thesis wrote markers every step), one frame kept at the end
+    out += [_case(f"obstacle-{shape}-paths", f"obstacle-{shape}", OBSTACLE_PATH_STEPS,
+                  PATH_INTERVAL, window=PATH_INTERVAL,
+                  quick=(OBSTACLE_PATH_STEPS, PATH_INTERVAL, PATH_INTERVAL), group="obstacle")
+            for shape in OBSTACLES]
     out += [
         _case("incline", "incline", INCLINE_STEPS, 96, window=768, quick=(1536, 96, 768)),
+        _case("incline-paths", "incline", INCLINE_STEPS, PATH_INTERVAL, window=PATH_INTERVAL,
+              quick=(1536, PATH_INTERVAL, PATH_INTERVAL), group="incline"),
         _case("poiseuille-small", "poiseuille-small", POISEUILLE_STEPS, 48, window=480,
               quick=(1536, 48, 480), group="poiseuille"),
         # the thesis's 508 032 grains (≈ 1.9e10 node-updates; the engine has no forecast:

@@ -196,3 +196,76 @@ def discharge(run: LgdRun, fit: dict, out: Path, name: str, caption: str) -> Fig
     ax.set_ylabel("grains discharged")
     ax.legend(fontsize=7)
     return _save(fig, out, name, caption)
+
+
+def _wrapped(path: np.ndarray, period: float) -> np.ndarray:
+    """A path (samples, 2) with x unwrapped, wrapped into [0, period) with NaN where it
+    crosses the periodic boundary (so that no line spans the box)."""
+    p = path.copy()
+    if period > 0:
+        p[:, 0] = np.mod(p[:, 0], period)
+        jump = np.flatnonzero(np.abs(np.diff(p[:, 0])) > period / 2) + 1
+        p = np.insert(p, jump, np.nan, axis=0)
+    return p
+
+
+def _lattice_axes(ax, run: LgdRun, title: str) -> None:
+    ax.set_xlim(0, run.nxt)
+    ax.set_ylim(-1, (run.nyt - 1) * ROW + 1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (d)")
+    ax.set_ylabel("y (d)")
+    ax.set_title(title, fontsize=9)
+
+
+def obstacle_paths(panels: Sequence[tuple[LgdRun, np.ndarray, np.ndarray, str]], out: Path,
+                   name: str, caption: str) -> Figure:
+    """Per (run, obstacle nodes, wall nodes, title): the walls (red) and each marker's path
+    in its own colour, start ○, end ●."""
+    first = panels[0][0]
+    aspect = (first.nyt - 1) * ROW / first.nxt
+    rows = -(-len(panels) // 2)
+    fig, axes = plt.subplots(rows, 2, figsize=(10.4, (5.2 * aspect + 1.2) * rows),
+                             squeeze=False)
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    for ax, (run, _nodes, walls, title) in zip(axes.flat, panels, strict=False):
+        tracks = run.extra["tracks"]
+        ax.scatter(walls[:, 0], walls[:, 1], s=0.3, c="C3", lw=0, rasterized=True)
+        period = float(tracks["period_x"])
+        for k in range(tracks["position"].shape[1]):
+            colour = plt.cm.tab10(k % 10)
+            path = tracks["position"][:, k]
+            ax.plot(*_wrapped(path, period).T, "-", color=colour, lw=0.8)
+            ok = path[np.isfinite(path).all(axis=1)]
+            ax.plot(ok[0, 0] % period, ok[0, 1], "o", mfc="none", color=colour, ms=3)
+            ax.plot(ok[-1, 0] % period, ok[-1, 1], "o", color=colour, ms=3)
+        steps = int(run.ts["steps"][-1])
+        _lattice_axes(ax, run, f"{title}: marker paths, steps 0-{steps}")
+    return _save(fig, out, name, caption)
+
+
+def incline_paths(run: LgdRun, tracks: dict, arcs: Sequence[dict], out: Path, name: str,
+                  caption: str) -> Figure:
+    """The last kept frame's positions (grey), walls (red), the marker's path (blue) with
+    its parabolic flights (orange)."""
+    from .lgd_measure import initial_state
+
+    aspect = (run.nyt - 1) * ROW / run.nxt
+    fig, ax = plt.subplots(figsize=(10.4, 10.4 * aspect + 1.4))
+    p = run.position[-1]
+    ax.scatter(p[:, 0], p[:, 1], s=0.15, c="0.6", lw=0, rasterized=True)
+    walls = initial_state(run)["walls"]
+    ax.scatter(walls[:, 0], walls[:, 1], s=0.3, c="C3", lw=0, rasterized=True)
+    period = float(tracks["period_x"])
+    path = tracks["position"][:, 0]
+    ax.plot(*_wrapped(path, period).T, "-", color="C0", lw=0.7, label="marker path")
+    for i, arc in enumerate(arcs):
+        seg = path[arc["start"]:arc["end"] + 1]
+        ax.plot(*_wrapped(seg, period).T, "-", color="C1", lw=2.0,
+                label="parabolic free flights" if i == 0 else None)
+    ax.plot(path[0, 0] % period, path[0, 1], "o", mfc="none", color="C0", ms=5)
+    _lattice_axes(ax, run, f"incline: positions at step {run.frame_steps[-1]}, marker path "
+                           f"over steps 0-{int(run.ts['steps'][-1])}")
+    ax.legend(fontsize=7, loc="lower right")
+    return _save(fig, out, name, caption)

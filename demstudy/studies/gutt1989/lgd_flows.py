@@ -31,9 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Analysis, Check, pm
+from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Analysis, Check, pm
 from . import lgd_figures as figs
 from . import lgd_measure as m
+from . import lgd_paths
 from .lgd_checks import not_run
 
 LINEAR_RATE, SIDE_SLOW, STAGNANT, STATIC_NODES = 0.25, 0.5, 0.5, 0.9
@@ -44,7 +45,9 @@ BAND_WIDTH, SIGMA_OVER_P, FINAL_SHEAR = 30.0, 0.25, 150.0 / 252.0
 def flows(runs: Mapping[str, m.LgdRun], out: Path, an: Analysis, quick: bool) -> None:
     hourglass(runs.get("lgd-hourglass"), out, an)
     obstacles({n: r for n, r in runs.items() if n.startswith("lgd-obstacle")}, out, an)
+    lgd_paths.obstacle_paths(runs, out, an)
     incline(runs.get("lgd-incline"), out, an, quick)
+    lgd_paths.incline_paths(runs.get("lgd-incline-paths"), out, an)
     poiseuille(runs.get("lgd-poiseuille-small"), runs.get("lgd-poiseuille-thesis"), out, an,
                quick)
 
@@ -191,10 +194,6 @@ def obstacles(runs: Mapping[str, m.LgdRun], out: Path, an: Analysis) -> None:
             f"speed {ratio:.2f} (stagnant if < {STAGNANT}){extra}",
             REPRODUCED if ok else (PARTLY if void_ok or cap_ok else NOT_REPRODUCED),
             "" if ok else _obstacle_reason(shape, void_ok, cap_ok, ratio)))
-    an.checks.append(Check(
-        ref, "marker paths at 1536 steps (figs 3.29b-3.32b, 3.34b)", "pictures", "n/a", NOT_RUN,
-        "the simulation loop keeps the common frame arrays only, not the LGD marks "
-        "(frame.extra['mark']), and grains on a lattice have no identity without them"))
     if panels:
         an.figures.append(figs.positions(
             panels, out, "lgd_obstacle_positions.png",

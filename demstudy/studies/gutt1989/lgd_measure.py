@@ -61,7 +61,15 @@ def load(name: str, path: Path) -> LgdRun:
     return LgdRun(name, dict(r.attrs), ts, np.asarray(r.frames["position"]),
                   np.asarray(r.frames["velocity"]), ts["steps"][idx].astype(int),
                   int(r.attrs["lgd_nxt"]), int(r.attrs["lgd_nyt"]),
-                  str(r.attrs.get("scene_toml", "")), {"scene": r.scene})
+                  str(r.attrs.get("scene_toml", "")),
+                  {"scene": r.scene, "tracks": _tracks(r)})
+
+
+def _tracks(r) -> dict | None:
+    """The marked grains' paths (``/tracks``) with their period, or None."""
+    if "tracks" not in r.groups:
+        return None
+    return {**r.groups["tracks"], "period_x": r.group_attrs["tracks"]["period_x"]}
 
 
 def initial_state(run: LgdRun) -> dict[str, np.ndarray]:
