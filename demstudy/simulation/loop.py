@@ -58,8 +58,10 @@ from .tracks import MarkedTracks
 
 __all__ = ["Simulation"]
 
-# 2: RunState.health, 3: RunState.tracks
-LOOP_VERSION = f"demstudy {__version__} (simulation loop 3)"
+# 2: RunState.health. RunState.tracks (marked grains' paths) came later without a new
+# version: a checkpoint pickled before it unpickles with the class default (None), and only
+# lattice scenes with marked grains have tracks (none were checkpointed before them)
+LOOP_VERSION = f"demstudy {__version__} (simulation loop 2)"
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 
 
