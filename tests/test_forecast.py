@@ -416,3 +416,20 @@ def test_the_pilots_own_counts_then_its_last_windows_rates():
         update={"equilibration": 0.0, "production": 1.0})})
     f = fc.forecast_run(short, get_backend("edmd"), pilot=pilot, costs=EVENT_COSTS)
     assert f.seconds == pytest.approx((1.5 * 2e-6 + 8.5 * 3e-7) * n / 2, rel=1e-12)
+
+
+def test_gravity_given_as_an_angle_is_forecast_and_matched():
+    """Chutes give gravity as an angle (no direction vector): the forecast's acceleration
+    test and the finished-run family both read the scene's gravity vector; a different
+    drive (wall speed) is another family."""
+    from demstudy.scene import load_scene
+    from demstudy.simulation.forecast import accelerates
+    from demstudy.simulation.forecast_events import same_family
+
+    chute = load_scene("campbell1982/chute-20")
+    assert chute.gravity.direction is None and accelerates(chute)
+    assert same_family(chute, load_scene("campbell1982/chute-20", ["run.production=10"]))
+    assert not same_family(chute, load_scene("campbell1982/chute-30"))
+    couette = load_scene("campbell1982/couette-rough")
+    faster = load_scene("campbell1982/couette-rough", ["walls.1.velocity=10.0"])
+    assert not same_family(couette, faster)

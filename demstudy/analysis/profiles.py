@@ -110,6 +110,10 @@ class ProfileAnalysis(AnalysisBase):
     strips: with ``wall_relative``, the number of strips (None: round(first gap/bin_width)).
     """
 
+    #: class default: an instance pickled into a checkpoint before wall-relative strips
+    #: existed unpickles without ``walls`` and resumes with its fixed strips
+    walls = None
+
     def __init__(
         self,
         axis: str | int = "y",

@@ -51,6 +51,11 @@ class StructureDistributions(AnalysisBase):
     walls that move: Campbell's |n − HGT/2| < ST with the current gap), ``y_mid`` unused.
     """
 
+    # class defaults: instances pickled into checkpoints before these attributes existed
+    # unpickle without them and resume with fixed strips (what they were built with)
+    walls = None
+    _y_mid_sum: float | None = None
+
     def __init__(self, dim: int = 2, r_max: float = 4.0, dr: float = 0.08,
                  half_width: float = 1.0, y_mid: float | None = None, max_blocks: int = 64,
                  wall_relative: bool = False, verbose: bool = False) -> None:
@@ -81,6 +86,9 @@ class StructureDistributions(AnalysisBase):
             y_mid = 0.5 * sum(self.walls.walls(frame))
         else:
             y_mid = 0.5 * (lo[1] + hi[1]) if self.y_mid is None else self.y_mid
+        if self._y_mid_sum is None:  # restored from a checkpoint pickled before the sum
+            # existed: its frames used this same fixed mid-plane (walls were not followed)
+            self._y_mid_sum = float(y_mid) * self.n_frames
         self._y_mid_sum += float(y_mid)
         test = np.flatnonzero(np.abs(pos[:, 1] - y_mid) < self.half_width)
         normal = np.zeros(self.n_r)

@@ -120,6 +120,10 @@ class VelocityDistribution(AnalysisBase):
     bin_width: the strip width asked for with ``wall_relative``.
     """
 
+    #: class default: an instance pickled into a checkpoint before wall-relative strips
+    #: existed unpickles without ``walls`` and resumes with its fixed strips
+    walls = None
+
     def __init__(
         self,
         dim: int = 2,

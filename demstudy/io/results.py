@@ -453,7 +453,11 @@ def _frame_walls(results: Results) -> np.ndarray | None:
     times (the frames are samples of the time series); None when the walls do not move."""
     fr, ts = results.frames, results.timeseries
     if "walls" in fr:
-        return np.asarray(fr["walls"], float).reshape(-1, 2)
+        walls = np.asarray(fr["walls"], float).reshape(-1, 2)
+        if len(walls) == len(fr["time"]):
+            return walls
+        # shorter: a run resumed from a checkpoint written before frames kept their walls;
+        # the servo's time series covers every frame
     if not {"wall_position_lower", "wall_position_upper", "time"} <= set(ts):
         return None
     t = np.asarray(ts["time"], float)

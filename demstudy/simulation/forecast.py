@@ -412,7 +412,8 @@ def expected_events(scene: Scene, pilot: PilotResult | None = None,
     if references is not None and Path(references).is_dir():
         rates = reference_rates(scene, Path(references), engine, exclude=out)
     if rates is None:
-        rates = pilot_rates(pilot, accelerates(scene))
+        rates = pilot_rates(pilot, accelerates(scene),
+                            scene.run.equilibration + scene.run.production)
     if rates is None:
         rates = estimated_rates(scene, typical_temperature(scene))
         if accelerates(scene):
@@ -436,7 +437,7 @@ def accelerates(scene: Scene) -> bool:
     if scene.gravity is None:
         return False
     periodic = [a != 1 or scene.y_periodic for a in range(scene.dimension)]
-    return any(p and abs(g) > 1e-9 for p, g in zip(periodic, scene.gravity.direction,
+    return any(p and abs(g) > 1e-9 for p, g in zip(periodic, scene.gravity_vector,
                                                      strict=False))
 
 

@@ -119,12 +119,14 @@ def estimated_rates(scene: Scene, temperature: float) -> EventRates:
                       f"particle per τ at T = {temperature:.3g}")
 
 
-def pilot_rates(pilot, accelerating: bool = False) -> EventRates | None:
+def pilot_rates(pilot, accelerating: bool = False,
+                duration: float | None = None) -> EventRates | None:
     """The rates of the pilot's last window (None for a pilot without window counts: an
     older cache entry). A lower bound when the flow is ``accelerating`` (gravity along a
     periodic axis: it speeds up over 10²–10³ τ, a pilot of seconds sees its start; measured
     in Malik's runs: 3–12× the pilot's events per particle per τ once the flow is steady)
-    or when the pilot stopped on its wall-time cap while its event rate still grew."""
+    or when the pilot stopped on its wall-time cap while its event rate still grew; never
+    when the pilot covered the whole run (``duration``, in τ): it then saw every event."""
     if not (pilot is not None and pilot.usable and pilot.window_time > 0):
         return None
     per = pilot.n_particles * pilot.window_time
@@ -132,7 +134,10 @@ def pilot_rates(pilot, accelerating: bool = False) -> EventRates | None:
     crossings = pilot.window_crossings / per
     why = ""
     rising = pilot.rate_growth > 1 + STILL_RISING
-    if accelerating:
+    whole_run = duration is not None and pilot.simulated_time >= duration * (1 - 1e-9)
+    if whole_run:
+        pass  # the pilot was the run: its counts are the run's
+    elif accelerating:
         why = (f"gravity accelerates the flow along a periodic axis and the pilot saw its "
                f"first {pilot.simulated_time:.3g} τ (event rate ×{pilot.rate_growth:.3g} "
                "over its windows): a steady flow has more events; a finished run of the "
@@ -157,13 +162,16 @@ def pilot_rates(pilot, accelerating: bool = False) -> EventRates | None:
 # -- finished runs of the same scene family -------------------------------------------------
 def same_family(scene: Scene, other: Scene) -> bool:
     """Whether a finished run of ``other`` tells the event rates of ``scene``: the same
-    dimension, walls, gravity and shear, the same wall gap (box size along y) and a solid
-    fraction within ``FAMILY_PHI``; N, the periodic lengths, e and β may differ."""
+    dimension, walls and their speeds, gravity (vector, magnitude included) and shear rate
+    (the drive sets the flow's speed and so its event rates), the same wall gap (box size
+    along y) and a solid fraction within ``FAMILY_PHI``; N, the periodic lengths, e and β
+    may differ."""
     def shape(s: Scene) -> tuple:
-        gravity = None if s.gravity is None else tuple(round(x, 6) for x in
-                                                        s.gravity.direction)
-        return (s.dimension, tuple(w.side for w in s.walls), gravity, s.shear is None,
-                s.y_periodic, round(s.box.size[1], 6))
+        g = s.gravity_vector
+        gravity = None if g is None else tuple(round(x, 6) for x in g)
+        return (s.dimension, tuple((w.side, round(w.velocity, 6)) for w in s.walls), gravity,
+                None if s.shear is None else round(s.shear.rate, 6), s.y_periodic,
+                round(s.box.size[1], 6))
     return (shape(scene) == shape(other)
             and abs(other.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI)
 

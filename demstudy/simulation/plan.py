@@ -126,9 +126,10 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
             and "finished run" not in forecast.basis
             and (forecast.seconds > PILOT_WORTH or forecast.lower_bound)):
         # a long event-driven run: a pilot of ≤ 10 % of it measures the real collision rate;
-        # a flow that gravity accelerates: Enskog knows nothing of its speed, a whole pilot
-        seconds = PILOT_SECONDS if forecast.lower_bound else min(PILOT_SECONDS,
-                                                                 0.1 * forecast.seconds)
+        # a flow that gravity accelerates: Enskog knows nothing of its speed, a longer pilot
+        # (at least 1 s, yet never more than a tenth of a longer run's own forecast)
+        floor = 1.0 if forecast.lower_bound else 0.0
+        seconds = min(PILOT_SECONDS, max(floor, 0.1 * forecast.seconds))
         pilot = run_pilot(scene, seconds=seconds)
         try:
             forecast = forecast_run(scene, backend, None, pilot, costs, measure=not dry_run,
