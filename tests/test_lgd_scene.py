@@ -186,3 +186,14 @@ def test_lgd_refuses_a_scene_without_a_lattice(tmp_path):
             "contact": {"restitution": 0.9}, "run": {"equilibration": 0, "production": 1}}
     with pytest.raises(UnsupportedByEngine, match=r"lattice = None: .*lattice scenes only"):
         check_run(get_backend("lgd"), validate_scene(data), RunOptions(out=tmp_path / "x.h5"))
+
+
+def test_steps_phases_must_be_whole_sample_intervals():
+    """With run.unit = 'steps' the samples fall on whole intervals: a production that is no
+    multiple of the interval is refused (it would silently run another number of steps)."""
+    from demstudy.scene import load_scene
+
+    with pytest.raises(SceneError, match=r"run.production = 1000: .* multiple of "
+                                         r"run.sample_interval = 32"):
+        load_scene("gutt1989/gas-box", ["run.production=1000"])
+    assert load_scene("gutt1989/gas-box", ["run.production=1024"]).run.production == 1024

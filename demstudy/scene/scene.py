@@ -272,6 +272,15 @@ class Scene(StrictModel):
             if run.sample_interval < 1:
                 problems.append(f"run.sample_interval = {run.sample_interval:g}: with unit = "
                                 "'steps' at least 1 step is allowed")
+            elif not problems:
+                # samples fall on whole intervals: a phase that is no multiple of the
+                # interval would silently run a different number of steps
+                for name in ("equilibration", "production"):
+                    value = getattr(run, name)
+                    if value % run.sample_interval:
+                        problems.append(
+                            f"run.{name} = {value:g}: with unit = 'steps' a multiple of "
+                            f"run.sample_interval = {run.sample_interval:g} is allowed")
         return problems
 
     def _sheared_gravity_problems(self) -> list[str]:
