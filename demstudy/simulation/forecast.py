@@ -36,8 +36,9 @@ benchmark runs through the same simulation loop (a least-squares fit with non-ne
 costs, ``scipy.optimize.nnls``) and cached in ``machine-rates.json`` of demstudy's cache
 folder ($XDG_CACHE_HOME/demstudy, default ~/.cache/demstudy) with the CPU model; another
 CPU, ``demstudy forecast --measure`` or ``measure_costs(..., remeasure=True)`` measures
-again; a run that measures says so on stderr first, a ``--dry-run`` never measures
-(``measure=False``). Parallel workers update the file under a lock
+again; a run that measures says so on stderr first, a ``--dry-run`` never runs these
+benchmarks (``measure=False``; it still times the scene's own analyses on one synthetic
+frame and the checkpoint write speed on a temporary file, :func:`scene_costs`). Parallel workers update the file under a lock
 (``demstudy.cache.locked``). The forecast covers the simulation loop (the results file's
 ``wall_seconds``), not the engine's start-up nor the pilot.
 """
