@@ -38,9 +38,10 @@ folder ($XDG_CACHE_HOME/demstudy, default ~/.cache/demstudy) with the CPU model;
 CPU, ``demstudy forecast --measure`` or ``measure_costs(..., remeasure=True)`` measures
 again; a run that measures says so on stderr first, a ``--dry-run`` never runs these
 benchmarks (``measure=False``; it still times the scene's own analyses on one synthetic
-frame and the checkpoint write speed on a temporary file, :func:`scene_costs`). Parallel workers update the file under a lock
-(``demstudy.cache.locked``). The forecast covers the simulation loop (the results file's
-``wall_seconds``), not the engine's start-up nor the pilot.
+frame and the checkpoint write speed on a temporary file, :func:`scene_costs`). Parallel
+workers update the file under a lock (``demstudy.cache.locked``). The forecast covers the
+simulation loop (the results file's ``wall_seconds``), not the engine's start-up nor the
+pilot.
 """
 
 from __future__ import annotations
@@ -122,8 +123,9 @@ class Forecast:
 
     def line(self) -> str:
         if self.lower_bound:
-            return (f"forecast: at least {_duration(self.seconds)} (a lower bound: "
-                    f"{self.lower_bound}) from {self.basis}")
+            return (f"forecast: probably more than {_duration(self.seconds)} (likely low: "
+                    f"{self.lower_bound}; such forecasts met ×0.7–2.3 of the actual time "
+                    f"in the 12 measured runs, docs/forecast.md) from {self.basis}")
         return (f"forecast: {_duration(self.seconds)} (measured accuracy: within "
                 f"×{self.factor:g} in {self.accuracy_met}) from {self.basis}")
 
