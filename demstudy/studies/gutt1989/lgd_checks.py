@@ -271,8 +271,8 @@ def couette(runs: Mapping[str, m.LgdRun], out: Path, an: Analysis) -> None:
             [(profs[n], t) for n, t in shown], out, "lgd_couette_profiles.png",
             "Couette (figs 3.21b, 3.23b): row profiles v̄x (red), v̄y (green), thermal "
             "velocity (blue) in units of the wall speed, averaged over the frames of the last "
-            "256 steps (error bars: their standard error); the last three panels are the "
-            "diagnostic runs", speed_label="velocity (wall speed U)"))
+            f"{COUETTE_WINDOW} steps (error bars: their standard error); the last three "
+            "panels are the diagnostic runs", speed_label="velocity (wall speed U)"))
     stress = [(runs[n], t) for n, t in shown[:2]]
     if stress:
         an.figures.append(figs.wall_stress(
