@@ -10,6 +10,9 @@ Proxies (the thesis's statements are about pictures; each proxy is named in its 
 * hourglass "nearly linear": the rates fitted to the two halves of the discharge window agree
   within ``LINEAR_RATE`` (relative); funnel flow: in the converging part of the bin the
   grains near the funnel walls move at less than ``SIDE_SLOW`` of the speed near the axis;
+  surface depression: the free surface (per ``SURFACE_BAND``-wide band across the bin, the
+  first 2 d slab along g that is more than half full) lies at least ``DEPRESSION`` deeper
+  in the central third of the width than in the outer thirds;
 * obstacles (frame at 512 steps; gravity along +x, so "below" is downstream): the **void**
   is the empty-node fraction of a box right below the obstacle (its half width along the
   flow, ±¼ of its width across), and its **length** the distance below the obstacle until
@@ -40,6 +43,11 @@ from .lgd_checks import not_run
 LINEAR_RATE, SIDE_SLOW, STAGNANT, STATIC_NODES = 0.25, 0.5, 0.5, 0.9
 #: thesis values (digest §3.15, L1119-L1127): band width, σ/p, final σ over g·N/N_wall
 BAND_WIDTH, SIGMA_OVER_P, FINAL_SHEAR = 30.0, 0.25, 150.0 / 252.0
+#: hourglass surface: band width across the bin (d) and the depth (d, along g) that counts
+#: as a depression: a few grain diameters, well above the ±2 d a 2 d slab resolves
+SURFACE_BAND, DEPRESSION = 8.0, 5.0
+#: the step of the thesis's picture of the hourglass (fig 3.24b)
+HOURGLASS_PICTURE = 2048
 
 
 def flows(runs: Mapping[str, m.LgdRun], out: Path, an: Analysis, quick: bool) -> None:
@@ -73,6 +81,24 @@ def funnel_speeds(pos: np.ndarray, vel: np.ndarray, walls: np.ndarray, x_range: 
             float(np.mean(core)) if core else math.nan)
 
 
+def surface_depth(pos: np.ndarray, width: float, x_max: float) -> tuple[float, float]:
+    """Mean free-surface position along g (+x) in the central third of the bin's width and
+    in its outer thirds: per ``SURFACE_BAND``-wide band, the first 2 d slab (x < ``x_max``,
+    the bin above the funnel) whose nodes are more than half occupied; a band with no such
+    slab has drained below the bin (counted as ``x_max``)."""
+    slab = 2.0
+    centre, sides = [], []
+    for y0 in np.arange(0.0, width - SURFACE_BAND / 2, SURFACE_BAND):
+        x = pos[(pos[:, 1] >= y0) & (pos[:, 1] < y0 + SURFACE_BAND), 0]
+        counts, edges = np.histogram(x, bins=np.arange(0.0, x_max + slab, slab))
+        full = np.flatnonzero(counts / (slab * SURFACE_BAND / m.ROW) > 0.5)
+        depth = float(edges[full[0]]) if full.size else x_max
+        off = abs(y0 + SURFACE_BAND / 2 - width / 2) / width
+        (centre if off < 1 / 6 else sides).append(depth)
+    return (float(np.mean(centre)) if centre else math.nan,
+            float(np.mean(sides)) if sides else math.nan)
+
+
 def hourglass(run: m.LgdRun | None, out: Path, an: Analysis) -> None:
     ref = "L1081-L1091, figs 3.24-3.26"
     if run is None:
@@ -95,18 +121,29 @@ def hourglass(run: m.LgdRun | None, out: Path, an: Analysis) -> None:
     walls = ini["walls"][(ini["wall_rows"] > 0) & (ini["wall_rows"] < run.nyt - 1)]
     funnel = walls[(walls[:, 0] > 60) & (walls[:, 0] < 118)]
     yc = 0.5 * (run.nyt - 1) * m.ROW
-    i = run.frame_at(1024) if 1024 in run.frame_steps else len(run.frame_steps) - 1
+    i = (run.frame_at(HOURGLASS_PICTURE) if HOURGLASS_PICTURE in run.frame_steps
+         else len(run.frame_steps) - 1)
     side, core = funnel_speeds(run.position[i], run.velocity[i], funnel, (80, 116), yc)
     ratio = side / core
+    funnel_flow = ratio < SIDE_SLOW
+    mid, outer = surface_depth(run.position[i], 2 * yc, float(funnel[:, 0].min()))
+    depressed = mid - outer >= DEPRESSION
+    verdict = (REPRODUCED if funnel_flow and depressed
+               else PARTLY if funnel_flow or depressed else NOT_REPRODUCED)
+    why = [s for s, failed in (
+        (f"only {run.frame_steps[i]} steps kept (the thesis's picture is at "
+         f"{HOURGLASS_PICTURE})", run.frame_steps[i] < HOURGLASS_PICTURE),
+        ("the side zones move too (mass flow rather than funnel flow)", not funnel_flow),
+        ("no surface depression", not depressed)) if failed]
     an.checks.append(Check(
         ref, "after 2048 steps: funnel (core) flow with static side zones and a surface "
              "depression (fig 3.24b)", "qualitative",
         f"step {run.frame_steps[i]}, converging part x = 80-116 d: mean speed in the outer "
         f"30 % of the half width {side:.2f}, in the inner 30 % {core:.2f} √(gd) (ratio "
-        f"{ratio:.2f}, funnel flow if < {SIDE_SLOW})",
-        REPRODUCED if ratio < SIDE_SLOW else PARTLY,
-        "" if ratio < SIDE_SLOW else "the side zones move too (mass flow rather than funnel "
-        "flow)"))
+        f"{ratio:.2f}, funnel flow if < {SIDE_SLOW}); free surface along g (bin x < "
+        f"{funnel[:, 0].min():.0f} d) at {mid:.1f} d in the central third of the width vs "
+        f"{outer:.1f} d in the outer thirds (a depression if ≥ {DEPRESSION:g} d deeper)",
+        verdict, "; ".join(why)))
     an.figures.append(figs.positions(
         [(run, run.frame_at(s), ini["walls"], "hourglass") for s in (1024, 2048)
          if s in run.frame_steps], out, "lgd_hourglass_positions.png",
