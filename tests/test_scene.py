@@ -89,9 +89,11 @@ def test_input_loads(path):
 @pytest.mark.parametrize("path", INPUTS, ids=IDS)
 def test_input_production_override(path):
     # 50: at least every shipped scene's sampling interval (Malik's largest boxes sample
-    # every 40 √(d/g))
-    scene = load_scene(path, ["run.production=50"])
-    assert scene.run.production == 50.0
+    # every 40 √(d/g)); lattice scenes counted in steps take whole sample intervals
+    interval = load_scene(path).run
+    production = 50 if interval.unit != "steps" else 2 * int(interval.sample_interval)
+    scene = load_scene(path, [f"run.production={production}"])
+    assert scene.run.production == production
 
 
 @pytest.mark.parametrize("path", INPUTS, ids=IDS)
