@@ -96,6 +96,27 @@ def test_initial_file_is_gutts_initial_data(tmp_path: Path):
     assert s.n_particles == 24
 
 
+def test_relative_initial_file_is_the_scene_folders(tmp_path: Path, monkeypatch):
+    """A scene file naming its initial-data file relatively means the file beside it, from
+    any working directory, and keeps meaning it once stored (the path is made absolute)."""
+    from demstudy.scene import load_scene
+
+    folder = tmp_path / "problem"
+    folder.mkdir()
+    (folder / "init").write_text("  nl = 1\n 3 1 2 12 3 0 0\n")
+    text = scene_to_toml(scene(lattice={"nxt": 12, "nyt": 8,
+                                        "initial_file": str(folder / "init")}))
+    (folder / "scene.toml").write_text(text.replace(str(folder / "init"), "init"))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    loaded = load_scene(folder / "scene.toml")
+    assert loaded.n_particles == 24
+    assert loaded.lattice.initial_file == str((folder / "init").resolve())
+    again = validate_scene(parse_scene_text(scene_to_toml(loaded)), "stored")
+    assert again.n_particles == 24
+
+
 # -- effects: presence and absence -------------------------------------------------------
 def test_absent_effects_leave_the_lattice_at_rest_and_elastic():
     setup = lattice_setup(scene())

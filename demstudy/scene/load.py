@@ -321,7 +321,19 @@ def load_scene(source: str | os.PathLike, overrides: Iterable[str] = (),
         check_depth(sections, f"{name} (keyword overrides)")
         data = apply_sections(data, sections, source=f"{name} (keyword overrides)")
     data = apply_overrides(data, overrides, source=name)
+    _anchor_files(data, path.parent)
     return validate_scene(data, name)
+
+
+def _anchor_files(data: dict, folder: Path) -> None:
+    """Files a scene names (a lattice's Gutt initial-data file) are relative to the scene
+    file's folder, not to where demstudy runs; made absolute here so that the scene, stored
+    in a results file or a checkpoint, validates from anywhere."""
+    lattice = data.get("lattice")
+    if isinstance(lattice, dict) and isinstance(lattice.get("initial_file"), str):
+        given = Path(lattice["initial_file"]).expanduser()
+        if not given.is_absolute():
+            lattice["initial_file"] = str((folder / given).resolve())
 
 
 def flat_fields(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
