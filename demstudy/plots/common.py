@@ -249,6 +249,21 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03,
     return fig
 
 
+def save_with_note(fig: Figure, path: str | Path, note: str, *, bottom: float = 0.04,
+                   dpi: int = 110, fontsize: float = 7, wrap: bool = False) -> Path:
+    """Write ``fig`` to ``path`` with ``note`` (units, constants) centred at the bottom, the
+    panels laid out above ``bottom`` (a figure fraction), and close it."""
+    import matplotlib.pyplot as plt
+
+    fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize=fontsize, wrap=wrap)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
 def save(fig: Figure, out: str | Path) -> Path:
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)

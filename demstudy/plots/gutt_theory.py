@@ -35,6 +35,7 @@ from ..theory import (  # noqa: E402
     wall_couette_sweep,
     wall_simple_shear_roughness,
 )
+from .common import save_with_note  # noqa: E402
 
 __all__ = ["CURVES", "K2", "SPIN", "WALL", "couette_figure", "fig_1_3", "fig_1_5",
            "fig_2_10", "fig_2_11", "fig_2_4_to_2_9"]
@@ -49,13 +50,7 @@ CH2_NOTE = ("γ = .16, q = .25, r = 1, t = 1, q_w = 1, r_w = 1, t_w = .5, h = 10
 
 def save(fig, out: Path, name: str, note: str) -> Path:
     """Write ``fig`` as out/name with the constants' note at the bottom; close it."""
-    fig.text(0.5, 0.005, note, ha="center", va="bottom", fontsize=7.5)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / name
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_with_note(fig, out / name, note, bottom=0.03, fontsize=7.5)
 
 
 # -- Ch. 1 ---------------------------------------------------------------------------------------

@@ -15,6 +15,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from ...plots.common import save_with_note  # noqa: E402
 from ...plots.gutt_theory import K2, WALL  # noqa: E402
 from ...theory import wall_couette_sweep  # noqa: E402
 from ..base import Figure  # noqa: E402
@@ -27,13 +28,7 @@ NOTE = ("d = 1, m = 1, u_w = 1 (no gravity); theory: Gutt's Ch. 2 solution, thes
 
 
 def _save(fig, out: Path, name: str, caption: str) -> Figure:
-    fig.text(0.5, 0.005, NOTE, ha="center", va="bottom", fontsize=7, wrap=True)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / name
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Figure(path, caption)
+    return Figure(save_with_note(fig, out / name, NOTE, wrap=True), caption)
 
 
 def against_roughness(runs: Sequence[CouetteRun], out: Path) -> Figure:

@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ...plots.common import save_with_note  # noqa: E402
 from ..base import Figure  # noqa: E402
 from .lgd_measure import ROW, LgdRun  # noqa: E402
 
@@ -27,13 +28,7 @@ NOTE = ("LGD (--engine lgd); d = 1 (lattice spacing), m = 1;\ng = 1 with gravity
 
 
 def _save(fig, out: Path, name: str, caption: str) -> Figure:
-    fig.text(0.5, 0.005, NOTE, ha="center", va="bottom", fontsize=7)
-    fig.tight_layout(rect=(0, 0.06, 1, 1))
-    out.mkdir(parents=True, exist_ok=True)
-    path = out / name
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return Figure(path, caption)
+    return Figure(save_with_note(fig, out / name, NOTE, bottom=0.06, dpi=100), caption)
 
 
 def _legend_room(ax) -> None:
