@@ -345,7 +345,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
                        dry_run=args.dry_run, analyse_only=args.analyse_only,
                        engines=[e.strip() for e in ",".join(args.engine).split(",")
                                 if e.strip()] if args.engine else None,
-                       only=args.only)
+                       only=args.only,
+                       # the full study keeps its run records with the docs (DOCS/data/...)
+                       records=(Path(args.docs) / "data" / "studies" / args.name / "records"
+                                if args.docs and not args.quick else None))
     if args.dry_run:
         return 0
     if args.docs:
@@ -629,10 +632,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dry-run", action="store_true",
                    help="print the runs to make and the forecast; run nothing")
     p.add_argument("--analyse-only", action="store_true",
-                   help="no runs: analyse the results files already made")
+                   help="no runs: analyse the results files (or run records) already made")
     p.add_argument("--docs", metavar="DOCS",
                    help="also publish the report and figures under DOCS (docs/studies/NAME.md,"
-                        " docs/figures/studies/NAME/)")
+                        " docs/figures/studies/NAME/) and keep the runs' records in "
+                        "DOCS/data/studies/NAME/records/, reused as made runs")
     p.set_defaults(func=_cmd_study)
 
     p = sub.add_parser("engine-map",

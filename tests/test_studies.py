@@ -222,3 +222,74 @@ def test_only_selects_what_to_run_and_the_report_covers_every_run_made(toy, tmp_
     second = run_study("toy", out=tmp_path, only=["cell-b"], echo=lambda s: None)
     assert second.made == ["cell-b"]
     assert [c.verdict for c in second.analysis.checks] == [REPRODUCED, REPRODUCED]
+
+
+# -- run records: a study's report made again without its results files ------------------
+def _toy_derive(name: str, path: Path) -> dict:
+    """What the toy study keeps of a run in place of its frames: the frames' count and the
+    mean x of the first frame (something only the frames hold)."""
+    res = ds.load(path)
+    frames = list(res.iter_frames())
+    return {"toy": ({"first_mean_x": frames[0].position[:, 0].mean()},
+                    {"frames": len(frames)})}
+
+
+def _recorded_toy(monkeypatch) -> Study:
+    from dataclasses import replace
+
+    kept = merge(SHORT, {"measure": {"keep_frames": True}})
+    study = replace(TOY, cases=lambda q: [Case("cell-a", "campbell1982/couette-rough",
+                                               sections=kept)],
+                    derive=_toy_derive)
+    monkeypatch.setattr(sys.modules["demstudy_toy_study"], "STUDY", study)
+    return study
+
+
+def test_records_stand_in_for_missing_runs_and_are_remade_when_stale(toy, tmp_path, monkeypatch):
+    """A study with ``derive`` writes a record of each run (no frames, no collision log, the
+    derived group, the run's attributes); without the runs a rerun reuses the records as made
+    runs and its analysis reads them; a record of another scene or a damaged one is not used
+    (the run is made again)."""
+    import h5py
+
+    from demstudy.studies.records import RECORD_VERSION
+
+    _recorded_toy(monkeypatch)
+    records = tmp_path / "records"
+    first = run_study("toy", out=tmp_path / "a", records=records, echo=lambda s: None)
+    assert first.made == ["cell-a"]
+    record = records / "cell-a.h5"
+    full = tmp_path / "a" / "runs" / "cell-a.h5"
+    with h5py.File(record, "r") as f:
+        assert "frames" not in f and "collisions" not in f
+        assert "frames" in h5py.File(full, "r")
+        assert f.attrs["record_of"] == "cell-a.h5" and f.attrs["record_version"] == RECORD_VERSION
+        assert f["study/toy"].attrs["frames"] > 2
+        assert "scene_toml" in f.attrs and "wall_seconds" in f.attrs
+    kept = ds.load(full)
+    assert ds.load(record).groups["study/toy"]["first_mean_x"] == pytest.approx(
+        next(kept.iter_frames()).position[:, 0].mean())
+
+    # a fresh checkout: the study folder is gone, the records are there
+    second = run_study("toy", out=tmp_path / "b", records=records, echo=lambda s: None)
+    assert second.made == [] and second.from_records == ["cell-a"]
+    assert second.analysis.checks[0].verdict == REPRODUCED
+    assert second.analysis.checks[0].measured == first.analysis.checks[0].measured
+    assert "1 from their records" in second.report.read_text()
+
+    record.write_bytes(record.read_bytes()[:2000])  # damaged: remade by running again
+    third = run_study("toy", out=tmp_path / "c", records=records, echo=lambda s: None)
+    assert third.made == ["cell-a"] and (records / "cell-a.h5").stat().st_size > 2000
+
+    changed = merge(SHORT, {"measure": {"keep_frames": True}, "run": {"production": 12.0}})
+    from dataclasses import replace
+    monkeypatch.setattr(sys.modules["demstudy_toy_study"], "STUDY", replace(
+        sys.modules["demstudy_toy_study"].STUDY,
+        cases=lambda q: [Case("cell-a", "campbell1982/couette-rough", sections=changed)]))
+    fourth = run_study("toy", out=tmp_path / "d", records=records, echo=lambda s: None)
+    assert fourth.made == ["cell-a"], "a record of another scene is not the run"
+
+
+def test_a_study_without_derive_keeps_no_records(toy, tmp_path):
+    run_study("toy", out=tmp_path, only=["cell-a"], echo=lambda s: None)
+    assert not (tmp_path / "records").exists()

@@ -170,3 +170,20 @@ def test_wall_values_follow_malik_two_bin_rule(tiny_run):
     info = d.run_info()
     assert info["production"] == pytest.approx(40.0, rel=0.05)
     assert info["collisions_per_particle"] > 0 and math.isfinite(info["wall_seconds"])
+
+
+def test_a_record_analyses_as_its_run(tiny_run, tmp_path):
+    """The study record of a run (no frames: the in-bin g(r) and the S-wave modes kept) gives
+    the same checks as the run itself."""
+    from demstudy.studies.malik2008.poiseuille_data import load_flow
+    from demstudy.studies.records import write_record
+
+    flow, path, out = tiny_run
+    record = write_record(path, tmp_path / f"{flow.name}.h5", poiseuille.derive(flow.name, path))
+    kept = load_flow(flow, record)
+    assert kept.res.frames is None and "study/gr" in kept.res.groups
+    np.testing.assert_array_equal(kept.gr["g"], load_flow(flow, path).gr["g"])
+    a = poiseuille.analyse({flow.name: path}, out, quick=True)
+    b = poiseuille.analyse({flow.name: record}, tmp_path, quick=True)
+    assert [(c.measured, c.verdict) for c in b.checks] == [(c.measured, c.verdict)
+                                                          for c in a.checks]

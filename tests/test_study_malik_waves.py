@@ -226,3 +226,33 @@ def test_plug_turning_into_slug_is_not_steady_though_energy_is(tmp_path: Path) -
     steady = measure(_synthetic_run(tmp_path / "steady.h5", plug))
     assert steady.stationary and steady.modes.pattern == "plug"
     assert steady_check(box, steady).verdict == REPRODUCED
+
+
+def test_a_record_measures_as_its_run(tmp_path: Path) -> None:
+    """A study record keeps the modes, the peak densities and the last frame instead of the
+    frames: measuring it gives what measuring the full results file gives."""
+    import h5py
+
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.records import write_record
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    full = _synthetic_run(tmp_path / "full.h5", slug)
+    record = write_record(full, tmp_path / "record.h5",
+                          waves.derive(waves.BOXES[0].name, full))
+    assert waves.derive("not-a-box", full) == {}
+    with h5py.File(record, "r") as f:
+        assert "frames" not in f
+    a, b = measure(full), measure(record)
+    assert [h.pattern for h in b.halves] == [h.pattern for h in a.halves] == ["plug", "slug"]
+    assert b.modes.pattern == a.modes.pattern and b.stationary == a.stationary
+    assert b.balance == a.balance and b.ke_halves == a.ke_halves and b.rate == a.rate
+    assert b.peak == pytest.approx(a.peak) and b.peak_coarse == pytest.approx(a.peak_coarse)
+    assert b.close_packed == a.close_packed and b.n == a.n
+    np.testing.assert_allclose(b.snapshot.position, a.snapshot.position, rtol=1e-6)
+    np.testing.assert_allclose(b.modes.results["family_power_xy"],
+                               a.modes.results["family_power_xy"])
+    for drift_a, drift_b in zip(a.drifts, b.drifts, strict=True):
+        assert drift_b.sigmas == pytest.approx(drift_a.sigmas)

@@ -106,7 +106,8 @@ class Analysis:
 class Study:
     """A seed study: ``cases(quick)`` lists its runs; ``analyse(runs, out, quick)`` reads
     them (``runs``: case name → results file path, only the cases of this run of the
-    study) and writes its figures into ``out``."""
+    study) and writes its figures into ``out``; ``derive`` (optional) lets the study keep
+    records of its runs that its analysis reads as it reads the runs."""
 
     name: str
     title: str
@@ -114,6 +115,10 @@ class Study:
     summary: str
     cases: Callable[[bool], Sequence[Case]]
     analyse: Callable[[Mapping[str, Path], Path, bool], Analysis]
+    #: what a record keeps of a run in place of its frames and collision log (``derive(case
+    #: name, results file)``, demstudy.studies.records); None: the study keeps no records
+    #: (its analysis needs the full results files)
+    derive: Callable[[str, Path], Mapping[str, Any]] | None = None
 
 
 def pm(value: float, err: float | None = None, digits: int = 2) -> str:

@@ -31,3 +31,15 @@ def combined_analysis(parts: Sequence[ModuleType]):
             total.sections += ana.sections
         return total
     return analyse
+
+
+def combined_derive(parts: Sequence[ModuleType]):
+    """The parts' ``derive(name, path)`` (what a study record keeps of a run, module
+    demstudy.studies.records), merged: each part answers for its own cases."""
+    def derive(name: str, path: Path) -> dict:
+        out: dict = {}
+        for part in parts:
+            if hasattr(part, "derive"):
+                out.update(part.derive(name, path))
+        return out
+    return derive

@@ -41,7 +41,10 @@ def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "")
         "```",
         "",
         f"Generated {_dt.date.today().isoformat()} on {machine}: {len(result.made)} runs made, "
-        f"{len(result.reused)} reused, {len(result.failed)} failed"
+        f"{len(result.reused)} reused"
+        + (f" ({len(result.from_records)} from their records: demstudy.studies.records)"
+           if result.from_records else "")
+        + f", {len(result.failed)} failed"
         + (f" ({', '.join(result.failed)})" if result.failed else "")
         + f"; the runs took {result.run_seconds / 60:.1f} min of engine time in all"
         + f" (this invocation {result.wall_seconds / 60:.1f} min)"

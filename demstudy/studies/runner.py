@@ -4,7 +4,10 @@ resumes), the analysis, the report.
 
 Runs go to ``<out>/runs/<case>.h5`` (``out`` default ``results/studies/<name>`` and
 ``results/studies/<name>-quick`` for ``--quick``); figures and the report ``<name>.md`` to
-``out``; ``publish`` copies report and figures into the docs (``--docs``).
+``out``; ``publish`` copies report and figures into the docs (``--docs``). A study that keeps
+records of its runs (``Study.derive``, demstudy.studies.records) writes them to ``records``
+(default ``<out>/records/``; ``--docs DOCS``: ``DOCS/data/studies/<name>/records/``, kept with
+the docs) and counts a run whose record is there as made: its analysis reads the record.
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 """
 
@@ -88,6 +91,8 @@ class StudyRun:
     made: list[str] = field(default_factory=list)
     reused: list[str] = field(default_factory=list)
     failed: list[str] = field(default_factory=list)
+    #: the reused runs whose results file is absent: read from their records
+    from_records: list[str] = field(default_factory=list)
     wall_seconds: float = 0.0
     #: the runs' own wall times summed (the results files' ``wall_seconds``): the study's
     #: compute cost, whether its runs were made now or reused
@@ -171,14 +176,16 @@ def _duration(seconds: float) -> str:
 def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
               workers: int = 1, dask: Any = None, dry_run: bool = False,
               engines: Sequence[str] | None = None, only: Sequence[str] | None = None,
-              analyse_only: bool = False, echo=print) -> StudyRun:
+              analyse_only: bool = False, records: str | Path | None = None,
+              echo=print) -> StudyRun:
     """Run study ``name`` (module doc). ``dry_run``: the forecast only. ``analyse_only``:
     no runs, analyse the results files already there. ``engines``/``only`` select the cases
     to run; the analysis and report cover every run of the study already made. A failed run
     does not stop the others nor the analysis: its checks say "not run" and ``failed`` lists
-    it."""
+    it. ``records``: where the study's run records are kept (module doc)."""
     from ..accuracy.execute import execute, is_done
     from . import get_study
+    from .records import current
 
     study = get_study(name)
     if workers < 1:
@@ -188,9 +195,18 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     started = time.perf_counter()
     tasks = tasks_of(study, quick, out, engines, only)
     result = StudyRun(study, out)
+    record_dir = (Path(records) if records is not None else out / "records") \
+        if study.derive is not None else None
     todo, done = [], []
     for task in tasks:
-        (done if is_done(task.path, task.scene_toml) else todo).append(task)
+        if is_done(task.path, task.scene_toml):
+            done.append(task)
+        elif record_dir is not None and current(record_dir / f"{task.case.name}.h5", None,
+                                                task.scene_toml):
+            done.append(task)
+            result.from_records.append(task.case.name)
+        else:
+            todo.append(task)
     result.reused = [t.case.name for t in done]
     echo(f"study {study.name}{' (quick)' if quick else ''}: {len(tasks)} runs, "
          f"{len(done)} already made, {len(todo)} to make; results in {out}/")
@@ -227,7 +243,15 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     # the analysis reads every run of the study already made, not only those selected to
     # make now (``engines``/``only`` choose what to run; the report covers the whole study)
     every = tasks_of(study, quick, out) if (engines or only) else tasks
-    runs = {t.case.name: t.path for t in every if t.path.is_file()}
+    runs = {}
+    for t in every:
+        record = record_dir / f"{t.case.name}.h5" if record_dir is not None else None
+        if record is not None and keep_record(study, t, record, echo):
+            runs[t.case.name] = record
+            if t.case.name not in result.from_records and not t.path.is_file():
+                result.from_records.append(t.case.name)
+        elif t.path.is_file():
+            runs[t.case.name] = t.path
     result.run_seconds = sum(_run_seconds(p) for p in runs.values())
     out.mkdir(parents=True, exist_ok=True)
     result.analysis = study.analyse(runs, out, quick)
@@ -235,6 +259,29 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     result.report = write_report(result, quick)
     echo(f"report: {result.report}")
     return result
+
+
+def keep_record(study: Study, task: StudyTask, record: Path, echo=print) -> bool:
+    """Whether ``record`` holds the run of ``task`` after this call: a finished results file
+    without a current record gets one (``Study.derive``); a record whose run is absent is
+    kept as it is (module doc)."""
+    from ..accuracy.execute import is_done
+    from ..errors import BadInputFile
+    from .records import current, write_record
+
+    full = task.path if is_done(task.path, task.scene_toml) else None
+    if current(record, full, task.scene_toml):
+        return True
+    if full is None:
+        return False
+    try:
+        write_record(full, record, study.derive(task.case.name, full))
+    except (BadInputFile, KeyError, ValueError, OSError) as exc:
+        # the analysis then reads the results file itself, as without records
+        echo(f"warning: no record of {task.case.name} ({type(exc).__name__}: {exc})")
+        return False
+    echo(f"  record {record}")
+    return True
 
 
 def _run_seconds(path: Path) -> float:

@@ -7,7 +7,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (times √(d/g), speeds √(gd
 from __future__ import annotations
 
 from ..base import Study
-from ..parts import combined_analysis, combined_cases
+from ..parts import combined_analysis, combined_cases, combined_derive
 from . import poiseuille, waves
 
 PARTS = (poiseuille, waves)
@@ -23,4 +23,5 @@ STUDY = Study(
             "in LAMMPS and LIGGGHTS where meaningful, analysed in the thesis's forms.",
     cases=combined_cases(PARTS),
     analyse=combined_analysis(PARTS),
+    derive=combined_derive(PARTS),
 )

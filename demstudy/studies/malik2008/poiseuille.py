@@ -13,10 +13,21 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
+import numpy as np
+
+from ...io.results import read_results
 from ..base import NOT_RUN, UNITS_NOTE, Analysis, Check, Figure
 from . import poiseuille_checks as pc
 from .poiseuille_cases import BETAS, QUICK, RESTITUTIONS, Flow, cases, flows
-from .poiseuille_data import BINS, BINS_DENSE, CENTRE_BIN, FlowData, collisions_text, load_flow
+from .poiseuille_data import (
+    BINS,
+    BINS_DENSE,
+    CENTRE_BIN,
+    FlowData,
+    collisions_text,
+    flow_gr,
+    load_flow,
+)
 from .poiseuille_figures import (
     gr_figure,
     lambda_figure,
@@ -26,8 +37,9 @@ from .poiseuille_figures import (
     vdf_figure,
     wall_figure,
 )
+from .poiseuille_waves import frame_mode_ratios
 
-__all__ = ["analyse", "cases"]
+__all__ = ["analyse", "cases", "derive"]
 
 Runs = dict[tuple[float, float, float], FlowData]  # (φ, β, e) -> run
 
@@ -49,6 +61,24 @@ def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
         flow = known.get(name)
         if flow is not None and flow.engine == "edmd" and Path(path).is_file():
             out[(flow.phi, flow.beta, flow.e)] = load_flow(flow, Path(path))
+    return out
+
+
+def derive(name: str, path: Path) -> dict[str, tuple[dict, dict]]:
+    """What a study record (demstudy.studies.records) keeps of run ``name`` in place of its
+    frames: the in-bin g(r) and the xy density modes of the S-wave check."""
+    flow = {**_known_flows(True), **_known_flows(False)}.get(name)
+    if flow is None or flow.engine != "edmd":
+        return {}
+    res = read_results(path, skip=("frames", "collisions"))
+    out: dict[str, tuple[dict, dict]] = {}
+    gr = flow_gr(flow, Path(path), res.profiles["edges"])
+    if gr:
+        out["gr"] = (gr, {"description": "in-bin g(r) (Malik §4.7) from the run's frames"})
+    ratios = frame_mode_ratios(Path(path))
+    out["mode_ratios"] = ({k: np.array(v) for k, v in ratios.items()}, {
+        "description": "R = <|X(k)|^2>/N over the frames (mean, standard error) of the xy "
+                       "count modes 11 = (1, ±1), 10 = (1, 0), 01 = (0, 1); shot noise = 1"})
     return out
 
 

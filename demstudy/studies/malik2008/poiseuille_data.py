@@ -20,6 +20,7 @@ import numpy as np
 
 from ...analysis.pair_correlation import PairCorrelation
 from ...io.results import Results, read_results
+from ..records import derived
 from .poiseuille_cases import Flow
 
 #: Malik's bins (1-based) shown in the VDF and g(r) figures (φ = 0.5: 1, 3, 13)
@@ -109,13 +110,20 @@ def in_bin_gr(path: Path, edges: np.ndarray, r_max: float = 5.0, dr: float = 0.0
     return dict(pc.results)
 
 
+def flow_gr(flow: Flow, path: Path, edges: np.ndarray) -> dict[str, np.ndarray]:
+    """The in-bin g(r) of the run of ``flow`` at ``path`` from its frames (dilute: wider
+    shells, g ≈ 1 is flat and the counts are few)."""
+    return in_bin_gr(Path(path), edges, dr=0.1 if flow.phi < 0.05 else 0.05)
+
+
 def load_flow(flow: Flow, path: Path, with_gr: bool = True) -> FlowData:
-    """The run of ``flow`` at ``path`` (``with_gr``: compute the in-bin g(r) from frames)."""
+    """The run of ``flow`` at ``path`` (``with_gr``: the in-bin g(r), as a study record keeps
+    it or computed from the frames)."""
     res = read_results(path, skip=("frames", "collisions"))
     data = FlowData(flow, Path(path), res)
-    if with_gr:  # dilute: wider shells (g ≈ 1 is flat, the counts are few)
-        data.gr = in_bin_gr(Path(path), res.profiles["edges"],
-                            dr=0.1 if flow.phi < 0.05 else 0.05)
+    if with_gr:
+        kept = derived(res.groups, "gr")
+        data.gr = kept if kept is not None else flow_gr(flow, Path(path), res.profiles["edges"])
     return data
 
 

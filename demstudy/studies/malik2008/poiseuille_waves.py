@@ -10,18 +10,30 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from ...io.results import read_results
+from ..records import derived
 from .poiseuille_data import FlowData
 
 CELLS = 10
 
 
 def mode_ratios(d: FlowData) -> dict[str, tuple[float, float]]:
-    """R (mean, error) of the modes (1, ±1) (S-wave), (1, 0) (slug) and (0, 1) (plug)."""
-    full = read_results(d.path, skip=("collisions",))
-    size = d.res.scene.box.size
+    """R (mean, error) of the modes (1, ±1) (S-wave), (1, 0) (slug) and (0, 1) (plug): as a
+    study record keeps them, or from the run's frames."""
+    kept = derived(d.res.groups, "mode_ratios")
+    if kept is not None:
+        return {k: (float(v[0]), float(v[1])) for k, v in kept.items()}
+    return frame_mode_ratios(d.path)
+
+
+def frame_mode_ratios(path: Path) -> dict[str, tuple[float, float]]:
+    """``mode_ratios`` from the frames of the results file at ``path``."""
+    full = read_results(path, skip=("collisions",))
+    size = full.scene.box.size
     per_frame: dict[str, list[float]] = {"11": [], "10": [], "01": []}
     for frame in full.iter_frames():
         x = np.mod(frame.position[:, 0], size[0])

@@ -38,6 +38,16 @@ def cases(quick: bool) -> list[Case]:
     return out
 
 
+def derive(name: str, path: Path) -> dict[str, tuple[dict, dict]]:
+    """What a study record keeps of box run ``name`` in place of its frames (the modes, the
+    peak densities, the last frame: waves_measure.derive)."""
+    if not any(box.name == name for box in BOXES):
+        return {}
+    from .waves_measure import derive as derive_waves
+
+    return derive_waves(Path(path))
+
+
 def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     from .waves_report import analyse_waves
 

@@ -230,9 +230,20 @@ def plane_fields(frame: Frame, lo: np.ndarray, hi: np.ndarray, cells: np.ndarray
     return ca, cb, nu.reshape(na, nb), ua.reshape(na, nb), ub.reshape(na, nb)
 
 
-def _scan(f: h5py.File, eq_end: float, size: np.ndarray):
-    """One pass over the production frames: the mode analysis of the whole production and
-    of each half, the peak densities per frame (2 d and COARSE d columns), the last frame."""
+@dataclass
+class Scan:
+    """What one pass over the production frames gives (``_scan``), or its stored copy in a
+    study record (``derive``/``_stored``): the modes of the whole production and of each
+    half, the peak densities per frame (2 d and COARSE d columns) and the last frame."""
+
+    modes: Modes
+    halves: tuple[Modes, Modes]
+    peaks: np.ndarray
+    last: Frame
+
+
+def _scan(f: h5py.File, eq_end: float, size: np.ndarray) -> Scan:
+    """One pass over the production frames (``Scan``)."""
     whole, halves = density_waves(size), (density_waves(size), density_waves(size))
     times = f["frames/time"][()]
     prod = times[times >= eq_end]
@@ -248,38 +259,85 @@ def _scan(f: h5py.File, eq_end: float, size: np.ndarray):
     if last is None or whole.n_frames < 4 or min(h.n_frames for h in halves) < 2:
         raise ValueError(f"{f.filename}: {whole.n_frames} frames in the production (t >= "
                          f"{eq_end}); the mode analysis needs at least 4 (keep_frames = true)")
-    return whole, halves, np.array(peaks), last
+    return Scan(Modes(*_finish(whole)), (Modes(*_finish(halves[0])), Modes(*_finish(halves[1]))),
+                np.array(peaks), last)
+
+
+#: the record groups (demstudy.studies.records) holding a ``Scan``
+_STORED = ("waves_modes", "waves_first_half", "waves_second_half")
+
+
+def derive(path: Path) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
+    """What a study record keeps of run ``path`` in place of its frames: the ``Scan``."""
+    with h5py.File(path, "r") as f:
+        attrs = read_attrs(f)
+        eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
+        scan = _scan(f, eq_end, f["frames/box_hi"][0] - f["frames/box_lo"][0])
+    last = scan.last
+    out = {name: (m.results, m.attrs) for name, m in
+           zip(_STORED, (scan.modes, *scan.halves), strict=True)}
+    out["waves_peaks"] = ({"peaks": scan.peaks}, {
+        "description": "densest xy cell column per production frame: 2 d cells, COARSE d "
+                       "columns", "coarse": COARSE})
+    # single precision: ample for the figures and the 1.05 d neighbour count, half the bytes
+    f32 = {k: np.asarray(getattr(last, k), np.float32) for k in ("position", "velocity", "radius")}
+    out["waves_last_frame"] = ({**f32, "box_lo": last.box_lo,
+                                "box_hi": last.box_hi}, {"time": last.time})
+    return out
+
+
+def _stored(f: h5py.File) -> Scan:
+    """The ``Scan`` kept in a study record (``derive``)."""
+
+    def group(name: str) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        g = f[f"study/{name}"]
+        return {k: v[()] for k, v in g.items()}, read_attrs(g)
+
+    modes = [Modes(*group(name)) for name in _STORED]
+    last, last_attrs = group("waves_last_frame")
+    wide = {k: np.asarray(last[k], float) for k in ("position", "velocity", "radius")}
+    frame = Frame(time=float(last_attrs["time"]), box_lo=last["box_lo"], box_hi=last["box_hi"],
+                  angular_velocity=np.zeros((0, 3)), **wide)
+    return Scan(modes[0], (modes[1], modes[2]), group("waves_peaks")[0]["peaks"], frame)
 
 
 def measure(path: Path) -> RunWaves:
-    """Measure one results file (module docstring)."""
+    """Measure one results file (module docstring): from its frames, or from what a study
+    record kept of them."""
     with h5py.File(path, "r") as f:
         attrs = read_attrs(f)
         ts = {k: v[()] for k, v in f["timeseries"].items()}
-        n = int(f["frames/position"].shape[1])
-        size = f["frames/box_hi"][0] - f["frames/box_lo"][0]
-        eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
-        whole, halves, peaks, last = _scan(f, eq_end, size)
+        if "frames" in f:
+            eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
+            scan = _scan(f, eq_end, f["frames/box_hi"][0] - f["frames/box_lo"][0])
+        elif "study/waves_modes" in f:
+            scan = _stored(f)
+            eq_end = float(attrs.get("equilibration_end", scan.modes.results["series_time"][0]))
+        else:
+            raise ValueError(f"{path}: neither frames (keep_frames = true) nor a study "
+                             "record's waves_* groups: the density modes cannot be measured")
+    last = scan.last
+    n = int(np.asarray(last.position).shape[0])
+    size = np.asarray(last.box_hi, float) - np.asarray(last.box_lo, float)
     time = ts["time"]
     cpp = 2.0 * ts["collisions"] / n
     ke = ts["kinetic_energy"] / n
-    modes = Modes(*_finish(whole))
-    both = (Modes(*_finish(halves[0])), Modes(*_finish(halves[1])))
+    modes, both, peaks = scan.modes, scan.halves, scan.peaks
     keep = time >= eq_end
     rate = float(np.ptp(cpp[keep]) / np.ptp(time[keep])) if keep.sum() > 1 else float("nan")
-    lo, hi = np.asarray(whole.attrs["lo"], float), np.asarray(whole.attrs["hi"], float)
-    cells = np.asarray(whole.attrs["cells"], int)
+    lo, hi = np.asarray(modes.attrs["lo"], float), np.asarray(modes.attrs["hi"], float)
+    cells = np.asarray(modes.attrs["cells"], int)
     snap = Snapshot(last.time, float(np.interp(last.time, time, cpp)),
                     np.asarray(last.position, float),
                     {p: plane_fields(last, lo, hi, cells, p) for p in PLANES})
     return RunWaves(
-        path=Path(path), n=n, size=np.asarray(size, float),
+        path=Path(path), n=n, size=size,
         restitution=_scene_restitution(attrs), time=time, cpp=cpp, ke=ke, eq_end=eq_end,
         modes=modes, halves=both, series_cpp=np.interp(modes.results["series_time"], time, cpp),
         drifts=_drifts(modes, both), ke_halves=_ke_halves(time, ke, eq_end),
         balance=_energy_balance(ts, eq_end), peak=_blocked_means(peaks[:, 0]),
         peak_coarse=_blocked_means(peaks[:, 1]),
-        close_packed=close_packed_fraction(last.position, np.asarray(size, float)), rate=rate,
+        close_packed=close_packed_fraction(last.position, size), rate=rate,
         wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
         tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap)
 
