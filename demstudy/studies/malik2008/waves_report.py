@@ -32,6 +32,9 @@ from .waves_measure import COARSE, DRIFT_SIGMAS, RunWaves, measure
 #: CPU seconds per particle per √(d/g), measured on this machine (N = 600 box, steady
 #: state, one core): the forecast of a run missing when no run of this analysis gives one
 COST_PER_PARTICLE_TIME = 2.0e-5
+#: CPU seconds per pair collision (cell crossings included), the slowest of the W = 15 and
+#: W = 30 boxes measured on 2026-12-02 (4.3-5.6e-6, one core)
+COST_PER_COLLISION = 6.0e-6
 STEADY_REF = "[L1088], [L1149]-[L1159] (digest §1.8)"
 
 
@@ -39,21 +42,32 @@ def _boxes(quick: bool) -> list[Box]:
     return [b for b in BOXES if not quick or (b.tag in QUICK and b.restitution == RESTITUTION)]
 
 
-def _duration(box: Box, quick: bool) -> float:
-    """The case's run length in √(d/g) (equilibration + production)."""
+def _duration(box: Box, quick: bool) -> tuple[float, str]:
+    """The case's run length (equilibration + production) and its unit ("time" in √(d/g)
+    or "collisions": pair collisions per particle)."""
     from .waves import cases
 
     case = next(c for c in cases(quick) if c.name == box.name)
     run = case.load(quick).run
-    return float(run.equilibration + run.production)
+    return float(run.equilibration + run.production), run.unit
 
 
-def _forecast(box: Box, quick: bool, cost: float) -> str:
-    seconds = cost * box.n * _duration(box, quick)
+def _forecast(box: Box, quick: bool, costs: Mapping[str, float]) -> str:
+    """The wall time of a missing run from the slowest cost measured here (``costs``: CPU s
+    per particle per √(d/g) under "time", per pair collision under "collisions")."""
+    length, unit = _duration(box, quick)
+    if unit == "collisions":
+        cost = costs["collisions"]
+        seconds, how = cost * box.n * length, (f"{cost:.1e} s per pair collision, the "
+                                               f"slowest measured here, × N × {length:.0f} "
+                                               "pair collisions per particle")
+    else:
+        cost = costs["time"]
+        seconds, how = cost * box.n * length, (f"{cost:.1e} s per particle per √(d/g), the "
+                                               f"slowest measured here, × N × {length:.0f} "
+                                               "√(d/g)")
     text = f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
-    return (f"forecast ≈ {text} on one core ({cost:.1e} s per particle per √(d/g), the "
-            f"slowest measured here, × N × "
-            f"{_duration(box, quick):.0f} √(d/g); `demstudy study malik2008 --only "
+    return (f"forecast ≈ {text} on one core ({how}; `demstudy study malik2008 --only "
             f"{box.name} --dry-run` gives the engine's own)")
 
 
@@ -215,9 +229,12 @@ the energy plateaus (≈ 100 √(d/g)) the W = 15 boxes make 10 (N = 600, a plug
 scenes' equilibration of 1000 √(d/g) therefore covers ≈ 1-6 × 10^4 c/p, beyond the thesis's
 snapshots (4000-14000 c/p), and their production of 3000 √(d/g) ≈ 3-13 × 10^4 c/p more
 (frames are kept in the production only: the structure at the thesis's snapshot times is
-not sampled, only the KE trace). The
-W = 30 and W = 50 scenes keep the shipped lengths (2000 + 4000 and 3000 + 5000 √(d/g));
-their rates are measured when they run (the table).
+not sampled, only the KE trace). The W = 30 and W = 50 boxes run over the thesis's own span
+instead, counted in collisions: 2000 c/p of equilibration, then production to 30000 c/p
+with a frame every 400 c/p, so that their structures are seen at the thesis's snapshot times
+(4000-14000 c/p, or up to 28000 had it counted N_pair / N) and the first half of the
+production (≈ 2000-16000 c/p) is the thesis's window. The shipped scenes' lengths
+(2000-3000 + 4000-5000 √(d/g), ≈ 2 × 10^5 c/p) would cost ×8 more (CPU-days at W = 50).
 
 **Modes.** demstudy.analysis.waves.DensityWaves over the production frames: cells of ≈ 2 d,
 each plane (xy, xz, yz) the depth average over the third axis, Malik's P = 2 X conj(X) /
@@ -258,14 +275,16 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
             measured[box.name] = measure(Path(path))
         except (OSError, KeyError, ValueError, BadInputFile) as exc:
             failed[box.name] = f"results file unreadable for the mode analysis: {exc}"
-    costs = [r.wall_seconds / (r.n * r.time[-1]) for r in measured.values()
-             if np.isfinite(r.wall_seconds) and r.time[-1] > 0]
-    cost = max(costs) if costs else COST_PER_PARTICLE_TIME
+    timed = [r for r in measured.values() if np.isfinite(r.wall_seconds) and r.time[-1] > 0]
+    costs = {"time": max([r.wall_seconds / (r.n * r.time[-1]) for r in timed],
+                         default=COST_PER_PARTICLE_TIME),
+             "collisions": max([2.0 * r.wall_seconds / (r.n * r.cpp[-1]) for r in timed
+                                if r.cpp[-1] > 0], default=COST_PER_COLLISION)}
     for box in boxes:
         run = measured.get(box.name)
         if run is None:
             ana.checks.append(class_check(box, None, failed.get(box.name) or
-                                          "run missing; " + _forecast(box, quick, cost)))
+                                          "run missing; " + _forecast(box, quick, costs)))
             continue
         ana.checks.append(class_check(box, run))
         ana.checks.append(steady_check(box, run))
