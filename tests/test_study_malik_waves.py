@@ -190,9 +190,10 @@ def test_spin_up_run_is_not_steady(tmp_path: Path) -> None:
 
 
 # -- stationarity is judged on the modes, not on the energy ----------------------------
-def _synthetic_run(path: Path, second_half) -> Path:
+def _synthetic_run(path: Path, second_half, rate: float = 5.0) -> Path:
     """A results file whose energy is flat and balanced (input = dissipation) throughout,
-    with 40 production frames: a plug, then ``second_half`` for the last 20."""
+    with 40 production frames: a plug, then ``second_half`` for the last 20; ``rate`` pair
+    collisions per particle per time unit (c/p = 2 rate t)."""
     import h5py
 
     plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
@@ -205,7 +206,7 @@ def _synthetic_run(path: Path, second_half) -> Path:
         f.attrs["equilibration_end"] = 20.0
         ts = f.create_group("timeseries")
         ts["time"] = t
-        ts["collisions"] = (5.0 * n * t).astype(np.int64)
+        ts["collisions"] = (rate * n * t).astype(np.int64)
         ts["kinetic_energy"] = n * (100.0 + rng.normal(0, 0.5, t.size))
         ts["gravity_work"] = 50.0 * n * t
         ts["dissipated_energy"] = 50.0 * n * t + rng.normal(0, 0.5 * n, t.size)
@@ -268,3 +269,36 @@ def test_a_record_measures_as_its_run(tmp_path: Path) -> None:
                                a.modes.results["family_power_xy"])
     for drift_a, drift_b in zip(a.drifts, b.drifts, strict=True):
         assert drift_b.sigmas == pytest.approx(drift_a.sigmas)
+
+
+def test_the_class_at_the_thesis_snapshot_time_under_either_reading(tmp_path: Path) -> None:
+    """Frames 600 c/p apart from 12600 c/p: a plug until 24000 c/p, then a slug. At the
+    thesis's 14000 c/p read as ours the window holds a plug; read as N_pair/N (28000 of
+    ours) a slug: the N = 50094 box's statement (slug at 14000) is reproduced under the
+    second reading and says which. Windows without frames are absent; a record keeps them."""
+    from demstudy.studies.base import NOT_REPRODUCED, REPRODUCED
+    from demstudy.studies.malik2008.waves_boxes import BOXES
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import class_check
+    from demstudy.studies.records import write_record
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    full = _synthetic_run(tmp_path / "late.h5", slug, rate=300.0)
+    run = measure(full)
+    assert run.windows[14000.0].pattern == "plug"
+    assert run.windows[28000.0].pattern == "slug"
+    assert 4000.0 not in run.windows and 8000.0 not in run.windows
+    box = next(b for b in BOXES if b.fig == "5.6-5.10")
+    check = class_check(box, run)
+    assert check.verdict == REPRODUCED and "c/p = N_pair/N" in check.reason
+    assert "14000 plug" in check.measured and "28000 slug" in check.measured
+    record = write_record(full, tmp_path / "late-record.h5", waves.derive(box.name, full))
+    kept = measure(record)
+    assert {c: m.pattern for c, m in kept.windows.items()} == \
+        {c: m.pattern for c, m in run.windows.items()}
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    never = measure(_synthetic_run(tmp_path / "plug.h5", plug, rate=300.0))
+    assert class_check(box, never).verdict == NOT_REPRODUCED

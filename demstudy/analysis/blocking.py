@@ -399,3 +399,34 @@ def blocking_curve(
             blocks, length = blocks[: 2 * m : 2] + blocks[1 : 2 * m : 2], 2 * length
     n = _flatten(estimator(acc.mean))[0].size
     return np.asarray(lengths), np.asarray(errors).reshape(len(lengths), n)
+
+
+def series_mean(values: ArrayLike, max_blocks: int = 32) -> tuple[float, float]:
+    """Mean of a correlated scalar series and its error: a ``BlockAccumulator`` of
+    ``max_blocks`` blocks and the jackknife with the block length the blocking curve asks for
+    (module docstring). Non-finite samples are dropped; (NaN, NaN) without any."""
+    v = np.asarray(values, float).ravel()
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return float("nan"), float("nan")
+    acc = BlockAccumulator(1, max_blocks)
+    for x in v:
+        acc.add(np.array([x]))
+    est, err = jackknife(acc, lambda mean: mean)
+    return float(np.ravel(est)[0]), float(np.ravel(err)[0])
+
+
+def split_mean(values: ArrayLike, blocks: int = 10) -> tuple[float, float]:
+    """Mean of a scalar series and its error from ``blocks`` contiguous block means taken as
+    independent (std of the block means / √blocks): for series whose blocks are known to be
+    longer than the correlation time (e.g. a run's production split in 8-10 parts).
+    Non-finite samples are dropped; with fewer samples than blocks the error is NaN; a
+    constant series (round-off only) has error 0."""
+    v = np.asarray(values, float).ravel()
+    v = v[np.isfinite(v)]
+    if v.size < max(blocks, 2):
+        return (float(v.mean()) if v.size else float("nan")), float("nan")
+    means = np.array([b.mean() for b in np.array_split(v, blocks)])
+    mean = float(v.mean())
+    err = float(means.std(ddof=1) / np.sqrt(blocks))
+    return mean, (err if err > 1e-12 * abs(mean) else 0.0)

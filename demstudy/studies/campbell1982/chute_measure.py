@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ...analysis.blocking import BlockAccumulator, jackknife
+from ...analysis.blocking import BlockAccumulator, jackknife, series_mean
 from ...analysis.derived import MATERIAL_DENSITY, campbell_depth
 from ...analysis.steady import energy_trend, is_steady
 
@@ -48,19 +48,6 @@ DENSE = (25.0, 200.0)
 SURFACE_NU = 0.05
 #: Campbell's band: the energy fluctuates within about 20 % of its mean
 BAND = 0.2
-
-
-def block_mean(values: np.ndarray, max_blocks: int = 32) -> tuple[float, float]:
-    """Mean of a correlated series and its jackknife block error (NaN when too short)."""
-    values = np.asarray(values, float)
-    values = values[np.isfinite(values)]
-    if values.size == 0:
-        return float("nan"), float("nan")
-    acc = BlockAccumulator(1, max_blocks)
-    for v in values:
-        acc.add(np.array([v]))
-    est, err = jackknife(acc, lambda mean: mean)
-    return float(np.ravel(est)[0]), float(np.ravel(err)[0])
 
 
 def trend_error(t: np.ndarray, energy: np.ndarray, blocks: int = 8) -> float:
@@ -220,7 +207,7 @@ def summarise(name: str, path: str | Path) -> ChuteRun:
     prod = _production(t, start)
     force = np.asarray(ts["wall_force_lower"], float)
     dense = (t > DENSE[0]) & (t <= DENSE[1])
-    e_mean, e_err = block_mean(energy[prod])
+    e_mean, e_err = series_mean(energy[prod])
     ratio, ratio_err = force_ratio(force[prod])
     ratio_d, ratio_d_err = force_ratio(force[dense]) if dense.any() else (np.nan, np.nan)
     prof = _profiles(res)

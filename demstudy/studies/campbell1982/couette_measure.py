@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import derived as dv
+from ...analysis.blocking import split_mean
 from ...analysis.profiles import ProfileAnalysis
 from ...io.results import read_results
 
@@ -58,18 +59,6 @@ class RunSummary:
 
     def e(self, key: str) -> float:
         return self.values.get(key, (math.nan, math.nan))[1]
-
-
-def block_mean(x: np.ndarray, blocks: int = 10) -> tuple[float, float]:
-    """Mean of a time series and its error from ``blocks`` contiguous block means."""
-    x = np.asarray(x, float)
-    x = x[np.isfinite(x)]
-    if x.size < blocks:
-        return (float(x.mean()) if x.size else math.nan), math.nan
-    means = np.array([b.mean() for b in np.array_split(x, blocks)])
-    err = float(means.std(ddof=1) / math.sqrt(blocks))
-    # a constant series (fixed gap) leaves round-off only: no error
-    return float(means.mean()), (err if err > 1e-12 * abs(means.mean()) else 0.0)
 
 
 def centre_mean(values: np.ndarray, errors: np.ndarray, mask: np.ndarray) -> tuple[float, float]:
@@ -111,10 +100,10 @@ def summarise(name: str, path: Path) -> RunSummary:
     width = ts.get("width", np.full(keep.shape, scene.box.size[0]))[keep]
     speed = ts.get("wall_velocity_upper", np.full(keep.shape, scene.wall("upper").velocity))
     speed = np.asarray(speed, float)[keep]
-    out.values["gap"] = block_mean(gap)
-    out.values["width"] = block_mean(width)
-    out.values["U_T"] = block_mean(speed)
-    out.values["nu_cell"] = block_mean(n * math.pi / 4 / (gap * width))
+    out.values["gap"] = split_mean(gap)
+    out.values["width"] = split_mean(width)
+    out.values["U_T"] = split_mean(speed)
+    out.values["nu_cell"] = split_mean(n * math.pi / 4 / (gap * width))
     if servo and "wall_position_lower" in ts:
         out.values["wall_wander"] = (float(np.ptp(ts["wall_position_lower"][keep])), 0.0)
     h, u_t = out.v("gap"), out.v("U_T")

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import curve_fit
 
+from ...analysis.blocking import split_mean
 from ...io.results import read_results
 from ...theory import GuttWallConstants, WallCouette, wall_couette
 
@@ -87,11 +88,7 @@ def roughness(kind: ArrayLike, normal: ArrayLike, time: ArrayLike,
     if k.shape[1] == 3:
         series["k2_z"] = k[:, 2] ** 2
     for key, x in series.items():
-        if x.size < blocks:
-            out[key] = (float(x.mean()) if x.size else math.nan, math.nan)
-            continue
-        means = np.array([b.mean() for b in np.array_split(x, blocks)])
-        out[key] = (float(x.mean()), float(means.std(ddof=1) / math.sqrt(blocks)))
+        out[key] = split_mean(x, blocks)
     out["wall_collisions_logged"] = (float(k.shape[0]), 0.0)
     return out
 

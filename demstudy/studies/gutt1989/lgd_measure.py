@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from ...analysis.blocking import split_mean
 from ...io.results import read_results
 
 ROW = math.sqrt(3) / 2
@@ -294,12 +295,7 @@ def momentum_balance(run: LgdRun) -> dict[str, float]:
 def interval_mean(t: np.ndarray, y: np.ndarray, t0: float, blocks: int = 8
                   ) -> tuple[float, float]:
     """Mean of the sampled ``y`` over t ≥ t0 and its error from ``blocks`` block means."""
-    v = np.asarray(y, float)[(np.asarray(t) >= t0) & np.isfinite(y)]
-    if v.size < blocks:
-        return float(np.mean(v)) if v.size else math.nan, math.nan
-    parts = np.array_split(v, blocks)
-    means = np.array([q.mean() for q in parts])
-    return float(v.mean()), float(means.std(ddof=1) / math.sqrt(blocks))
+    return split_mean(np.asarray(y, float)[np.asarray(t) >= t0], blocks)
 
 
 def nodes_of(pos: np.ndarray, nxt: int) -> np.ndarray:

@@ -19,7 +19,7 @@ from typing import Any
 import h5py
 import numpy as np
 
-from ...analysis.blocking import BlockAccumulator, jackknife
+from ...analysis.blocking import BlockAccumulator, jackknife, series_mean
 from ...analysis.waves import DensityWaves
 from ...io.frames import Frame
 from ...io.results import read_attrs
@@ -30,6 +30,19 @@ _AX = {"x": 0, "y": 1, "z": 2}
 DRIFT_SIGMAS = 2.0
 #: width (d) of the coarse cells of the second peak-density estimate (the thesis's unstated)
 COARSE = 5.0
+#: the thesis's snapshot times in collisions per particle (digest §1.8: [L1149]-[L1159],
+#: [L1297]-[L1305]); its c/p is undefined: read as ours (2 N_pair/N) and as N_pair/N (ours × 2)
+SNAPSHOTS = (4000.0, 8000.0, 10000.0, 11000.0, 14000.0)
+#: half-width (c/p) of the frame window classified at each snapshot time (3-5 frames at the
+#: thesis-span runs' 400 c/p spacing)
+WINDOW = 800.0
+#: fewest frames a window needs to be classified
+WINDOW_FRAMES = 3
+
+
+def snapshot_centres() -> list[float]:
+    """Our c/p of the thesis's snapshots under both readings, sorted."""
+    return sorted({*SNAPSHOTS, *(2.0 * t for t in SNAPSHOTS)})
 
 
 @dataclass
@@ -114,6 +127,8 @@ class RunWaves:
     wall_seconds: float
     tc_fraction: float  # pair collisions the engine's TC model made elastic (not in the thesis)
     snapshot: Snapshot
+    #: the class at the thesis's snapshot times (Scan.windows: our c/p → modes)
+    windows: dict[float, Modes] = field(default_factory=dict)
 
     @property
     def end_cpp(self) -> float:
@@ -163,14 +178,6 @@ def iter_frames(f: h5py.File, start: float) -> Iterator[Frame]:
                     angular_velocity=np.zeros((0, 3)), radius=fr["radius"][i])
 
 
-def _blocked_means(samples: np.ndarray) -> tuple[float, float]:
-    acc = BlockAccumulator(1, 16)
-    for v in samples:
-        acc.add(np.array([v]))
-    est, err = jackknife(acc, lambda m: m)
-    return float(np.ravel(est)[0]), float(np.ravel(err)[0])
-
-
 def _energy_balance(ts: dict[str, np.ndarray], start: float) -> tuple[float, float]:
     """Dissipation rate over gravity's power in the production, jackknife error over time
     blocks (steady state: 1; digest §1.8 [L1088])."""
@@ -190,7 +197,7 @@ def _energy_balance(ts: dict[str, np.ndarray], start: float) -> tuple[float, flo
 def _ke_halves(time: np.ndarray, ke: np.ndarray, start: float):
     keep = np.flatnonzero(time >= start)
     half = keep.size // 2
-    return (_blocked_means(ke[keep[:half]]), _blocked_means(ke[keep[half:]]))
+    return (series_mean(ke[keep[:half]], 16), series_mean(ke[keep[half:]], 16))
 
 
 def _drifts(modes: Modes, halves: tuple[Modes, Modes]) -> list[Drift]:
@@ -240,6 +247,9 @@ class Scan:
     halves: tuple[Modes, Modes]
     peaks: np.ndarray
     last: Frame
+    #: the modes of the frames within ±WINDOW c/p of each of ``snapshot_centres()`` that has
+    #: at least WINDOW_FRAMES of them (key: the centre, our c/p)
+    windows: dict[float, Modes] = field(default_factory=dict)
 
 
 def _scan(f: h5py.File, eq_end: float, size: np.ndarray) -> Scan:
@@ -248,10 +258,17 @@ def _scan(f: h5py.File, eq_end: float, size: np.ndarray) -> Scan:
     times = f["frames/time"][()]
     prod = times[times >= eq_end]
     split = prod[len(prod) // 2] if len(prod) else eq_end
+    ts_time, coll = f["timeseries/time"][()], f["timeseries/collisions"][()]
+    n = int(f["frames/position"].shape[1])
+    windows = {c: density_waves(size) for c in snapshot_centres()}
     last, peaks = None, []
     for frame in iter_frames(f, eq_end):
         whole.feed(frame)
         halves[int(frame.time >= split)].feed(frame)
+        cpp = 2.0 * float(np.interp(frame.time, ts_time, coll)) / n
+        for centre, window in windows.items():
+            if abs(cpp - centre) <= WINDOW:
+                window.feed(frame)
         coarse = np.maximum(2, np.round(whole.length / COARSE)).astype(int)
         peaks.append([float(np.max(plane_fields(frame, whole.lo, whole.hi, grid, "xy")[2]))
                       for grid in (whole.n, coarse)])
@@ -260,11 +277,14 @@ def _scan(f: h5py.File, eq_end: float, size: np.ndarray) -> Scan:
         raise ValueError(f"{f.filename}: {whole.n_frames} frames in the production (t >= "
                          f"{eq_end}); the mode analysis needs at least 4 (keep_frames = true)")
     return Scan(Modes(*_finish(whole)), (Modes(*_finish(halves[0])), Modes(*_finish(halves[1]))),
-                np.array(peaks), last)
+                np.array(peaks), last,
+                {c: Modes(*_finish(w)) for c, w in windows.items()
+                 if w.n_frames >= WINDOW_FRAMES})
 
 
 #: the record groups (demstudy.studies.records) holding a ``Scan``
 _STORED = ("waves_modes", "waves_first_half", "waves_second_half")
+_WINDOW_GROUP = "waves_window_"
 
 
 def derive(path: Path) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
@@ -276,6 +296,10 @@ def derive(path: Path) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
     last = scan.last
     out = {name: (m.results, m.attrs) for name, m in
            zip(_STORED, (scan.modes, *scan.halves), strict=True)}
+    for centre, modes in scan.windows.items():
+        out[f"{_WINDOW_GROUP}{centre:.0f}"] = (modes.results, {**modes.attrs,
+                                                                "centre_cpp": centre,
+                                                                "half_width_cpp": WINDOW})
     out["waves_peaks"] = ({"peaks": scan.peaks}, {
         "description": "densest xy cell column per production frame: 2 d cells, COARSE d "
                        "columns", "coarse": COARSE})
@@ -298,7 +322,13 @@ def _stored(f: h5py.File) -> Scan:
     wide = {k: np.asarray(last[k], float) for k in ("position", "velocity", "radius")}
     frame = Frame(time=float(last_attrs["time"]), box_lo=last["box_lo"], box_hi=last["box_hi"],
                   angular_velocity=np.zeros((0, 3)), **wide)
-    return Scan(modes[0], (modes[1], modes[2]), group("waves_peaks")[0]["peaks"], frame)
+    windows = {}
+    for name in f["study"]:
+        if name.startswith(_WINDOW_GROUP):
+            data, attrs = group(name)
+            windows[float(attrs["centre_cpp"])] = Modes(data, attrs)
+    return Scan(modes[0], (modes[1], modes[2]), group("waves_peaks")[0]["peaks"], frame,
+                dict(sorted(windows.items())))
 
 
 def measure(path: Path) -> RunWaves:
@@ -335,11 +365,12 @@ def measure(path: Path) -> RunWaves:
         restitution=_scene_restitution(attrs), time=time, cpp=cpp, ke=ke, eq_end=eq_end,
         modes=modes, halves=both, series_cpp=np.interp(modes.results["series_time"], time, cpp),
         drifts=_drifts(modes, both), ke_halves=_ke_halves(time, ke, eq_end),
-        balance=_energy_balance(ts, eq_end), peak=_blocked_means(peaks[:, 0]),
-        peak_coarse=_blocked_means(peaks[:, 1]),
+        balance=_energy_balance(ts, eq_end), peak=series_mean(peaks[:, 0], 16),
+        peak_coarse=series_mean(peaks[:, 1], 16),
         close_packed=close_packed_fraction(last.position, size), rate=rate,
         wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
-        tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap)
+        tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap,
+        windows=scan.windows)
 
 
 def close_packed_fraction(position: np.ndarray, size: np.ndarray) -> float:

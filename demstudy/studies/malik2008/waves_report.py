@@ -27,7 +27,7 @@ from ..base import (
 )
 from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
-from .waves_measure import COARSE, DRIFT_SIGMAS, RunWaves, measure
+from .waves_measure import COARSE, DRIFT_SIGMAS, SNAPSHOTS, WINDOW, RunWaves, measure
 
 #: CPU seconds per particle per √(d/g), measured on this machine (N = 600 box, steady
 #: state, one core): the forecast of a run missing when no run of this analysis gives one
@@ -98,6 +98,32 @@ def _stationary_text(run: RunWaves) -> str:
             f"{run.eq_cpp:.0f}-{run.end_cpp:.0f} c/p (halves: {halves}; {drift})")
 
 
+def _windows_text(run: RunWaves) -> str:
+    """The classes at the thesis's snapshot times, under both readings of its c/p."""
+    if not run.windows:
+        return ""
+    ours = [f"{c:.0f} {run.windows[c].pattern}" for c in SNAPSHOTS if c in run.windows]
+    doubled = [f"{2 * c:.0f} {run.windows[2 * c].pattern}" for c in SNAPSHOTS
+               if 2 * c in run.windows]
+    parts = []
+    if ours:
+        parts.append("at the thesis's snapshot times read as our c/p: " + ", ".join(ours))
+    if doubled:
+        parts.append("read as N_pair/N (our c/p × 2): " + ", ".join(doubled))
+    return "; ".join(parts) + f" (frames within ±{WINDOW:.0f} c/p)"
+
+
+def at_thesis_time(run: RunWaves, cls: str, time: float) -> list[str]:
+    """The readings of the thesis's c/p under which ``run`` has class ``cls`` at its time
+    ``time`` (c/p)."""
+    out = []
+    for label, ours in (("c/p = 2 N_pair/N", time), ("c/p = N_pair/N", 2.0 * time)):
+        modes = run.windows.get(ours)
+        if modes is not None and modes.pattern.split(" ")[0] == cls:
+            out.append(f"{label} ({ours:.0f} of ours)")
+    return out
+
+
 def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     """The structure class of ``box`` against the thesis's (digest) where known."""
     ref = (f"Fig {box.fig} (N = {box.n}, L/W = {box.aspect:.2g}, W/d = {box.width}, "
@@ -107,8 +133,21 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     statement = "steady density structure (plug, S-wave, slug, ...) of this box"
     if run is None:
         return Check(ref, statement, thesis_text, "not run", NOT_RUN, missing)
-    measured = f"{run.modes.pattern}; {_modes_text(run)}; {_stationary_text(run)}"
+    windows = _windows_text(run)
+    measured = (f"{run.modes.pattern}; {_modes_text(run)}; {_stationary_text(run)}"
+                + (f"; {windows}" if windows else ""))
     found = run.modes.pattern.split(" ")[0]
+    if thesis and thesis.time is not None and run.windows:
+        # the thesis's class is a snapshot: compare at its time, under either reading
+        readings = at_thesis_time(run, thesis.cls, thesis.time)
+        if readings:
+            return Check(ref, statement, thesis_text, measured, REPRODUCED,
+                         f"{thesis.cls} at t = {thesis.time:.0f} c/p with " +
+                         " and ".join(readings))
+        return Check(ref, statement, thesis_text, measured, NOT_REPRODUCED,
+                     f"no {thesis.cls} at t = {thesis.time:.0f} c/p under either reading of "
+                     "the thesis's c/p (classes above); the whole production is "
+                     f"{run.modes.pattern}")
     if thesis:
         if found != thesis.cls:
             return Check(ref, statement, thesis_text, measured, NOT_REPRODUCED,
