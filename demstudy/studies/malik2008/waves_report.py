@@ -293,6 +293,12 @@ jackknife errors). The engine's TC model (Luding & McNamara, t_c = 10⁻⁵ √(
 small fraction of pair collisions elastic (column): a deviation from the thesis's model,
 which has none.
 
+**Snapshot times.** The thesis's classes are snapshots (t = 4000, 8000, 10000, 11000, 14000
+c/p, digest §1.8). The frames within ±800 c/p of each of these times, read as our c/p and as
+N_pair / N (our c/p × 2), are classified on their own (3 frames at least); a statement the
+thesis ties to a time (N = 50094: a slug at 14000 c/p) is compared there, under either
+reading, and the report names the reading that agrees.
+
 **Peak density.** The densest cell column of the xy plane in each production frame (mean
 over the frames), on the 2 d grid and on ≈ 5 d columns, since the thesis's cells are not
 stated; and in the last frame the fraction of particles with 12 neighbours closer than
