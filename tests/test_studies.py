@@ -17,6 +17,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import demstudy as ds  # noqa: E402
@@ -248,13 +249,15 @@ def _recorded_toy(monkeypatch) -> Study:
 def test_records_stand_in_for_missing_runs_and_are_remade_when_stale(toy, tmp_path, monkeypatch):
     """A study with ``derive`` writes a record of each run (no frames, no collision log, the
     derived group, the run's attributes); without the runs a rerun reuses the records as made
-    runs and its analysis reads them; a record of another scene or a damaged one is not used
-    (the run is made again)."""
+    runs and its analysis reads them; a record older than its run or of an older ``derive``
+    is remade from the run; a damaged record or one of another scene is not used (the run is
+    made again, with a warning)."""
+    import os
+    from dataclasses import replace
+
     import h5py
 
-    from demstudy.studies.records import RECORD_VERSION
-
-    _recorded_toy(monkeypatch)
+    study = _recorded_toy(monkeypatch)
     records = tmp_path / "records"
     first = run_study("toy", out=tmp_path / "a", records=records, echo=lambda s: None)
     assert first.made == ["cell-a"]
@@ -263,12 +266,24 @@ def test_records_stand_in_for_missing_runs_and_are_remade_when_stale(toy, tmp_pa
     with h5py.File(record, "r") as f:
         assert "frames" not in f and "collisions" not in f
         assert "frames" in h5py.File(full, "r")
-        assert f.attrs["record_of"] == "cell-a.h5" and f.attrs["record_version"] == RECORD_VERSION
+        assert f.attrs["record_of"] == "cell-a.h5"
+        assert f.attrs["record_version"] == "1/toy:1"
         assert f["study/toy"].attrs["frames"] > 2
         assert "scene_toml" in f.attrs and "wall_seconds" in f.attrs
     kept = ds.load(full)
     assert ds.load(record).groups["study/toy"]["first_mean_x"] == pytest.approx(
         next(kept.iter_frames()).position[:, 0].mean())
+
+    # stale: a run newer than its record, or a newer derive, remakes the record from the run
+    written = record.stat().st_mtime
+    os.utime(full, (written + 10, written + 10))
+    lines: list[str] = []
+    again = run_study("toy", out=tmp_path / "a", records=records, echo=lines.append)
+    assert again.made == [] and any(line.startswith("  record ") for line in lines)
+    monkeypatch.setattr(sys.modules["demstudy_toy_study"], "STUDY",
+                        replace(study, derive_version=2))
+    run_study("toy", out=tmp_path / "a", records=records, echo=lambda s: None)
+    assert h5py.File(record, "r").attrs["record_version"] == "1/toy:2"
 
     # a fresh checkout: the study folder is gone, the records are there
     second = run_study("toy", out=tmp_path / "b", records=records, echo=lambda s: None)
@@ -277,17 +292,41 @@ def test_records_stand_in_for_missing_runs_and_are_remade_when_stale(toy, tmp_pa
     assert second.analysis.checks[0].measured == first.analysis.checks[0].measured
     assert "1 from their records" in second.report.read_text()
 
-    record.write_bytes(record.read_bytes()[:2000])  # damaged: remade by running again
-    third = run_study("toy", out=tmp_path / "c", records=records, echo=lambda s: None)
-    assert third.made == ["cell-a"] and (records / "cell-a.h5").stat().st_size > 2000
+    # damaged data behind intact attributes (a dataset that cannot be read): not used, the
+    # run is made again
+    with h5py.File(record, "r+") as f:
+        f["timeseries"].create_dataset("lost", data=np.arange(10000.0), compression="gzip")
+        chunk = f["timeseries/lost"].id.get_chunk_info(0)
+    with open(record, "r+b") as fh:  # the compressed chunk overwritten: inflating it fails
+        fh.seek(chunk.byte_offset)
+        fh.write(b"\xff" * chunk.size)
+    assert h5py.File(record, "r").attrs["record_of"] == "cell-a.h5"
+    lines = []
+    third = run_study("toy", out=tmp_path / "c", records=records, echo=lines.append)
+    assert third.made == ["cell-a"]
+    assert "lost" not in h5py.File(record, "r")["timeseries"]  # remade from the new run
+    assert any("record of cell-a is not used" in line for line in lines), lines
 
     changed = merge(SHORT, {"measure": {"keep_frames": True}, "run": {"production": 12.0}})
-    from dataclasses import replace
     monkeypatch.setattr(sys.modules["demstudy_toy_study"], "STUDY", replace(
         sys.modules["demstudy_toy_study"].STUDY,
         cases=lambda q: [Case("cell-a", "campbell1982/couette-rough", sections=changed)]))
     fourth = run_study("toy", out=tmp_path / "d", records=records, echo=lambda s: None)
     assert fourth.made == ["cell-a"], "a record of another scene is not the run"
+
+
+def test_a_record_scene_that_differs_only_by_written_defaults_is_the_same_scene():
+    """A schema field added later with its default changes the scene text, not the scene:
+    such a record still stands for its run; another value does not."""
+    from demstudy.scene import load_scene, scene_to_toml
+    from demstudy.studies.records import same_scene
+
+    text = scene_to_toml(load_scene("campbell1982/couette-rough"))
+    lines = text.splitlines()
+    sparse = "\n".join(line for line in lines if not line.startswith("sample_interval"))
+    assert sparse != text and same_scene(sparse, text)  # the default is written back
+    other = text.replace("restitution = ", "restitution = 0.5 #", 1)
+    assert not same_scene(other, text) and not same_scene(None, text)
 
 
 def test_a_study_without_derive_keeps_no_records(toy, tmp_path):

@@ -187,3 +187,33 @@ def test_a_record_analyses_as_its_run(tiny_run, tmp_path):
     b = poiseuille.analyse({flow.name: record}, tmp_path, quick=True)
     assert [(c.measured, c.verdict) for c in b.checks] == [(c.measured, c.verdict)
                                                           for c in a.checks]
+
+
+def test_a_large_tc_share_caps_the_verdicts_and_says_so(tiny_run, tmp_path):
+    """A run whose collisions the TC model made elastic in a large share (here set to 20 %)
+    no longer measures the thesis's dissipation: its verdicts are at most "partly", with the
+    share and t_c in the reason and in the runs table; 1 % changes nothing."""
+    import shutil
+
+    import h5py
+
+    flow, path, out = tiny_run
+    base = poiseuille.analyse({flow.name: path}, out, quick=True)
+    for share, capped in ((0.2, True), (0.01, False)):
+        copy = tmp_path / f"{share}" / path.name
+        copy.parent.mkdir()
+        shutil.copy(path, copy)
+        with h5py.File(copy, "r+") as f:
+            f.attrs["tc_elastic_fraction"] = share
+        ana = poiseuille.analyse({flow.name: copy}, copy.parent, quick=True)
+        table = dict(ana.sections)["Poiseuille flows (Malik Ch. 3-4): runs"]
+        assert f"| {100 * share:.2g} % |" in table
+        for a, b in zip(base.checks, ana.checks, strict=True):
+            if a.verdict == NOT_RUN or "plateau of the kinetic energy" in a.statement:
+                continue  # the plateau statement is about the run's length, not its model
+            if capped:
+                assert b.verdict != REPRODUCED
+                assert "TC model made a large share" in b.reason, b.statement
+                assert "20.0 % (t_c = 1e-05" in b.reason
+            else:
+                assert (b.verdict, b.reason) == (a.verdict, a.reason)

@@ -44,5 +44,6 @@ def study(name: str, *, quick: bool = False, **kwargs):
     """Run the seed study ``name`` (``study_names()``) end to end and return its
     :class:`~demstudy.studies.runner.StudyRun` (``.report``, ``.analysis.checks``, ``.made``,
     ``.failed``); keywords as ``demstudy study``: ``out``, ``workers``, ``dask``, ``dry_run``,
-    ``engines``, ``only``, ``analyse_only``, ``echo`` (a print function)."""
+    ``engines``, ``only``, ``analyse_only``, ``records`` (where the study keeps its run
+    records, demstudy.studies.records), ``echo`` (a print function)."""
     return run_study(name, quick=quick, **kwargs)

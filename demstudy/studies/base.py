@@ -119,6 +119,9 @@ class Study:
     #: name, results file)``, demstudy.studies.records); None: the study keeps no records
     #: (its analysis needs the full results files)
     derive: Callable[[str, Path], Mapping[str, Any]] | None = None
+    #: raised whenever ``derive`` changes what it keeps: records of an older one are remade
+    #: from their runs where the runs exist
+    derive_version: int = 1
 
 
 def pm(value: float, err: float | None = None, digits: int = 2) -> str:

@@ -185,7 +185,7 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     it. ``records``: where the study's run records are kept (module doc)."""
     from ..accuracy.execute import execute, is_done
     from . import get_study
-    from .records import current
+    from .records import current, record_version
 
     study = get_study(name)
     if workers < 1:
@@ -202,11 +202,20 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         if is_done(task.path, task.scene_toml):
             done.append(task)
         elif record_dir is not None and current(record_dir / f"{task.case.name}.h5", None,
-                                                task.scene_toml):
+                                                task.scene_toml,
+                                                record_version(study.name,
+                                                               study.derive_version)):
             done.append(task)
             result.from_records.append(task.case.name)
         else:
             todo.append(task)
+            if record_dir is not None and (record_dir / f"{task.case.name}.h5").is_file():
+                from .records import why_not_current
+
+                why = why_not_current(record_dir / f"{task.case.name}.h5", None,
+                                      task.scene_toml, "")
+                echo(f"warning: the record of {task.case.name} is not used ({why}): "
+                     "the run is made again")
     result.reused = [t.case.name for t in done]
     echo(f"study {study.name}{' (quick)' if quick else ''}: {len(tasks)} runs, "
          f"{len(done)} already made, {len(todo)} to make; results in {out}/")
@@ -266,17 +275,17 @@ def keep_record(study: Study, task: StudyTask, record: Path, echo=print) -> bool
     without a current record gets one (``Study.derive``); a record whose run is absent is
     kept as it is (module doc)."""
     from ..accuracy.execute import is_done
-    from ..errors import BadInputFile
-    from .records import current, write_record
+    from .records import current, record_version, write_record
 
+    version = record_version(study.name, study.derive_version)
     full = task.path if is_done(task.path, task.scene_toml) else None
-    if current(record, full, task.scene_toml):
+    if current(record, full, task.scene_toml, version):
         return True
     if full is None:
         return False
     try:
-        write_record(full, record, study.derive(task.case.name, full))
-    except (BadInputFile, KeyError, ValueError, OSError) as exc:
+        write_record(full, record, study.derive(task.case.name, full), version)
+    except Exception as exc:  # noqa: BLE001 - whatever derive meets: a warning, not a crash
         # the analysis then reads the results file itself, as without records
         echo(f"warning: no record of {task.case.name} ({type(exc).__name__}: {exc})")
         return False

@@ -24,4 +24,5 @@ STUDY = Study(
     cases=combined_cases(PARTS),
     analyse=combined_analysis(PARTS),
     derive=combined_derive(PARTS),
+    derive_version=2,  # 2: the density-wave windows at the thesis's snapshot times
 )

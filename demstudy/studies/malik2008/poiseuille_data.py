@@ -94,7 +94,10 @@ class FlowData:
                 "trend": float(attrs.get("kinetic_energy_trend", float("nan"))),
                 "production": float(t[-1] - t0), "collisions_per_particle": per_particle,
                 "equilibration_collisions": 2.0 * float(coll[min(start, coll.size - 1)]) / n,
-                "wall_seconds": float(attrs.get("wall_seconds", float("nan")))}
+                "wall_seconds": float(attrs.get("wall_seconds", float("nan"))),
+                # the engine's TC model (not in the thesis): share of pair collisions elastic
+                "tc_fraction": float(attrs.get("tc_elastic_fraction", float("nan"))),
+                "tc": float(attrs.get("tc", float("nan")))}
 
 
 def in_bin_gr(path: Path, edges: np.ndarray, r_max: float = 5.0, dr: float = 0.05,

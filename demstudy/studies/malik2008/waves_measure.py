@@ -267,7 +267,7 @@ def _scan(f: h5py.File, eq_end: float, size: np.ndarray) -> Scan:
         halves[int(frame.time >= split)].feed(frame)
         cpp = 2.0 * float(np.interp(frame.time, ts_time, coll)) / n
         for centre, window in windows.items():
-            if abs(cpp - centre) <= WINDOW:
+            if -WINDOW <= cpp - centre < WINDOW:  # half-open: a frame in one window per edge
                 window.feed(frame)
         coarse = np.maximum(2, np.round(whole.length / COARSE)).astype(int)
         peaks.append([float(np.max(plane_fields(frame, whole.lo, whole.hi, grid, "xy")[2]))
@@ -291,8 +291,8 @@ def derive(path: Path) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
     """What a study record keeps of run ``path`` in place of its frames: the ``Scan``."""
     with h5py.File(path, "r") as f:
         attrs = read_attrs(f)
-        eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
-        scan = _scan(f, eq_end, f["frames/box_hi"][0] - f["frames/box_lo"][0])
+        scan = _scan(f, _equilibration_end(f, attrs),
+                     f["frames/box_hi"][0] - f["frames/box_lo"][0])
     last = scan.last
     out = {name: (m.results, m.attrs) for name, m in
            zip(_STORED, (scan.modes, *scan.halves), strict=True)}
@@ -331,6 +331,15 @@ def _stored(f: h5py.File) -> Scan:
                 dict(sorted(windows.items())))
 
 
+def _equilibration_end(f: h5py.File, attrs: dict[str, Any]) -> float:
+    """The run's production start (the first frame's time when a file does not say)."""
+    if "equilibration_end" in attrs:
+        return float(attrs["equilibration_end"])
+    if f["frames/time"].shape[0] == 0:
+        raise ValueError(f"{f.filename}: no frames (keep_frames = true)")
+    return float(f["frames/time"][0])
+
+
 def measure(path: Path) -> RunWaves:
     """Measure one results file (module docstring): from its frames, or from what a study
     record kept of them."""
@@ -338,7 +347,7 @@ def measure(path: Path) -> RunWaves:
         attrs = read_attrs(f)
         ts = {k: v[()] for k, v in f["timeseries"].items()}
         if "frames" in f:
-            eq_end = float(attrs.get("equilibration_end", f["frames/time"][0]))
+            eq_end = _equilibration_end(f, attrs)
             scan = _scan(f, eq_end, f["frames/box_hi"][0] - f["frames/box_lo"][0])
         elif "study/waves_modes" in f:
             scan = _stored(f)
