@@ -122,3 +122,26 @@ def test_one_colour_per_run(runs, kind, tmp_path):
         assert lines
         for ln in lines:
             assert tuple(np.round(to_rgb(ln.get_color()), 6)) in shades, ln.get_gid()
+
+
+def test_a_long_title_on_a_narrow_figure_is_wrapped_inside_it_above_the_panels(runs):
+    """A one-panel figure whose title is wider than the figure: the title is wrapped so that
+    it lies inside the figure and above the panel's own title; a short title is one line."""
+    import matplotlib.pyplot as plt
+
+    from demstudy.plots.common import finish, new_figure
+
+    for title, lines in (("Malik Figs 3.2d/4.1c/4.15b: kinetic energy vs collisions, "
+                          "φ = 0.5 (| = start of averaging)", 2), ("short", 1)):
+        fig, axes = new_figure(1, 1, width=4.2, height=3.6)
+        axes[0, 0].plot([0, 1], [0, 1])
+        axes[0, 0].set_title("panel", fontsize=9)
+        finish(fig, runs[:1], title)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        box = fig._suptitle.get_window_extent(renderer)
+        panel = axes[0, 0].title.get_window_extent(renderer)
+        assert box.x0 >= 0 and box.x1 <= fig.bbox.width and box.y1 <= fig.bbox.height
+        assert box.y0 > panel.y1
+        assert fig._suptitle.get_text().count("\n") == lines - 1
+        plt.close(fig)

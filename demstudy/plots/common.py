@@ -227,7 +227,11 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03,
     panels, above the footer, with the most columns (≤ ``max_cols``) whose drawn width fits
     the figure, so that it covers no data and is not cut off; the panels make room for it."""
     engines = ", ".join(dict.fromkeys(run.engine for run in runs))
-    fig.suptitle(title, fontsize=10)
+    heading = fig.suptitle(title, fontsize=10)
+    top = 0.96
+    if _extent(fig, heading)[0] > 0.98:  # a long title on a narrow figure: wrapped to fit
+        _wrapped(fig, heading, (title,), 0.98)
+        top = min(top, 0.99 - _extent(fig, heading)[1])
     text = fig.text(0.005, 0.005, "", fontsize=7, ha="left", va="bottom")
     units, engine = units_text(runs), f"engine: {engines}"
     one_line = f"{units}  |  {engine}"
@@ -245,7 +249,7 @@ def finish(fig: Figure, runs: Sequence[Run], title: str, bottom: float = 0.03,
             box.remove()
         height += _extent(fig, box)[1] + 0.01
     bottom = max(bottom, height + 0.01)
-    fig.set_layout_engine("tight", rect=(0, bottom, 1, 0.96))  # applied when drawn (saved)
+    fig.set_layout_engine("tight", rect=(0, bottom, 1, top))  # applied when drawn (saved)
     return fig
 
 
