@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from demstudy.io.frames import Frame
-from demstudy.studies.base import NOT_RUN, PARTLY, REPRODUCED, merge
+from demstudy.studies.base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, merge
 from demstudy.studies.malik2008 import poiseuille
 from demstudy.studies.malik2008.poiseuille_cases import QUICK, THESIS_SYSTEM, Flow, case_of, cases
 from demstudy.studies.malik2008.poiseuille_checks import lambda_mean
@@ -217,3 +217,25 @@ def test_a_large_tc_share_caps_the_verdicts_and_says_so(tiny_run, tmp_path):
                 assert "20.0 % (t_c = 1e-05" in b.reason
             else:
                 assert (b.verdict, b.reason) == (a.verdict, a.reason)
+
+
+def test_a_vdf_spike_is_named_a_spike_not_a_skewed_core():
+    """A bin moving nearly as a solid (the dense plug): its σ-scaled VDF is one narrow spike
+    off the P(0) bin, so the P(0) = 1 scaling blows the core deviation up: the check calls it
+    a spike, not a skewed core, and is not "reproduced"."""
+    from demstudy.studies.malik2008.poiseuille_checks import vdf_checks
+
+    x = np.linspace(-4.9, 4.9, 50)
+    gauss = np.exp(-0.5 * x**2)
+    p = np.tile(gauss, (25, 6, 1))
+    p[12, 1] = np.where(np.abs(x - 0.3) < 0.1, 2000.0, 1e-3)  # bin 13, C_y: a spike
+    vdf = {"malik_centres": x, "malik_P": p, "malik_P_err": np.full_like(p, 1e-3),
+           "gaussian_binned": gauss, "kurtosis": np.full((25, 6), 3.0),
+           "kurtosis_err": np.full((25, 6), 0.1), "skewness": np.zeros((25, 6))}
+    d = SimpleNamespace(flow=Flow(0.5, 0.9, 0.9), stat=lambda name: vdf,
+                        run_info=lambda: {"steady": True, "trend": 0.0, "tc_fraction": 0.0,
+                                          "tc": 1e-5})
+    check = next(c for c in vdf_checks({(0.5, 0.9, 0.9): d}) if c.statement.startswith("φ = 0.5"))
+    assert "bin 13: core a spike" in check.measured
+    assert "β = 0.9, e = 0.9 bin 13 the σ-scaled VDF is a spike" in check.reason
+    assert "C_x is skewed" not in check.reason and check.verdict == NOT_REPRODUCED
