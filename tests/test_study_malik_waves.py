@@ -302,3 +302,26 @@ def test_the_class_at_the_thesis_snapshot_time_under_either_reading(tmp_path: Pa
     plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
     never = class_check(box, measure(_synthetic_run(tmp_path / "plug.h5", plug, rate=250.0)))
     assert never.verdict == NOT_REPRODUCED and "under either reading" in never.reason
+
+
+def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> None:
+    """A box run whose pair collisions the TC model made elastic in a large share (20 %):
+    its class verdict is at most "partly", with the share in the reason; 1 % changes
+    nothing."""
+    import dataclasses
+
+    from demstudy.studies.base import PARTLY, REPRODUCED
+    from demstudy.studies.malik2008.waves_boxes import BOXES
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import class_check, tc_caveat
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    run = measure(_synthetic_run(tmp_path / "late.h5", slug, rate=250.0))
+    box = next(b for b in BOXES if b.fig == "5.6-5.10")
+    assert class_check(box, run).verdict == REPRODUCED
+    low = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.01))
+    assert low.verdict == REPRODUCED and "TC" not in low.reason
+    high = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
+    assert high.verdict == PARTLY and "made 20.0 % of the pair collisions elastic" in high.reason
