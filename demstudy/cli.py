@@ -347,7 +347,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
                                 if e.strip()] if args.engine else None,
                        only=args.only,
                        # the full study keeps its run records with the docs (DOCS/data/...)
-                       records=(Path(args.docs) / "data" / "studies" / args.name / "records"
+                       records=(Path(args.records) if args.records else
+                                Path(args.docs) / "data" / "studies" / args.name / "records"
                                 if args.docs and not args.quick else None))
     if args.dry_run:
         return 0
@@ -637,6 +638,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also publish the report and figures under DOCS (docs/studies/NAME.md,"
                         " docs/figures/studies/NAME/) and keep the runs' records in "
                         "DOCS/data/studies/NAME/records/, reused as made runs")
+    p.add_argument("--records", metavar="DIR",
+                   help="where the runs' records are kept and reused (default: "
+                        "DOCS/data/studies/NAME/records/ with --docs, else OUT/records/); "
+                        "with --analyse-only: a report from committed records, unpublished")
     p.set_defaults(func=_cmd_study)
 
     p = sub.add_parser("engine-map",

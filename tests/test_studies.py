@@ -332,3 +332,20 @@ def test_a_record_scene_that_differs_only_by_written_defaults_is_the_same_scene(
 def test_a_study_without_derive_keeps_no_records(toy, tmp_path):
     run_study("toy", out=tmp_path, only=["cell-a"], echo=lambda s: None)
     assert not (tmp_path / "records").exists()
+
+
+def test_cli_records_option_analyses_kept_records_without_publishing(toy, tmp_path,
+                                                                     monkeypatch):
+    """``demstudy study NAME --analyse-only --records DIR``: the report from the records in
+    DIR alone (no runs folder), nothing published."""
+    from demstudy.cli import main
+
+    _recorded_toy(monkeypatch)
+    records = tmp_path / "kept"
+    run_study("toy", out=tmp_path / "made", records=records, echo=lambda s: None)
+    code = main(["study", "toy", "--analyse-only", "--records", str(records),
+                 "--out", str(tmp_path / "fresh")])
+    assert code == 0
+    report = (tmp_path / "fresh" / "toy.md").read_text()
+    assert "1 from their records" in report and "| 1 | toy | cell-a" in report
+    assert not (tmp_path / "fresh" / "runs").exists()
