@@ -185,7 +185,7 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     it. ``records``: where the study's run records are kept (module doc)."""
     from ..accuracy.execute import execute, is_done
     from . import get_study
-    from .records import current, record_version
+    from .records import current, record_version, why_not_current
 
     study = get_study(name)
     if workers < 1:
@@ -210,8 +210,6 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         else:
             todo.append(task)
             if record_dir is not None and (record_dir / f"{task.case.name}.h5").is_file():
-                from .records import why_not_current
-
                 why = why_not_current(record_dir / f"{task.case.name}.h5", None,
                                       task.scene_toml, "")
                 echo(f"warning: the record of {task.case.name} is not used ({why}): "
