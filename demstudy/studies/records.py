@@ -23,7 +23,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -38,10 +38,6 @@ DERIVED = "study"
 RECORD_VERSION = 1
 #: the groups of a results file a record leaves out (the large ones)
 LEFT_OUT = ("frames", "collisions")
-
-#: what a study derives from a full results file: ``derive(case_name, path)`` returns
-#: {name: (datasets, attributes)}, stored as groups ``study/<name>``
-Derive = Callable[[str, Path], Mapping[str, tuple[Mapping[str, Any], Mapping[str, Any]]]]
 
 
 def record_version(study_name: str, derive_version: int) -> str:
@@ -70,20 +66,11 @@ def write_record(full: Path, record: Path, derived: Mapping[str, tuple[Mapping[s
     return write_results(record, res, command_line=str(res.attrs.get("command_line", "")))
 
 
-def is_record(attrs: Mapping[str, Any]) -> bool:
-    """Whether root attributes ``attrs`` are a record's."""
-    return "record_of" in attrs
-
-
 def derived(groups: Mapping[str, Mapping[str, np.ndarray]], name: str
             ) -> dict[str, np.ndarray] | None:
     """The derived group ``name`` among a results file's ``groups`` (None when absent)."""
     found = groups.get(f"{DERIVED}/{name}")
     return dict(found) if found is not None else None
-
-
-def derived_attrs(group_attrs: Mapping[str, Mapping[str, Any]], name: str) -> dict[str, Any]:
-    return dict(group_attrs.get(f"{DERIVED}/{name}", {}))
 
 
 def same_scene(stored: Any, expected: str) -> bool:
