@@ -34,7 +34,7 @@ def _box_of(scene) -> tuple[int, int, int, int]:
 
 
 def test_cases_are_the_thesis_boxes_with_its_collision_parameters() -> None:
-    cases = waves.cases(False)
+    cases = [c for c in waves.cases(False) if c.name != waves.twin_name()]
     scenes = {c.name: c.load() for c in cases}  # every scene validates
     e07 = {n: s for n, s in scenes.items() if s.contact.restitution == 0.7}
     assert {_box_of(s) for s in e07.values()} == THESIS_TABLE
@@ -73,8 +73,22 @@ def test_case_names_unique_and_the_wide_boxes_run_over_the_thesis_span() -> None
     for case in waves.cases(False):
         scene = case.load()
         e = "" if scene.contact.restitution == 0.7 else f"-e{scene.contact.restitution:g}"
+        tc = f"-tc{case.options['tc']:g}" if "tc" in case.options else ""
         n, length, width, height = _box_of(scene)
-        assert case.name == f"waves-phi0.15-L{length}W{width}H{height}{e}-edmd"
+        assert case.name == f"waves-phi0.15-L{length}W{width}H{height}{e}{tc}-edmd"
+
+
+def test_the_tc_twin_is_its_box_at_a_smaller_tc_only() -> None:
+    """The TC twin runs the L42W30H30 box's scene over the same span, only the engine's t_c
+    smaller than its default; it is not part of --quick."""
+    from demstudy.engines.edmd.core import DEFAULT_TC
+
+    by_name = {c.name: c for c in waves.cases(False)}
+    twin = by_name["waves-phi0.15-L42W30H30-tc1e-06-edmd"]
+    box = by_name["waves-phi0.15-L42W30H30-edmd"]
+    assert dict(twin.options) == {"tc": 1e-6} and 1e-6 < DEFAULT_TC
+    assert twin.load() == box.load() and twin.scene == box.scene
+    assert not any("tc" in c.name for c in waves.cases(True))
 
 
 def test_quick_subset_is_small_and_short() -> None:
@@ -145,7 +159,7 @@ def test_classifier_homogeneous_gas_has_no_structure() -> None:
 @pytest.mark.parametrize("quick", [True, False])
 def test_missing_runs_give_not_run_checks(tmp_path: Path, quick: bool) -> None:
     ana = analyse_waves({}, tmp_path, quick)
-    boxes = {c.name for c in waves.cases(quick)}
+    boxes = {c.name for c in waves.cases(quick)} - {waves.twin_name()}
     per_box = [c for c in ana.checks if c.ref.startswith("Fig 5.") and "digest §4.11" in c.ref]
     assert len(per_box) == len(boxes)
     assert all(c.verdict == NOT_RUN and "forecast" in c.reason for c in per_box)
@@ -325,3 +339,36 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     assert low.verdict == REPRODUCED and "TC" not in low.reason
     high = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
     assert high.verdict == PARTLY and "made 20.0 % of the pair collisions elastic" in high.reason
+
+
+def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
+    """The TC row: the same slug at both t_c with a small share at the smaller one is
+    "reproduced"; a plug at the smaller t_c "not reproduced"; a KE apart or a large share at
+    the smaller t_c "partly"; a missing twin "not run"."""
+    import dataclasses
+
+    from demstudy.studies.base import NOT_REPRODUCED, PARTLY, REPRODUCED
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import tc_dependence
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    base = dataclasses.replace(measure(_synthetic_run(tmp_path / "a.h5", slug, rate=250.0)),
+                               tc_fraction=0.06)
+    twin = dataclasses.replace(base, tc_fraction=0.004)
+    same = tc_dependence(base, twin)
+    assert same.verdict == REPRODUCED and "share at 1e-06: 0.4 % < 5 %" in same.reason
+    assert "TC share 6.0 %" in same.measured and "TC share 0.4 %" in same.measured
+    other = dataclasses.replace(measure(_synthetic_run(tmp_path / "b.h5", plug, rate=250.0)),
+                                tc_fraction=0.004)
+    differs = tc_dependence(base, other)
+    assert differs.verdict == NOT_REPRODUCED and "the class differs" in differs.reason
+    (m1, e1), (m2, e2) = base.ke_halves
+    hotter = dataclasses.replace(twin, ke_halves=((m1, e1), (1.5 * m2, e2)))
+    apart = tc_dependence(base, hotter)
+    assert apart.verdict == PARTLY and "second half differs" in apart.reason
+    shared = tc_dependence(base, dataclasses.replace(twin, tc_fraction=0.08))
+    assert shared.verdict == PARTLY and "≥ 5 %" in shared.reason
+    assert tc_dependence(base, None).verdict == NOT_RUN

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...engines.edmd.core import DEFAULT_TC
 from ...engines.edmd.tc_share import WARN_SHARE
 from ...errors import BadInputFile
 from ..base import (
@@ -26,6 +27,7 @@ from ..base import (
     Figure,
     pm,
 )
+from .waves import TC_TWIN, twin_box, twin_name
 from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
 from .waves_measure import COARSE, DRIFT_SIGMAS, SNAPSHOTS, WINDOW, RunWaves, measure
@@ -182,6 +184,57 @@ def tc_caveat(check: Check, run: RunWaves) -> Check:
     return check
 
 
+def _cls(pattern: str) -> str:
+    return pattern.split(" ")[0]
+
+
+def tc_dependence(base: RunWaves | None, twin: RunWaves | None) -> Check:
+    """The TC twin against its box at the default t_c (demstudy's own check; the thesis has
+    no TC model): the class of the whole production and at every snapshot window both
+    sampled, the KE of each half, and the share at the smaller t_c."""
+    box, tc = twin_box(), TC_TWIN[1]
+    ref = "TC model (demstudy; not in the thesis)"
+    statement = (f"the structure of {box.tag} (N = {box.n}) does not depend on the "
+                 f"event-driven engine's t_c ({DEFAULT_TC:g} against {tc:g} √(d/g)), and the "
+                 "TC-elastic share is small at the smaller t_c")
+    thesis = "— (the thesis's collisions all dissipate: no TC model)"
+    if base is None or twin is None:
+        absent = [n for n, r in ((box.name, base), (twin_name(), twin)) if r is None]
+        return Check(ref, statement, thesis, "not run", NOT_RUN,
+                     "run missing: " + ", ".join(absent))
+    common = sorted(set(base.windows) & set(twin.windows))
+    differ = [c for c in common
+              if _cls(base.windows[c].pattern) != _cls(twin.windows[c].pattern)]
+    texts = []
+    for t, r in ((DEFAULT_TC, base), (tc, twin)):
+        windows = ", ".join(f"{c:.0f} {r.windows[c].pattern}" for c in common)
+        (m1, e1), (m2, e2) = r.ke_halves
+        texts.append(f"t_c {t:g}: TC share {100 * r.tc_fraction:.1f} %, class "
+                     f"{r.modes.pattern}; at {windows or 'no common window'}; "
+                     f"dissipation/input {pm(*r.balance)}; KE/N halves {pm(m1, e1)} → "
+                     f"{pm(m2, e2)} m g d")
+    halves = zip(base.ke_halves, twin.ke_halves, strict=True)
+    ke_apart = [i for i, ((a, ea), (b, eb)) in enumerate(halves)
+                if abs(a - b) > 2.0 * float(np.hypot(ea, eb)) + 0.05 * abs(a)]
+    same = _cls(base.modes.pattern) == _cls(twin.modes.pattern) and not differ
+    small = twin.tc_fraction < WARN_SHARE
+    reasons = [("same class over the production and at every common snapshot window" if same
+                else "the class differs: " + (f"{base.modes.pattern} against "
+                                              f"{twin.modes.pattern}" if not differ else
+                                              "at " + ", ".join(f"{c:.0f}" for c in differ)
+                                              + " c/p"))]
+    if ke_apart:
+        reasons.append("the KE/N of the " + " and ".join(("first", "second")[i]
+                                                        for i in ke_apart)
+                       + " half differs by more than 2σ + 5 %: the TC model changes the "
+                       "dissipation")
+    reasons.append(f"share at {tc:g}: {100 * twin.tc_fraction:.1f} % "
+                   + ("< 5 %" if small else "≥ 5 % (the engine's warning level)"))
+    verdict = (REPRODUCED if same and small and not ke_apart
+               else PARTLY if same else NOT_REPRODUCED)
+    return Check(ref, statement, thesis, "; ".join(texts), verdict, "; ".join(reasons))
+
+
 def steady_check(box: Box, run: RunWaves) -> Check:
     """Energy balance, KE plateau and stationary modes in the production of ``run``."""
     ratio, err = run.balance
@@ -317,6 +370,13 @@ N_pair / N (our c/p × 2), are classified on their own (3 frames at least); a st
 thesis ties to a time (N = 50094: a slug at 14000 c/p) is compared there, under either
 reading, and the report names the reading that agrees.
 
+**TC model.** The engine turns a pair collision elastic when the pair collided less than
+t_c ago (the TC model that keeps dense clumps from inelastic collapse; the thesis has none).
+At the default t_c = 10⁻⁵ √(d/g) this made 3-13 % of the W = 30/50 boxes' pair collisions
+elastic, so L42W30H30 is run again at t_c = 10⁻⁶ over the same span (case
+waves-phi0.15-L42W30H30-tc1e-06-edmd): the "TC model" row compares the class over the
+production and at each snapshot window, the KE of each half and the share.
+
 **Peak density.** The densest cell column of the xy plane in each production frame (mean
 over the frames), on the 2 d grid and on ≈ 5 d columns, since the thesis's cells are not
 stated; and in the last frame the fraction of particles with 12 neighbours closer than
@@ -358,6 +418,12 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
                                         "and mode amplitudes against collisions per "
                                         "particle (class " + run.modes.pattern + ")"))
     diagram = [b for b in boxes if b.restitution == RESTITUTION and b.height == b.width]
+    table = dict(measured)
+    if not quick:
+        twin = _measure_twin(runs, failed)
+        ana.checks.append(tc_dependence(measured.get(twin_box().name), twin))
+        if twin is not None:
+            table[twin_name()] = twin
     ana.checks.append(peak_check(measured))
     ana.checks += _phase_checks(boxes, diagram, measured)
     thesis = [(b, THESIS[b.fig].cls, "digest") for b in diagram if b.fig in THESIS]
@@ -369,9 +435,20 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
                                     "(L/W, W/d), demstudy (filled) and the thesis where the "
                                     "digest gives it (rings); × not run"))
     ana.sections.append(("Density waves (Malik Ch. 5): method", METHOD))
-    if measured:
-        ana.sections.append(("Density waves: the runs", _run_table(measured)))
+    if table:
+        ana.sections.append(("Density waves: the runs", _run_table(table)))
     return ana
+
+
+def _measure_twin(runs: Mapping[str, Path], failed: dict[str, str]) -> RunWaves | None:
+    path = runs.get(twin_name())
+    if path is None:
+        return None
+    try:
+        return measure(Path(path))
+    except (OSError, KeyError, ValueError, BadInputFile) as exc:
+        failed[twin_name()] = f"results file unreadable for the mode analysis: {exc}"
+        return None
 
 
 def _phase_checks(boxes: Sequence[Box], diagram: Sequence[Box],
