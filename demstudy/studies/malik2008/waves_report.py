@@ -372,10 +372,11 @@ reading, and the report names the reading that agrees.
 
 **TC model.** The engine makes a pair collision elastic (e = 1, no tangential impulse)
 when either partner collided less than t_c earlier (Luding & McNamara's TC model against
-inelastic collapse; the thesis has none). At the default t_c = 10⁻⁵ √(d/g) this made 3-13 % of the W = 30/50 boxes' pair collisions
-elastic, so L42W30H30 is run again at t_c = 10⁻⁶ over the same span (case
-waves-phi0.15-L42W30H30-tc1e-06-edmd): the "TC model" row compares the class over the
-production and at each snapshot window, the KE of each half and the share.
+inelastic collapse; the thesis has none). At the default t_c = 10⁻⁵ √(d/g) this made
+3-13 % of the W = 30/50 boxes' pair collisions elastic, so L42W30H30 is run again at
+t_c = 10⁻⁶ over the same span (case waves-phi0.15-L42W30H30-tc1e-06-edmd): the "TC model"
+row compares the class over the production and at each snapshot window, the KE of each
+half and the share.
 
 **Peak density.** The densest cell column of the xy plane in each production frame (mean
 over the frames), on the 2 d grid and on ≈ 5 d columns, since the thesis's cells are not
