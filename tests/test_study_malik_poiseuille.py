@@ -16,7 +16,14 @@ import pytest
 from demstudy.io.frames import Frame
 from demstudy.studies.base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, merge
 from demstudy.studies.malik2008 import poiseuille
-from demstudy.studies.malik2008.poiseuille_cases import QUICK, THESIS_SYSTEM, Flow, case_of, cases
+from demstudy.studies.malik2008.poiseuille_cases import (
+    QUICK,
+    SOFT,
+    THESIS_SYSTEM,
+    Flow,
+    case_of,
+    cases,
+)
 from demstudy.studies.malik2008.poiseuille_checks import lambda_mean
 from demstudy.studies.malik2008.poiseuille_data import carnahan_starling, contact_value
 
@@ -30,9 +37,9 @@ def test_case_names_unique_and_quick_is_the_named_subset():
     assert len(names) == len(set(names))
     assert {c.name for c in quick} == {f.name for f in QUICK}
     assert {c.name for c in quick} <= set(names)
-    assert all(c.engine == "edmd" for c in full)
+    assert [c.name for c in full if c.engine != "edmd"] == [SOFT.name]  # the soft check
     # the thesis's grid: 3 β × 4 e at φ = 0.01 and at φ = 0.1, one dense flow
-    assert sum("phi0.01-" in n for n in names) == 12
+    assert sum("phi0.01-" in n and n.endswith("-edmd") for n in names) == 12
     assert sum("phi0.1-" in n for n in names) == 12
     assert sum("phi0.5-" in n for n in names) == 1
 
@@ -40,7 +47,8 @@ def test_case_names_unique_and_quick_is_the_named_subset():
 @pytest.mark.parametrize("quick", [False, True])
 def test_scenes_validate_with_the_thesis_n_box_e_beta_and_25_bins(quick):
     for case in cases(quick):
-        flow = next(f for f in (QUICK if quick else poiseuille._known_flows(False).values())
+        flow = next(f for f in (QUICK if quick else
+                                [*poiseuille._known_flows(False).values(), SOFT])
                     if f.name == case.name)
         scene = case.load(quick)
         n, box = THESIS_SYSTEM[flow.phi]
@@ -239,3 +247,49 @@ def test_a_vdf_spike_is_named_a_spike_not_a_skewed_core():
     assert "bin 13: core a spike" in check.measured
     assert "β = 0.9, e = 0.9 bin 13 the σ-scaled VDF is a spike" in check.reason
     assert "C_x is skewed" not in check.reason and check.verdict == NOT_REPRODUCED
+
+
+# ------------------------------------------------------------------ soft cross-check
+def test_the_soft_case_is_the_hard_flow_in_lammps_shorter_at_ten_steps_per_contact():
+    by_name = {c.name: c for c in cases(False)}
+    soft, hard = by_name[SOFT.name], by_name[SOFT.name.replace("lammps", "edmd")]
+    s, h = soft.load(), hard.load()
+    assert soft.engine == "lammps" and s.soft.steps_per_contact == 10
+    assert (s.particles.count, s.box.size, s.contact, s.walls) == \
+        (h.particles.count, h.box.size, h.contact, h.walls)
+    assert "freepath" not in s.measure.statistics  # the collision log is the event engine's
+    assert s.run.equilibration + s.run.production < h.run.equilibration + h.run.production
+    assert SOFT.name not in {c.name for c in cases(True)}
+
+
+def test_soft_check_agrees_with_itself_and_finds_a_hotter_run(tiny_run):
+    """The soft row compares profiles with both runs' errors: a run (the committed record of
+    the hard flow, 2000 √(d/g) of production) against itself is "reproduced"; a copy 30 %
+    hotter is "not reproduced", naming the temperature; the short tiny run is too noisy to
+    judge ("partly", saying so) even against a 30 % hotter copy; a missing run "not run"."""
+    import copy
+    from pathlib import Path
+
+    from demstudy.studies.malik2008.poiseuille_data import load_flow
+    from demstudy.studies.malik2008.poiseuille_soft import soft_check
+
+    def hotter(path):
+        hot = load_flow(SOFT, path, with_gr=False)
+        hot.res = copy.copy(hot.res)
+        hot.res.profiles = {**hot.res.profiles,
+                            "temperature": 1.3 * hot.res.profiles["temperature"]}
+        return hot
+
+    flow = Flow(SOFT.phi, SOFT.e, SOFT.beta)
+    record = (Path(__file__).parents[1] / "docs" / "data" / "studies" / "malik2008" /
+              "records" / f"{flow.name}.h5")
+    hard = load_flow(flow, record, with_gr=False)
+    same = soft_check(hard, load_flow(SOFT, record, with_gr=False))
+    assert same.verdict == REPRODUCED and "temperature: rel. L2 0 " in same.measured
+    hot = soft_check(hard, hotter(record))
+    assert hot.verdict == NOT_REPRODUCED and "temperature differ" in hot.reason
+    assert "debiased 0.3," in hot.measured
+    _flow, path, _out = tiny_run
+    noisy = soft_check(load_flow(flow, path, with_gr=False), hotter(path))
+    assert noisy.verdict == PARTLY and "too noisy to judge" in noisy.reason
+    assert soft_check(hard, None).verdict == NOT_RUN
