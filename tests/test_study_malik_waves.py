@@ -371,4 +371,11 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     assert apart.verdict == PARTLY and "second half differs" in apart.reason
     shared = tc_dependence(base, dataclasses.replace(twin, tc_fraction=0.08))
     assert shared.verdict == PARTLY and "≥ 5 %" in shared.reason
-    assert tc_dependence(base, None).verdict == NOT_RUN
+    unknown = tc_dependence(base, dataclasses.replace(twin, tc_fraction=float("nan")))
+    assert unknown.verdict == PARTLY and "share at 1e-06: unknown" in unknown.reason
+    wrong = tc_dependence(base, dataclasses.replace(twin, tc=1e-5))
+    assert wrong.verdict == NOT_RUN and "ran at t_c = 1e-05, not 1e-06" in wrong.reason
+    assert tc_dependence(dataclasses.replace(base, tc=1e-5),
+                         dataclasses.replace(twin, tc=1e-6)).verdict == REPRODUCED
+    missing = tc_dependence(base, None, "results file unreadable")
+    assert missing.verdict == NOT_RUN and "unreadable" in missing.reason

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import BadInputFile
 from ...io.results import read_results
 from ..base import NOT_RUN, UNITS_NOTE, Analysis, Check, Figure
 from . import poiseuille_checks as pc
@@ -37,7 +38,7 @@ from .poiseuille_figures import (
     vdf_figure,
     wall_figure,
 )
-from .poiseuille_soft import soft_check
+from .poiseuille_soft import soft_check, soft_unreadable
 from .poiseuille_waves import frame_mode_ratios
 
 __all__ = ["analyse", "cases", "derive"]
@@ -65,12 +66,18 @@ def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
     return out
 
 
-def load_soft(runs: Mapping[str, Path], quick: bool) -> FlowData | None:
-    """The soft cross-check's run (full study only), read without g(r)."""
+def soft_row(data: Runs, runs: Mapping[str, Path]) -> Check:
+    """The soft cross-check's row (full study only): its run read without g(r) and compared
+    with the hard run; an unreadable file or profiles that do not compare give "not run"
+    with the cause, never an exception."""
+    hard = data.get((SOFT.phi, SOFT.beta, SOFT.e))
     path = runs.get(SOFT.name)
-    if quick or path is None or not Path(path).is_file():
-        return None
-    return load_flow(SOFT, Path(path), with_gr=False)
+    if path is None or not Path(path).is_file():
+        return soft_check(hard, None)
+    try:
+        return soft_check(hard, load_flow(SOFT, Path(path), with_gr=False))
+    except (OSError, KeyError, ValueError, BadInputFile) as exc:  # NotComparable: ValueError
+        return soft_unreadable(f"unreadable or not comparable: {exc}")
 
 
 def _percent(fraction: float) -> str:
@@ -102,7 +109,7 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     checks = [c for check in CHECKS for c in check(data)]
     pc.tc_caveats(checks, data)
     if not quick:
-        checks.append(soft_check(data.get((SOFT.phi, SOFT.beta, SOFT.e)), load_soft(runs, quick)))
+        checks.append(soft_row(data, runs))
     for c in checks:  # a statement without runs says so, never crashes
         if c.verdict == NOT_RUN and not c.reason:
             c.reason = "its runs are not in this run of the study"
@@ -218,7 +225,7 @@ def _over_e(ds: list[FlowData], name: str, phi: float, b: float,
 
 def sections(data: Runs, runs: Mapping[str, Path], quick: bool) -> list[tuple[str, str]]:
     """The report's text: what ran, for how long against the thesis, what did not run."""
-    known = _known_flows(quick)
+    known = [*_known_flows(quick), *([] if quick else [SOFT.name])]
     made = sorted(n for n in known if n in runs)
     missing = sorted(n for n in known if n not in runs)
     lines = [UNITS_NOTE, "",

@@ -127,6 +127,7 @@ class RunWaves:
     wall_seconds: float
     tc_fraction: float  # pair collisions the engine's TC model made elastic (not in the thesis)
     snapshot: Snapshot
+    tc: float = float("nan")  # the TC model's t_c the run used (√(d/g))
     #: the class at the thesis's snapshot times (Scan.windows: our c/p → modes)
     windows: dict[float, Modes] = field(default_factory=dict)
 
@@ -379,7 +380,7 @@ def measure(path: Path) -> RunWaves:
         close_packed=close_packed_fraction(last.position, size), rate=rate,
         wall_seconds=float(attrs.get("wall_seconds", float("nan"))),
         tc_fraction=float(attrs.get("tc_elastic_fraction", float("nan"))), snapshot=snap,
-        windows=scan.windows)
+        tc=float(attrs.get("tc", float("nan"))), windows=scan.windows)
 
 
 def close_packed_fraction(position: np.ndarray, size: np.ndarray) -> float:

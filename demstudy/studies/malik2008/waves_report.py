@@ -9,6 +9,7 @@ the thesis is collisions per particle, here c/p = 2 N_pair / N.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -188,10 +189,11 @@ def _cls(pattern: str) -> str:
     return pattern.split(" ")[0]
 
 
-def tc_dependence(base: RunWaves | None, twin: RunWaves | None) -> Check:
+def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -> Check:
     """The TC twin against its box at the default t_c (demstudy's own check; the thesis has
     no TC model): the class of the whole production and at every snapshot window both
-    sampled, the KE of each half, and the share at the smaller t_c."""
+    sampled, the KE of each half, and the share at the smaller t_c. ``why``: the cause when
+    a run is missing (unreadable, failed)."""
     box, tc = twin_box(), TC_TWIN[1]
     ref = "TC model (demstudy; not in the thesis)"
     statement = (f"the structure of {box.tag} (N = {box.n}) does not depend on the "
@@ -201,7 +203,12 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None) -> Check:
     if base is None or twin is None:
         absent = [n for n, r in ((box.name, base), (twin_name(), twin)) if r is None]
         return Check(ref, statement, thesis, "not run", NOT_RUN,
-                     "run missing: " + ", ".join(absent))
+                     "run missing: " + ", ".join(absent) + (f" ({why})" if why else ""))
+    ran = [(t, r) for t, r in ((DEFAULT_TC, base), (tc, twin))
+           if math.isfinite(r.tc) and not math.isclose(r.tc, t)]
+    if ran:
+        return Check(ref, statement, thesis, "not run", NOT_RUN, "; ".join(
+            f"{r.path.name} ran at t_c = {r.tc:g}, not {t:g}" for t, r in ran))
     common = sorted(set(base.windows) & set(twin.windows))
     differ = [c for c in common
               if _cls(base.windows[c].pattern) != _cls(twin.windows[c].pattern)]
@@ -209,30 +216,40 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None) -> Check:
     for t, r in ((DEFAULT_TC, base), (tc, twin)):
         windows = ", ".join(f"{c:.0f} {r.windows[c].pattern}" for c in common)
         (m1, e1), (m2, e2) = r.ke_halves
-        texts.append(f"t_c {t:g}: TC share {100 * r.tc_fraction:.1f} %, class "
-                     f"{r.modes.pattern}; at {windows or 'no common window'}; "
-                     f"dissipation/input {pm(*r.balance)}; KE/N halves {pm(m1, e1)} → "
-                     f"{pm(m2, e2)} m g d")
+        texts.append(f"t_c {t:g}: TC share {_share(r)}, class {r.modes.pattern}; at "
+                     f"{windows or 'no common window'}; dissipation/input {pm(*r.balance)}; "
+                     f"KE/N halves {pm(m1, e1)} → {pm(m2, e2)} m g d")
     halves = zip(base.ke_halves, twin.ke_halves, strict=True)
     ke_apart = [i for i, ((a, ea), (b, eb)) in enumerate(halves)
                 if abs(a - b) > 2.0 * float(np.hypot(ea, eb)) + 0.05 * abs(a)]
     same = _cls(base.modes.pattern) == _cls(twin.modes.pattern) and not differ
-    small = twin.tc_fraction < WARN_SHARE
-    reasons = [("same class over the production and at every common snapshot window" if same
-                else "the class differs: " + (f"{base.modes.pattern} against "
-                                              f"{twin.modes.pattern}" if not differ else
-                                              "at " + ", ".join(f"{c:.0f}" for c in differ)
-                                              + " c/p"))]
+    if not same:
+        reasons = ["the class differs: " + (f"{base.modes.pattern} against "
+                                            f"{twin.modes.pattern}" if not differ else
+                                            "at " + ", ".join(f"{c:.0f}" for c in differ)
+                                            + " c/p")]
+    else:
+        reasons = ["same class over the production" + (
+            f" and at the {len(common)} common snapshot windows" if common else
+            " (no snapshot window in both runs)")]
+        if base.modes.pattern != twin.modes.pattern:
+            reasons[0] += f" ({base.modes.pattern} against {twin.modes.pattern})"
     if ke_apart:
         reasons.append("the KE/N of the " + " and ".join(("first", "second")[i]
                                                         for i in ke_apart)
                        + " half differs by more than 2σ + 5 %: the TC model changes the "
                        "dissipation")
-    reasons.append(f"share at {tc:g}: {100 * twin.tc_fraction:.1f} % "
-                   + ("< 5 %" if small else "≥ 5 % (the engine's warning level)"))
+    small = twin.tc_fraction < WARN_SHARE
+    reasons.append(f"share at {tc:g}: {_share(twin)} " + (
+        "< 5 %" if small else "≥ 5 % (the engine's warning level)"
+        if math.isfinite(twin.tc_fraction) else "(unknown: not in the results file)"))
     verdict = (REPRODUCED if same and small and not ke_apart
                else PARTLY if same else NOT_REPRODUCED)
     return Check(ref, statement, thesis, "; ".join(texts), verdict, "; ".join(reasons))
+
+
+def _share(run: RunWaves) -> str:
+    return f"{100 * run.tc_fraction:.1f} %" if math.isfinite(run.tc_fraction) else "unknown"
 
 
 def steady_check(box: Box, run: RunWaves) -> Check:
@@ -422,7 +439,9 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     table = dict(measured)
     if not quick:
         twin = _measure_twin(runs, failed)
-        ana.checks.append(tc_dependence(measured.get(twin_box().name), twin))
+        ana.checks.append(tc_dependence(measured.get(twin_box().name), twin,
+                                        failed.get(twin_name()) or
+                                        failed.get(twin_box().name, "")))
         if twin is not None:
             table[twin_name()] = twin
     ana.checks.append(peak_check(measured))
