@@ -65,7 +65,9 @@ def soft_check(hard: FlowData | None, soft: FlowData | None) -> Check:
             f"{', resolved' if f.resolved else ''})" for name, f in comp.fields.items()]
     (hs, ht), (ss, st) = (_cost(d) for d in (hard, soft))
     cost = (f"; cost (one core): soft {ss:.0f} s for {st:.0f} √(d/g), hard {hs:.0f} s for "
-            f"{ht:.0f} √(d/g): ×{(ss / st) / (hs / ht):.0f} per unit of simulated time"
+            f"{ht:.0f} √(d/g): ×{(ss / st) / (hs / ht):.0f} per unit of simulated time (the "
+            "runs' own wall times, not timed side by side: docs/accuracy-cost.md compares "
+            "costs interleaved)"
             if all(v > 0 for v in (hs, ht, ss, st)) else "")
     measured = "; ".join(rows) + cost
     fields = comp.fields.values()
