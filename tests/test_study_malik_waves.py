@@ -340,6 +340,18 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     high = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
     assert high.verdict == PARTLY and "made 20.0 % of the pair collisions elastic" in high.reason
 
+    # the box's own TC twin agreed (same class and KE at a small share): no cap, said so;
+    # another box's twin agreeing is mentioned, the cap stays
+    from demstudy.studies.base import Check
+
+    agreed = Check("TC model", "", "", "", REPRODUCED)
+    lifted = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                       agreed, True)
+    assert lifted.verdict == REPRODUCED and "the share does not matter here" in lifted.reason
+    other = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                      None, True)
+    assert other.verdict == PARTLY and "this box's share is not tested" in other.reason
+
 
 def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     """The TC row: the same slug at both t_c with a small share at the smaller one is
