@@ -377,6 +377,10 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
                                 tc_fraction=0.004)
     differs = tc_dependence(base, other)
     assert differs.verdict == NOT_REPRODUCED and "the class differs" in differs.reason
+    c = max(other.windows)  # one snapshot window a plug, the production still a slug
+    window = dataclasses.replace(twin, windows={**twin.windows, c: other.windows[c]})
+    once = tc_dependence(base, window)
+    assert once.verdict == NOT_REPRODUCED and f"the class differs: at {c:.0f} c/p" in once.reason
     (m1, e1), (m2, e2) = base.ke_halves
     hotter = dataclasses.replace(twin, ke_halves=((m1, e1), (1.5 * m2, e2)))
     apart = tc_dependence(base, hotter)
