@@ -212,10 +212,11 @@ def dissipation_checks(data: Runs) -> list[Check]:
         ref = "[L664], [L873]; digest §2.3"
         statement = (f"φ = {phi:g}: β = 0 is the most dissipative case (lowest T at "
                      "each e)")
-        rows, held, tested, used = [], 0, 0, []
+        rows, held, tested, used, untested = [], 0, 0, [], []
         for e in RESTITUTIONS[phi]:
             runs = {b: r for b in BETAS if (r := data.get((phi, b, e))) is not None}
             if 0.0 not in runs or len(runs) < 2:  # β = 0 and at least one other
+                untested.append(f"{e:g}")
                 continue
             means = {b: _mean(*r.series("T")) for b, r in runs.items()}
             used += runs.values()
@@ -231,13 +232,18 @@ def dissipation_checks(data: Runs) -> list[Check]:
                                 f"β = 0 and another β at one e (φ = {phi:g})"))
             continue
         verdict = REPRODUCED if held == tested else PARTLY if held else NOT_REPRODUCED
+        if untested and verdict == REPRODUCED:  # the e not run could still break it
+            verdict = PARTLY
         unsteady = [d for d in used if not d.run_info()["steady"]]
+        missing = (f"; not tested at e = {', '.join(untested)} (β = 0 and another β not both "
+                   "run)" if untested else "")
         out.append(Check(ref, statement, "lowest T for β = 0",
                          f"channel-mean T*: {'; '.join(rows)}; holds at {held} of {tested} e",
                          _cap(verdict, unsteady[0]) if unsteady else verdict,
-                         ("" if held == tested else "β = 0 is not the coldest beyond 2σ at "
-                                                    "every e")
-                         + (_steady_note(unsteady[0]) if unsteady else "")))
+                         (("" if held == tested else "β = 0 is not the coldest beyond 2σ at "
+                                                     "every e tested")
+                          + missing + (_steady_note(unsteady[0]) if unsteady else "")
+                          ).strip().removeprefix("; ")))
     return out
 
 
