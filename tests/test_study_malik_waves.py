@@ -395,3 +395,43 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
                          dataclasses.replace(twin, tc=1e-6)).verdict == REPRODUCED
     missing = tc_dependence(base, None, "results file unreadable")
     assert missing.verdict == NOT_RUN and "unreadable" in missing.reason
+
+
+def test_unbalanced_run_names_the_clock_that_dense_clumps_speed_up(tmp_path: Path) -> None:
+    """A run still accelerating (input > dissipation) whose collision rate grows ×10 over the
+    production (a slug forming): the KE against c/p rises ten times more slowly than in time,
+    and the reason must say so with the measured rates; with a steady collision rate it must
+    not blame the clock."""
+    import dataclasses
+
+    from demstudy.studies.base import NOT_REPRODUCED
+    from demstudy.studies.malik2008.waves_boxes import BOXES
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import steady_check
+
+    box = next(b for b in BOXES if b.tag == "L70W50H50")
+    base = measure(_synthetic_run(tmp_path / "base.h5", lambda x, y: 0.15 + 0.0 * x))
+    t = base.time
+    prod = t - base.eq_end
+    span = float(prod[-1])
+    # c/p per unit time rises linearly from 100 to 1000 over the production
+    cpp = np.where(prod > 0, 100.0 * prod + 450.0 * prod ** 2 / span, 100.0 * prod)
+    ke = 1000.0 + 10.0 * t  # KE/N rises steadily in time
+    running = dataclasses.replace(base, cpp=cpp, ke=ke, balance=(0.5, 0.02))
+    clock = running.clock()
+    assert 5.0 < clock.speed_up < 12.0
+    # the KE's rise per unit c/p is the rise per unit time over the clock's late rate
+    rel_t = clock.ke_per_10t / 10.0  # % per unit time
+    assert math.isclose(clock.ke_per_kcpp, 1000.0 * rel_t / clock.end, rel_tol=0.05)
+    check = steady_check(box, running)
+    assert check.verdict == NOT_REPRODUCED
+    assert "speed the clock up" in check.reason and f"×{clock.speed_up:.1f}" in check.reason
+    assert "still accelerates" in check.reason
+
+    steady_clock = dataclasses.replace(running, cpp=100.0 * t)
+    check = steady_check(box, steady_clock)
+    assert check.verdict == NOT_REPRODUCED and "clock" not in check.reason
+    assert "runs longer in time" in check.reason
+
+    slowing = dataclasses.replace(running, balance=(1.5, 0.02))
+    assert "decelerates" in steady_check(box, slowing).reason

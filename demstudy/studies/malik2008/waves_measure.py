@@ -161,6 +161,47 @@ class RunWaves:
         ratio, err = self.balance
         return abs(ratio - 1.0) <= 2.0 * err
 
+    def clock(self) -> Clock:
+        """The thesis's clock (collisions per particle) against time over the production: its
+        rate over the first and the last fifth, and the KE's rise over the last fifth per
+        1000 c/p and per 10 √(d/g). Dense clumps collide far more often than the dilute
+        gas, so as a slug forms c/p runs ahead of time and the KE against c/p can look flat
+        while the flow still accelerates (the thesis's warning, digest §1.8)."""
+        keep = np.flatnonzero(self.time >= self.eq_end)
+        if keep.size < 6:
+            nan = float("nan")
+            return Clock(nan, nan, nan, nan, nan)
+        k = max(2, keep.size // 5)
+        first, last = keep[:k], keep[-k:]
+
+        def slope(y: np.ndarray, x: np.ndarray) -> float:
+            return float(np.polyfit(x, y, 1)[0])
+
+        ke_last = float(np.mean(self.ke[last]))
+        return Clock(
+            start=slope(self.cpp[first], self.time[first]),
+            end=slope(self.cpp[last], self.time[last]),
+            ke_per_kcpp=1e5 * slope(self.ke[last], self.cpp[last]) / ke_last,
+            ke_per_10t=1e3 * slope(self.ke[last], self.time[last]) / ke_last,
+            span=float(np.ptp(self.time[keep])))
+
+
+@dataclass(frozen=True)
+class Clock:
+    """See RunWaves.clock: c/p per √(d/g) at the start and the end of the production, the
+    KE's rise over the last fifth in % per 1000 c/p and per 10 √(d/g), and the production's
+    length in √(d/g)."""
+
+    start: float
+    end: float
+    ke_per_kcpp: float
+    ke_per_10t: float
+    span: float
+
+    @property
+    def speed_up(self) -> float:
+        return self.end / self.start if self.start > 0 else float("nan")
+
 
 def density_waves(size: np.ndarray) -> DensityWaves:
     """The package's density-wave analysis on a channel of ``size`` (walls along y: the
