@@ -253,6 +253,14 @@ def test_plug_turning_into_slug_is_not_steady_though_energy_is(tmp_path: Path) -
     steady = measure(_synthetic_run(tmp_path / "steady.h5", plug))
     assert steady.stationary and steady.modes.pattern == "plug"
     assert steady_check(box, steady).verdict == REPRODUCED
+    # a slug at one snapshot window of the production (too short to move a half): the
+    # structure has not settled, and the row names the window
+    import dataclasses
+
+    early = dataclasses.replace(steady, windows={11000.0: changing.halves[1]})
+    assert early.window_changes == [11000.0] and not early.stationary
+    check = steady_check(box, early)
+    assert check.verdict == PARTLY and "11000 c/p: slug" in check.measured
 
 
 def test_a_record_measures_as_its_run(tmp_path: Path) -> None:
@@ -373,6 +381,9 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     same = tc_dependence(base, twin)
     assert same.verdict == REPRODUCED and "share at 1e-06: 0.4 % < 5 %" in same.reason
     assert "TC share 6.0 %" in same.measured and "TC share 0.4 %" in same.measured
+    assert "clock" not in same.reason  # the same collision rate: equal c/p is equal time
+    faster = tc_dependence(base, dataclasses.replace(twin, rate=1.44 * base.rate))
+    assert faster.verdict == REPRODUCED and "the collision clock runs ×1.44" in faster.reason
     other = dataclasses.replace(measure(_synthetic_run(tmp_path / "b.h5", plug, rate=250.0)),
                                 tc_fraction=0.004)
     differs = tc_dependence(base, other)

@@ -70,6 +70,12 @@ class FlowData:
             return fp["knudsen"], fp["knudsen_err"]
         raise KeyError(f"profile {key!r}: allowed ux, omz, phi, T, theta, Kn")
 
+    def mean_temperature(self) -> tuple[float, float]:
+        """The run's mass-weighted mean translational T over the bins and its jackknife
+        error (the profiles analysis's ``mean_temperature``)."""
+        return (float(self.prof["mean_temperature"]),
+                float(self.prof["mean_temperature_err"]))
+
     def wall_value(self, key: str) -> tuple[float, float]:
         """Malik's wall value (§4.5): the mean of the two bins adjacent to the walls (bins 1
         and 25); ω_z is antisymmetric, so its lower-wall value enters with the opposite sign

@@ -40,6 +40,11 @@ THESIS_SPAN = {"run": {"unit": "collisions", "equilibration": 1000.0, "productio
 TC_TWIN = ("L42W30H30", 1e-6)
 
 
+def on_thesis_span(box: Box) -> bool:
+    """Whether ``box`` runs over the thesis's span (W ≥ 30) rather than its shipped scene's."""
+    return box.width >= 30
+
+
 def twin_box() -> Box:
     return next(b for b in BOXES if b.tag == TC_TWIN[0] and b.restitution == 0.7)
 
@@ -57,7 +62,7 @@ def cases(quick: bool) -> list[Case]:
     for box in BOXES:
         sections = {} if box.restitution == 0.7 else {"contact": {"restitution":
                                                                   box.restitution}}
-        if box.width >= 30:
+        if on_thesis_span(box):
             sections = {**sections, **THESIS_SPAN}
         is_quick = box.tag in QUICK and box.restitution == 0.7
         if quick and not is_quick:

@@ -141,10 +141,20 @@ class RunWaves:
 
     @property
     def stationary(self) -> bool:
-        """Modes stationary: the same class in both halves and no family drifting by more
-        than DRIFT_SIGMAS."""
+        """Modes stationary: the same class in both halves, no family drifting by more than
+        DRIFT_SIGMAS, and no snapshot window of the production with another class (a plug
+        turning into a slug early in the production hides in a half otherwise)."""
         same = self.halves[0].pattern == self.halves[1].pattern
-        return same and all(d.sigmas <= DRIFT_SIGMAS for d in self.drifts)
+        return (same and all(d.sigmas <= DRIFT_SIGMAS for d in self.drifts)
+                and not self.window_changes)
+
+    @property
+    def window_changes(self) -> list[float]:
+        """The snapshot windows (our c/p; all within the production) whose class, its first
+        word, differs from the whole production's."""
+        whole = self.modes.pattern.split(" ")[0]
+        return [c for c, m in sorted(self.windows.items())
+                if m.pattern.split(" ")[0] != whole]
 
     @property
     def max_drift(self) -> Drift | None:

@@ -28,7 +28,7 @@ from ..base import (
     Figure,
     pm,
 )
-from .waves import TC_TWIN, twin_box, twin_name
+from .waves import TC_TWIN, on_thesis_span, twin_box, twin_name
 from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
 from .waves_measure import COARSE, DRIFT_SIGMAS, SNAPSHOTS, WINDOW, RunWaves, measure
@@ -98,8 +98,9 @@ def _stationary_text(run: RunWaves) -> str:
     drift = (f"largest drift {worst.sigmas:.1f}σ ({worst.plane} {worst.k}: "
              f"{pm(*worst.first)} → {pm(*worst.second)})" if worst else "no modes")
     halves = " / ".join(h.pattern for h in run.halves)
+    changes = "".join(f"; {c:.0f} c/p: {run.windows[c].pattern}" for c in run.window_changes)
     return (f"modes {'stationary' if run.stationary else 'NOT stationary'} over "
-            f"{run.eq_cpp:.0f}-{run.end_cpp:.0f} c/p (halves: {halves}; {drift})")
+            f"{run.eq_cpp:.0f}-{run.end_cpp:.0f} c/p (halves: {halves}; {drift}{changes})")
 
 
 def _windows_text(run: RunWaves) -> str:
@@ -231,7 +232,8 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -
         (m1, e1), (m2, e2) = r.ke_halves
         texts.append(f"t_c {t:g}: TC share {_share(r)}, class {r.modes.pattern}; at "
                      f"{windows or 'no common window'}; dissipation/input {pm(*r.balance)}; "
-                     f"KE/N halves {pm(m1, e1)} → {pm(m2, e2)} m g d")
+                     f"KE/N halves {pm(m1, e1)} → {pm(m2, e2)} m g d; {r.rate:.0f} c/p per "
+                     "√(d/g)")
     halves = zip(base.ke_halves, twin.ke_halves, strict=True)
     ke_apart = [i for i, ((a, ea), (b, eb)) in enumerate(halves)
                 if abs(a - b) > 2.0 * float(np.hypot(ea, eb)) + 0.05 * abs(a)]
@@ -252,6 +254,12 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -
                                                         for i in ke_apart)
                        + " half differs by more than 2σ + 5 %: the TC model changes the "
                        "dissipation")
+    clock = twin.rate / base.rate
+    if not 0.8 < clock < 1.25:
+        # equal c/p is then not equal time: the dense clumps collide at another rate
+        reasons.append(f"the collision clock runs ×{clock:.2f} at t_c = {tc:g} (the clumps "
+                       "collide more often when fewer collisions are elastic): the windows "
+                       "compare at equal c/p, not at equal time")
     small = twin.tc_fraction < WARN_SHARE
     reasons.append(f"share at {tc:g}: {_share(twin)} " + (
         "< 5 %" if small else "≥ 5 % (the engine's warning level)"
@@ -277,15 +285,16 @@ def steady_check(box: Box, run: RunWaves) -> Check:
     thesis = "balance = 1; KE plateau; stationary modes"
     if not run.balanced:
         return Check(STEADY_REF, statement, thesis, measured, NOT_REPRODUCED,
-                     _unbalanced_reason(run))
+                     _unbalanced_reason(run, on_thesis_span(box)))
     if not run.plateau:
         return Check(STEADY_REF, statement, thesis, measured, PARTLY,
                      "energy balance holds but the KE of the two halves differs by > 2σ")
     if not run.stationary:
         return Check(STEADY_REF, statement, thesis, measured, PARTLY,
                      f"energy balanced and KE on a plateau, but a mode drifts by > "
-                     f"{DRIFT_SIGMAS:g}σ or the class changes between the halves: the "
-                     "structure has not settled (the thesis's warning, N = 50094)")
+                     f"{DRIFT_SIGMAS:g}σ or the class changes between the halves or at a "
+                     "snapshot window: the structure has not settled (the thesis's warning, "
+                     "N = 50094)")
     return Check(STEADY_REF, statement, thesis, measured, REPRODUCED)
 
 
@@ -293,11 +302,16 @@ def steady_check(box: Box, run: RunWaves) -> Check:
 CLOCK_SPEED_UP = 2.0
 
 
-def _unbalanced_reason(run: RunWaves) -> str:
+def _unbalanced_reason(run: RunWaves, thesis_span: bool) -> str:
     """Why input and dissipation differ: which way, and, when dense clumps speed up the
     thesis's clock (c/p) over the production, how flat the KE looks against c/p while it
-    still rises in time (the thesis's plateau at 11000 c/p for N = 50094 may be this)."""
+    still rises in time (the thesis's plateau at 11000 c/p for N = 50094 may be this).
+    ``thesis_span``: the run is as long as the thesis's, so its structures are transients."""
     ratio, _ = run.balance
+    if thesis_span:
+        return _unbalanced_reason(run, False) + (
+            "; this run spans the thesis's own c/p, so the thesis's snapshots (≤ 14000 c/p) "
+            "show a flow not yet steady in time")
     if not ratio < 1.0:
         return ("input and dissipation do not balance within 2σ: the dissipation exceeds "
                 "gravity's input, the flow decelerates from an overshoot (longer runs needed)")
