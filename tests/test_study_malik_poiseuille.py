@@ -342,3 +342,36 @@ def test_coldest_beta_is_judged_on_the_mass_weighted_temperature():
     assert "holds at 1 of 1 e" in row.measured and "mass-weighted" in row.measured
     # only e = 0.99 tested: the other e of the thesis could still break it
     assert row.verdict == PARTLY and "not tested at e = 0.7, 0.8, 0.9" in row.reason
+
+
+def test_a_heavy_tailed_symmetric_vdf_is_not_blamed_on_skewness():
+    """C_y with Student-t tails (kurtosis 4, no skew) scaled by its σ and P(0) = 1: its core
+    lies 14 % below exp(-x²/2) at |x| = 1. The check names C_y and the tails-narrow-the-core
+    cause, not a skewed C_x; the skewed C_x of another bin is named as skewed."""
+    from scipy import stats
+
+    from demstudy.studies.malik2008.poiseuille_checks import vdf_checks
+
+    x = np.linspace(-4.9, 4.9, 50)
+    gauss = np.exp(-0.5 * x**2)
+    nu = 10.0
+    scale = math.sqrt(nu / (nu - 2.0))
+    student = stats.t.pdf(x * scale, nu) / stats.t.pdf(0.0, nu)
+    assert 0.13 < 1.0 - np.interp(1.0, x, student) / math.exp(-0.5) < 0.15
+    p = np.tile(gauss, (25, 6, 1))
+    kurt, skew = np.full((25, 6), 3.0), np.zeros((25, 6))
+    p[12, 1], kurt[12, 1] = student, 4.0  # bin 13, C_y: symmetric, heavy tails
+    p[3, 0], skew[3, 0] = np.exp(-0.5 * (x - 0.4) ** 2), -0.8  # bin 4, C_x: displaced peak
+    vdf = {"malik_centres": x, "malik_P": p, "malik_P_err": np.full_like(p, 1e-3),
+           "gaussian_binned": gauss, "kurtosis": kurt, "kurtosis_err": np.full((25, 6), 0.1),
+           "skewness": skew}
+    d = SimpleNamespace(flow=Flow(0.01, 0.8, 0.99), stat=lambda name: vdf,
+                        run_info=lambda: {"steady": True, "trend": 0.0, "tc_fraction": 0.0,
+                                          "tc": 1e-5})
+    check = next(c for c in vdf_checks({(0.01, 0.99, 0.8): d})
+                 if c.statement.startswith("φ = 0.01"))
+    assert check.verdict == PARTLY  # tails non-Gaussian, core not within 10 %
+    assert "C_y symmetric but with kurtosis ≠ 3" in check.reason
+    assert "C_x skewed" in check.reason and "C_y skewed" not in check.reason
+    assert "unexplained" not in check.reason
+    assert "bin 13: core dev 0/1" in check.measured  # C_x within, C_y ≈ 14 % off
