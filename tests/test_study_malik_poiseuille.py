@@ -375,3 +375,63 @@ def test_a_heavy_tailed_symmetric_vdf_is_not_blamed_on_skewness():
     assert "C_x skewed" in check.reason and "C_y skewed" not in check.reason
     assert "unexplained" not in check.reason
     assert "bin 13: core dev 0/1" in check.measured  # C_x within, C_y ≈ 14 % off
+
+
+def _vdf_run(flow: Flow, excess: float, steady: bool = True) -> SimpleNamespace:
+    """A run whose centre bin has kurtosis 3 + ``excess`` (± 0.03) in C_x, C_y, C_z."""
+    vdf = {"kurtosis": np.full((25, 6), 3.0 + excess), "kurtosis_err": np.full((25, 6), 0.03)}
+    return SimpleNamespace(flow=flow, stat=lambda name: vdf,
+                           run_info=lambda: {"steady": steady, "trend": 0.0 if steady else 0.3,
+                                             "tc_fraction": 0.0, "tc": 1e-5})
+
+
+def test_vdfs_approach_the_gaussian_as_e_goes_to_one():
+    """[L1491]: |κ - 3| at the centre falls from the smallest to the largest e at every β
+    ("reproduced"); where it does not fall beyond 2σ the row says at how many β; an
+    unsteady run caps the verdict; one e per β cannot test it."""
+    from demstudy.studies.malik2008.poiseuille_checks import vdf_elastic_limit_checks
+
+    def check(data):
+        return next(c for c in vdf_elastic_limit_checks(data) if c.statement.startswith(
+            "φ = 0.01"))
+
+    falls = {(0.01, b, e): _vdf_run(Flow(0.01, e, b), x) for b in (0.0, 0.99)
+             for e, x in ((0.8, 0.8), (0.9, 0.5), (0.99, 0.1))}
+    good = check(falls)
+    assert good.verdict == REPRODUCED and "holds at 2 of 2 β" in good.measured
+    assert "e = 0.8 0.800 ± 0.017 → e = 0.99 0.100 ± 0.017" in good.measured
+    flat = {**falls, (0.01, 0.99, 0.99): _vdf_run(Flow(0.01, 0.99, 0.99), 0.78)}
+    half = check(flat)
+    assert half.verdict == PARTLY and "at 1 of 2 β" in half.reason
+    rising = {k: _vdf_run(d.flow, 1.0 - v) for (k, d), v in
+              zip(falls.items(), (0.8, 0.5, 0.1) * 2, strict=True)}
+    assert check(rising).verdict == NOT_REPRODUCED
+    unsteady = {**falls, (0.01, 0.0, 0.8): _vdf_run(Flow(0.01, 0.8, 0.0), 0.8, steady=False)}
+    capped = check(unsteady)
+    assert capped.verdict == PARTLY and "not in steady state" in capped.reason
+    single = {k: d for k, d in falls.items() if k[2] == 0.8}
+    assert check(single).verdict == NOT_RUN
+
+
+def test_elastic_walls_cannot_dissipate_so_the_wall_dissipation_claim_fails():
+    """[L726] claims large wall dissipation at β = 0, but the thesis's walls (e_w = β_w = 1)
+    conserve energy: with such walls the row is "not reproduced" and says why; a run with
+    dissipative walls cannot separate the wall share ("partly"); no β = 0 run: "not run"."""
+    from demstudy.studies.malik2008.poiseuille_checks import wall_dissipation_checks
+
+    def run(restitution: float) -> SimpleNamespace:
+        wall = SimpleNamespace(restitution=restitution,
+                               tangential=SimpleNamespace(model="beta", beta=1.0))
+        ts = {"dissipated_energy": np.array([0.0, 99.0]), "gravity_work": np.array([0.0, 100.0]),
+              "wall_work_lower": np.zeros(2), "wall_work_upper": np.zeros(2)}
+        return SimpleNamespace(flow=Flow(0.01, 0.8, 0.0),
+                               res=SimpleNamespace(scene=SimpleNamespace(walls=[wall, wall]),
+                                                   timeseries=ts))
+
+    (row,) = wall_dissipation_checks({(0.01, 0.0, 0.8): run(1.0)})
+    assert row.verdict == NOT_REPRODUCED and "dissipate nothing" in row.reason
+    assert "dissipation/gravity's work 0.9900" in row.measured
+    (lossy,) = wall_dissipation_checks({(0.01, 0.0, 0.8): run(0.9)})
+    assert lossy.verdict == PARTLY and "not separated" in lossy.reason
+    (none,) = wall_dissipation_checks({(0.01, 0.99, 0.8): run(1.0)})
+    assert none.verdict == NOT_RUN

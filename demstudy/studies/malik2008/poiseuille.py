@@ -48,7 +48,8 @@ Runs = dict[tuple[float, float, float], FlowData]  # (φ, β, e) -> run
 #: the checks, in the report's order: each takes the runs and returns its Check(s)
 CHECKS: tuple[Callable[[Runs], list[Check]], ...] = (
     pc.steady_checks, pc.validation_checks, pc.dissipation_checks, pc.knudsen_checks,
-    pc.vdf_checks, pc.contact_checks, pc.lambda_checks, pc.dense_checks, pc.wave_checks)
+    pc.vdf_checks, pc.vdf_elastic_limit_checks, pc.wall_dissipation_checks,
+    pc.contact_checks, pc.lambda_checks, pc.dense_checks, pc.wave_checks)
 
 
 def _known_flows(quick: bool) -> dict[str, Flow]:
