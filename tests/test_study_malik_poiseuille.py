@@ -435,3 +435,29 @@ def test_elastic_walls_cannot_dissipate_so_the_wall_dissipation_claim_fails():
     assert lossy.verdict == PARTLY and "not separated" in lossy.reason
     (none,) = wall_dissipation_checks({(0.01, 0.99, 0.8): run(1.0)})
     assert none.verdict == NOT_RUN
+
+
+def test_plug_knudsen_reports_both_readings_of_the_free_path():
+    """[L875]: Kn 'extremely low' in the β = 0 plug. Free paths relative to the flow give
+    0.005 there, the lab-frame displacements of the thesis's formula ≈ 0.1 (the plug carries
+    the particles between collisions): holding under one reading only is "partly" and says
+    which; under both "reproduced"; under neither "not reproduced"."""
+    from demstudy.studies.malik2008.poiseuille_checks import knudsen_checks
+
+    def run(beta: float, rel: float, lab: float) -> SimpleNamespace:
+        values = {"Kn": (rel, 0.0005), "Kn_lab": (lab, 0.002)}
+        return SimpleNamespace(flow=Flow(0.1, 0.7, beta), centre_value=values.__getitem__,
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    def row(plug_lab: float, plug_rel: float = 0.005):
+        data = {(0.1, 0.0, 0.7): run(0.0, plug_rel, plug_lab),
+                (0.1, 0.99, 0.7): run(0.99, 0.03, 0.2), (0.1, -0.99, 0.7): run(-0.99, 0.04, 0.3)}
+        return knudsen_checks(data)[-1]
+
+    relative_only = row(0.1)
+    assert relative_only.verdict == PARTLY
+    assert "holds only with free paths relative to the local mean flow" in relative_only.reason
+    assert "β = 0: 0.1000 ± 0.0020" in relative_only.measured.split("lab-frame")[1]
+    assert row(0.004).verdict == REPRODUCED
+    assert row(0.1, plug_rel=0.05).verdict == NOT_REPRODUCED

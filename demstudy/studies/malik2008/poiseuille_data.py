@@ -50,7 +50,7 @@ class FlowData:
         return self.prof["y"]
 
     def series(self, key: str) -> tuple[np.ndarray, np.ndarray]:
-        """(value, error) profile of ``key``: ux, omz, phi, T, theta, Kn."""
+        """(value, error) profile of ``key``: ux, omz, phi, T, theta, Kn, Kn_lab."""
         p = self.prof
         if key == "ux":
             return p["velocity"][:, 0], p["velocity_err"][:, 0]
@@ -62,13 +62,16 @@ class FlowData:
             return p["temperature"], p["temperature_err"]
         if key == "theta":
             return p["rotational_temperature"], p["rotational_temperature_err"]
-        if key == "Kn":
+        if key in ("Kn", "Kn_lab"):
+            # Kn: free paths relative to the local mean flow; Kn_lab: the lab-frame
+            # displacements between collisions of the thesis's formula (digest §4.4)
+            name = "knudsen" if key == "Kn" else "lab_knudsen"
             fp = self.stat("freepath")
-            if "knudsen" not in fp:
+            if name not in fp:
                 n = self.y.size
                 return np.full(n, np.nan), np.full(n, np.nan)
-            return fp["knudsen"], fp["knudsen_err"]
-        raise KeyError(f"profile {key!r}: allowed ux, omz, phi, T, theta, Kn")
+            return fp[name], fp[f"{name}_err"]
+        raise KeyError(f"profile {key!r}: allowed ux, omz, phi, T, theta, Kn, Kn_lab")
 
     def mean_temperature(self) -> tuple[float, float]:
         """The run's mass-weighted mean translational T over the bins and its jackknife
