@@ -446,3 +446,31 @@ def test_unbalanced_run_names_the_clock_that_dense_clumps_speed_up(tmp_path: Pat
 
     slowing = dataclasses.replace(running, balance=(1.5, 0.02))
     assert "decelerates" in steady_check(box, slowing).reason
+
+
+def test_peak_density_is_judged_box_by_box(tmp_path: Path) -> None:
+    """The colour bars' ≈ 0.58: a box whose 2 d / 5 d peaks bracket 0.58 (± 2σ + 0.03)
+    counts; one box in range makes the row "partly" (the thesis's cells are unknown), none
+    "not reproduced", and a close-packed densest box is named only when it is out of range."""
+    import dataclasses
+
+    from demstudy.studies.base import NOT_REPRODUCED, PARTLY
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import peak_check
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    base = measure(_synthetic_run(tmp_path / "p.h5", plug))
+
+    def box(fine: float, coarse: float, packed: float = 0.0):
+        return dataclasses.replace(base, peak=(fine, 0.002), peak_coarse=(coarse, 0.002),
+                                   close_packed=packed)
+
+    runs = {"waves-phi0.15-L45W15H15-edmd": box(0.64, 0.58),
+            "waves-phi0.15-L75W15H15-edmd": box(0.73, 0.68, packed=0.05)}
+    row = peak_check(runs)
+    assert row.verdict == PARTLY and "in 1 of 2 boxes" in row.reason
+    assert "L45W15H15 0.6400 ± 0.0020 / 0.5800 ± 0.0020 (0.58 within)" in row.measured
+    assert "the densest, L75W15H15, has 5.0 %" in row.reason
+    none = peak_check({"waves-phi0.15-L9W15H15-edmd": box(0.39, 0.32)})
+    assert none.verdict == NOT_REPRODUCED and "in every box" in none.reason
+    assert peak_check({}).verdict == NOT_RUN

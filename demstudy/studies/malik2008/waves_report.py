@@ -349,40 +349,48 @@ def _series_check(ref: str, statement: str, boxes: Sequence[Box],
                  (f"; not run: {', '.join(missing)}" if missing else ""))
 
 
+def _peak_range(run: RunWaves) -> tuple[float, float]:
+    """The range of the peak over the two grids, ± 2σ + 0.03 (the colour bar's reading)."""
+    fine, coarse = run.peak, run.peak_coarse
+    err = 2 * max(fine[1], coarse[1]) + 0.03
+    return min(fine[0], coarse[0]) - err, max(fine[0], coarse[0]) + err
+
+
 def peak_check(measured: Mapping[str, RunWaves]) -> Check:
-    """The densest cells of the structures against the thesis's colour bars (≈ 0.58): the
-    thesis's cells are not stated, so the peak is given on two grids (≈ 2 d and ≈ 5 d)."""
+    """The densest cells of the structures against the thesis's colour bars (≈ 0.58), box by
+    box: the thesis's cells are not stated, so each box's peak is given on two grids (≈ 2 d
+    and ≈ 5 d) and 0.58 "lies within" when it falls in their range ± 2σ + 0.03. At most
+    "partly" (the cells and the snapshot times differ); "not reproduced" when no box's range
+    holds it."""
     ref = "Ch. 5 colour bars (digest §3.4, §6)"
     statement = "dense plugs and slugs reach a local solid fraction of about 0.58"
     if not measured:
         return Check(ref, statement, "≈ 0.58", "not run", NOT_RUN, "no run made")
-    name, run = max(measured.items(), key=lambda item: item[1].peak_coarse[0])
-    fine, coarse = run.peak, run.peak_coarse
-    text = (f"densest cell column of the xy plane (depth-averaged), mean over the production "
-            f"frames, {name}: {pm(*fine)} on 2 d cells, {pm(*coarse)} on {COARSE:g} d cells "
-            f"({100 * run.close_packed:.1f} % of its particles have 12 neighbours within "
-            "1.05 d in the last frame); "
-            "others (2 d / 5 d): " + "; ".join(
-                f"{n.split('-')[2]} {pm(*r.peak)} / {pm(*r.peak_coarse)}"
-                for n, r in measured.items() if n != name))
-    lo = min(fine[0], coarse[0]) - 2 * max(fine[1], coarse[1]) - 0.03
-    hi = max(fine[0], coarse[0]) + 2 * max(fine[1], coarse[1]) + 0.03
+    tag = {n: n.split("-")[2] + ("-tc" if "-tc" in n else "") for n in measured}
+    within = [n for n, r in measured.items() if _peak_range(r)[0] <= 0.58 <= _peak_range(r)[1]]
+    text = ("densest cell column of the xy plane (depth-averaged), mean over the production "
+            f"frames, on 2 d / {COARSE:g} d cells: " + "; ".join(
+                f"{tag[n]} {pm(*r.peak)} / {pm(*r.peak_coarse)}"
+                + (" (0.58 within)" if n in within else "") for n, r in measured.items())
+            + f"; 0.58 within {len(within)} of {len(measured)} boxes")
     cells = ("the thesis's cells (N1 × N2 × N3) are not stated and the peak depends on them "
-             f"({pm(*fine)} on 2 d, {pm(*coarse)} on {COARSE:g} d columns)")
-    if lo <= 0.58 <= hi:
-        return Check(ref, statement, "≈ 0.58", text, PARTLY,
-                     "0.58 lies within the range of the two grids (± 2σ + 0.03, the colour "
-                     "bar's reading), but " + cells)
-    packed = (f"; {100 * run.close_packed:.1f} % of the particles of {name} touch 12 "
-              "neighbours (a close-packed, FCC/HCP-like core; random close packing is 0.64): "
-              "the clump compacts beyond the thesis's, possibly helped by the engine's TC "
-              "model (elastic pair collisions within t_c = 10⁻⁵, absent from the thesis) and "
-              "sampled far later (production from "
+             f"(2 d against {COARSE:g} d columns above)")
+    name, run = max(measured.items(), key=lambda item: item[1].peak_coarse[0])
+    packed = (f"; the densest, {tag[name]}, has {100 * run.close_packed:.1f} % of its "
+              "particles touching 12 neighbours (a close-packed, FCC/HCP-like core; random "
+              "close packing is 0.64): its clump compacts beyond the thesis's, possibly helped "
+              "by the engine's TC model (elastic pair collisions within t_c = 10⁻⁵, absent "
+              "from the thesis) and sampled far later (production from "
               f"{run.eq_cpp:.0f} c/p, the thesis's snapshots ≤ 14000)"
-              if run.close_packed > 0.01 else "")
+              if run.close_packed > 0.01 and name not in within else "")
+    if within:
+        return Check(ref, statement, "≈ 0.58", text, PARTLY,
+                     f"0.58 lies within the two grids' range (± 2σ + 0.03, the colour bar's "
+                     f"reading) in {len(within)} of {len(measured)} boxes, but " + cells
+                     + packed)
     return Check(ref, statement, "≈ 0.58", text, NOT_REPRODUCED,
-                 "0.58 lies outside the range of the two grids (± 2σ + 0.03); " + cells +
-                 packed)
+                 "0.58 lies outside the two grids' range (± 2σ + 0.03) in every box; " + cells
+                 + packed)
 
 
 def _run_table(measured: Mapping[str, RunWaves]) -> str:
