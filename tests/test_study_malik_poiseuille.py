@@ -461,3 +461,27 @@ def test_plug_knudsen_reports_both_readings_of_the_free_path():
     assert "β = 0: 0.1000 ± 0.0020" in relative_only.measured.split("lab-frame")[1]
     assert row(0.004).verdict == REPRODUCED
     assert row(0.1, plug_rel=0.05).verdict == NOT_REPRODUCED
+
+
+def test_an_s_wave_must_beat_the_slug_mode():
+    """Fig 4.5's S-wave: the (1, ±1) mode above the shot noise and above the slug's (1, 0)
+    beyond 2σ; a (1, 1) above noise but no stronger than (1, 0) is not an S-wave."""
+    from demstudy.studies.malik2008.poiseuille_checks import wave_checks
+
+    def run(r11: float, r10: float):
+        from demstudy.studies.records import DERIVED
+
+        groups = {f"{DERIVED}/mode_ratios": {"11": np.array([r11, 10.0]),
+                                        "10": np.array([r10, 5.0]),
+                                        "01": np.array([7000.0, 100.0])}}
+        return SimpleNamespace(flow=Flow(0.1, 0.7, 0.99), res=SimpleNamespace(groups=groups),
+                               path=None,
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    (s,) = wave_checks({(0.1, 0.99, 0.7): run(391.0, 70.0)})
+    assert s.verdict == REPRODUCED and "R(1,±1) S-wave = 391 ± 10" in s.measured
+    (slug,) = wave_checks({(0.1, 0.99, 0.7): run(80.0, 75.0)})
+    assert slug.verdict == NOT_REPRODUCED and "rather than an S-wave" in slug.reason
+    (noise,) = wave_checks({(0.1, 0.99, 0.7): run(1.0, 0.5)})
+    assert noise.verdict == NOT_REPRODUCED and "noise of independent" in noise.reason

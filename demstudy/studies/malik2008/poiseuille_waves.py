@@ -51,10 +51,9 @@ def frame_mode_ratios(path: Path) -> dict[str, tuple[float, float]]:
     return out
 
 
-def s_wave(d: FlowData) -> tuple[float, float, str]:
-    """(R of (1, ±1), its error, text with all three modes)."""
-    r = mode_ratios(d)
+def s_wave_text(r: dict[str, tuple[float, float]]) -> str:
+    """The three modes of ``mode_ratios`` as the report shows them."""
     text = ", ".join(f"R{k} = {m:.3g} ± {e:.2g}" for k, (m, e) in
                      (("(1,±1) S-wave", r["11"]), ("(1,0) slug", r["10"]),
                       ("(0,1) plug", r["01"])))
-    return r["11"][0], r["11"][1], text + " (shot noise of independent particles = 1)"
+    return text + " (shot noise of independent particles = 1)"
