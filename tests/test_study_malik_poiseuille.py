@@ -485,3 +485,36 @@ def test_an_s_wave_must_beat_the_slug_mode():
     assert slug.verdict == NOT_REPRODUCED and "rather than an S-wave" in slug.reason
     (noise,) = wave_checks({(0.1, 0.99, 0.7): run(1.0, 0.5)})
     assert noise.verdict == NOT_REPRODUCED and "noise of independent" in noise.reason
+
+
+def test_lambda_is_judged_on_rough_spheres_with_smooth_ones_as_control():
+    """§4.8: Λ departs from 1/3 for rough spheres. The nearly smooth β = -0.99 runs are the
+    control: at 1/3 they do not make the row "partly", off it the row says by how much and
+    that anisotropy alone moves Λ; an unsteady run is left out of the e trends and caps the
+    row only when it is a rough one."""
+    from demstudy.studies.malik2008.poiseuille_checks import lambda_checks
+
+    def run(beta: float, e: float, lam: float, steady: bool = True) -> SimpleNamespace:
+        stat = {"lambda": np.full(25, lam), "lambda_err": np.full(25, 0.0005),
+                "count": np.full(25, 100)}
+        return SimpleNamespace(flow=Flow(0.01, e, beta), stat=lambda name: stat,
+                               run_info=lambda: {"steady": steady, "trend": 0.0 if steady
+                                                 else 0.3, "tc_fraction": 0.0, "tc": 1e-5})
+
+    def row(data):
+        return next(c for c in lambda_checks(data) if c.statement.startswith("φ = 0.01"))
+
+    rough = {(0.01, 0.99, 0.8): run(0.99, 0.8, 0.30), (0.01, 0.99, 0.99): run(0.99, 0.99, 0.33)}
+    control = {(0.01, -0.99, 0.8): run(-0.99, 0.8, 1 / 3, steady=False),
+               (0.01, -0.99, 0.99): run(-0.99, 0.99, 1 / 3)}
+    good = row({**rough, **control})
+    assert good.verdict == REPRODUCED and "in 2 of 2 runs, as expected" in good.reason
+    assert "1 unsteady run(s) left out of the trends" in good.measured
+    assert "β = 0.99: |Λ̄ - 1/3| grows as e falls" in good.measured
+    off = row({**rough, (0.01, -0.99, 0.99): run(-0.99, 0.99, 0.32)})
+    assert off.verdict == REPRODUCED and "off 1/3 by up to 0.013" in off.reason
+    assert "anisotropic" in off.reason
+    flat = row({(0.01, 0.99, 0.8): run(0.99, 0.8, 1 / 3), **control})
+    assert flat.verdict == NOT_REPRODUCED and "consistent with 1/3 (2σ) for β = 0.99" in \
+        flat.reason
+    assert row(control).verdict == NOT_RUN
