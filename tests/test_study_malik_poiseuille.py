@@ -518,3 +518,37 @@ def test_lambda_is_judged_on_rough_spheres_with_smooth_ones_as_control():
     assert flat.verdict == NOT_REPRODUCED and "consistent with 1/3 (2σ) for β = 0.99" in \
         flat.reason
     assert row(control).verdict == NOT_RUN
+
+
+def test_dense_core_above_melting_with_a_split_second_shell_is_called_glassy():
+    """§6's 'liquid-like' core: the thesis's φ range (0.494-0.64) holds at φ = 0.61, but
+    that is above hard-sphere melting (0.545); a centre-bin g(r) with the sharp 2 d peak of
+    collinear triples and no √2 d crystal peak is named an amorphous, glass-like packing; a
+    liquid's smooth second shell is not."""
+    from demstudy.studies.malik2008.poiseuille_checks import dense_checks
+
+    edges = np.arange(0.0, 3.0001, 0.05)
+    r = 0.5 * (edges[1:] + edges[:-1])
+
+    def run(glass: bool) -> SimpleNamespace:
+        g = np.where(r < 1.0, 0.0, 1.0 + 0.3 * np.cos(2 * np.pi * (r - 2.0) / 1.0))
+        g[np.searchsorted(r, 1.0)] = 9.0
+        if glass:
+            g[(r > 1.9) & (r < 2.0)] = 1.6
+            g[(r > 1.65) & (r < 1.9)] = 1.25
+        y = np.arange(1.0, 50.0, 2.0)
+        u = np.where(np.abs(y - 25.0) < 8, 10.0, 10.0 - 0.5 * (np.abs(y - 25.0) - 8))
+        series = {"phi": (np.full(25, 0.61), np.full(25, 0.001)), "ux": (u, np.zeros(25))}
+        return SimpleNamespace(flow=Flow(0.5, 0.9, 0.9), y=y, series=series.__getitem__,
+                               gr={"g": np.tile(g, (25, 1)), "r_edges": edges},
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    (glass,) = dense_checks({(0.5, 0.9, 0.9): run(True)})
+    assert glass.verdict == REPRODUCED  # the thesis's own criteria: φ range and a plug
+    assert "above hard-sphere melting" in glass.reason and "glass-like" in glass.reason
+    assert "1.6 at 1.9-2 d" in glass.measured
+    # both walls' |dU_x/dy| (0.5 per d here, of opposite signs), not their difference
+    assert "at the walls 0.5 per √(d/g)" in glass.measured
+    (liquid,) = dense_checks({(0.5, 0.9, 0.9): run(False)})
+    assert "above hard-sphere melting" in liquid.reason and "glass-like" not in liquid.reason

@@ -671,17 +671,55 @@ def dense_checks(data: Runs) -> list[Check]:
     u, _eu = d.series("ux")
     y = d.y
     shear_core = abs(float(np.polyfit(y[core], u[core], 1)[0]))
-    shear_wall = 0.5 * abs((u[1] - u[0]) - (u[-2] - u[-1])) / float(y[1] - y[0])
+    # the mean of the two walls' |dU_x/dy| (the profile is symmetric: opposite signs)
+    shear_wall = 0.5 * (abs(u[1] - u[0]) + abs(u[-1] - u[-2])) / float(y[1] - y[0])
     liquid = 0.494 < fc < 0.64
     plug = shear_core < 0.2 * shear_wall
     verdict = REPRODUCED if liquid and plug else PARTLY if (liquid or plug) else NOT_REPRODUCED
     reason = "" if verdict == REPRODUCED else (
         ("core φ outside the liquid range; " if not liquid else "")
         + ("core shear not < 20 % of the wall's" if not plug else ""))
+    structure, glassy = _second_shell(d)
+    if liquid and fc > MELTING:
+        reason += (f" The thesis's φ range holds, but the core lies above hard-sphere melting "
+                   f"(φ = {MELTING}), where no equilibrium fluid exists"
+                   + ("; its centre bin's g(r) has the sharp peak at 2 d of collinear "
+                      "touching triples and no crystal's peak at √2 d (above): an amorphous, "
+                      "glass-like packing rather than a liquid" if glassy else "") + ".")
     return [Check(ref, statement, "liquid-like core and plug",
                   f"core φ (bins 10-16) {pm(fc, efc, 2)}; |dU_x/dy| core {shear_core:.3g}, "
-                  f"at the walls {shear_wall:.3g} per √(d/g)",
+                  f"at the walls {shear_wall:.3g} per √(d/g)" + structure,
                   _cap(verdict, d), (reason + _steady_note(d)).strip())]
+
+
+#: hard-sphere melting: the densest equilibrium fluid coexists with the crystal up to here
+MELTING = 0.545
+
+
+def _second_shell(d: FlowData) -> tuple[str, bool]:
+    """The centre bin's g(r) second shell: its largest value near √3 d (1.65-1.9 d) and just
+    below 2 d (1.9-2.0 d), and whether the 2 d one is a peak standing above the √3 d one by
+    more than 10 % (collinear touching triples: dense amorphous packings; a liquid's second
+    shell is one smooth peak near 2 d)."""
+    gr = d.gr
+    if "g" not in gr:
+        return "", False
+    r = 0.5 * (gr["r_edges"][1:] + gr["r_edges"][:-1])
+    g = gr["g"][CENTRE_BIN - 1]
+    near_root3 = (r > 1.65) & (r < 1.9)
+    near_two = (r >= 1.9) & (r < 2.0)
+    beyond = (r >= 2.0) & (r < 2.1)
+    if not (near_root3.any() and near_two.any() and beyond.any()):
+        return "", False
+    g3, g2, g_after = (float(np.max(g[near_root3])), float(np.max(g[near_two])),
+                       float(np.max(g[beyond])))
+    root2 = (r > 1.35) & (r < 1.48)  # FCC/HCP's second neighbours
+    g_root2 = float(np.max(g[root2])) if root2.any() else float("nan")
+    glassy = g2 > 1.1 * g3 and g2 > 1.2 * g_after and not g_root2 > 1.0
+    return (f"; centre-bin g(r): {float(np.max(g)):.3g} in the first shell (d to 1.05 d), "
+            f"{g_root2:.3g} at most near √2 d (no crystal's peak when < 1), second shell max "
+            f"{g3:.3g} at 1.65-1.9 d and {g2:.3g} at 1.9-2 d, then {g_after:.3g} at 2-2.1 d"), \
+        glassy
 
 
 def wave_checks(data: Runs) -> list[Check]:
