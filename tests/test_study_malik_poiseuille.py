@@ -552,3 +552,34 @@ def test_dense_core_above_melting_with_a_split_second_shell_is_called_glassy():
     assert "at the walls 0.5 per √(d/g)" in glass.measured
     (liquid,) = dense_checks({(0.5, 0.9, 0.9): run(False)})
     assert "above hard-sphere melting" in liquid.reason and "glass-like" not in liquid.reason
+
+
+def test_contact_value_row_names_clustering_or_freezing_as_the_cause():
+    """g(d+) against Carnahan-Starling at the bin's φ: a run whose g(r) stays above 1 at
+    4-5 d (clusters) is named with that value; a bin above freezing (0.494) is outside CS's
+    range and said so; the pooled ratio is always shown."""
+    from demstudy.studies.malik2008.poiseuille_checks import contact_checks
+    from demstudy.studies.malik2008.poiseuille_data import carnahan_starling
+
+    edges = np.arange(0.0, 5.0001, 0.05)
+    r = 0.5 * (edges[1:] + edges[:-1])
+
+    def run(phi: float, beta: float, contact: float, far: float) -> SimpleNamespace:
+        g = np.where(r < 1.0, 0.0, far + (contact - far) * np.exp(-(r - 1.0) / 0.3))
+        gr = {"g": np.tile(g, (25, 1)), "g_err": np.full((25, r.size), 0.002),
+              "r_edges": edges}
+        return SimpleNamespace(flow=Flow(phi, 0.8, beta), gr=gr,
+                               centre_value=lambda key: (phi, 0.001),
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    chi = carnahan_starling(0.2)
+    rows = contact_checks({(0.1, 0.99, 0.8): run(0.2, 0.99, 1.5 * chi, 1.08),
+                           (0.1, 0.0, 0.8): run(0.2, 0.0, chi, 1.0)})
+    row = next(c for c in rows if c.statement.startswith("φ = 0.1"))
+    assert row.verdict == PARTLY and "agree (2σ + 10 %) in 1 of 2" in row.measured
+    assert "g stays above 1 at 4-5 d in β = 0.99, e = 0.8 1.08" in row.reason
+    assert "β = 0, e = 0.8" not in row.reason and "pooled g(d+)/χ_CS = " in row.measured
+    dense = next(c for c in contact_checks({(0.5, 0.9, 0.9): run(0.6, 0.9, 13.0, 1.0)})
+                 if c.statement.startswith("φ = 0.5"))
+    assert dense.verdict == NOT_REPRODUCED and "above freezing (0.494)" in dense.reason
