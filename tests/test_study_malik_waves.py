@@ -474,3 +474,32 @@ def test_peak_density_is_judged_box_by_box(tmp_path: Path) -> None:
     none = peak_check({"waves-phi0.15-L9W15H15-edmd": box(0.39, 0.32)})
     assert none.verdict == NOT_REPRODUCED and "in every box" in none.reason
     assert peak_check({}).verdict == NOT_RUN
+
+
+def test_the_sequence_of_classes_is_compared_with_the_thesis_order(tmp_path: Path) -> None:
+    """N = 50094's plug → S-wave → slug: our windows' classes in time order (repeats merged,
+    classes the thesis does not name skipped) must follow the thesis's order from some class
+    on; a slug turning back into a plug is another order."""
+    import dataclasses
+
+    from demstudy.studies.malik2008.waves_measure import measure
+    from demstudy.studies.malik2008.waves_report import sequence_text
+
+    def slug(x, y):
+        return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
+
+    plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
+    p = measure(_synthetic_run(tmp_path / "p.h5", plug)).modes
+    run = measure(_synthetic_run(tmp_path / "s.h5", slug))
+    s = run.modes
+    assert (p.pattern, s.pattern) == ("plug", "slug")
+    thesis = ("plug", "s-wave", "slug")
+    forward = dataclasses.replace(run, windows={4000.0: p, 8000.0: p, 11000.0: s})
+    assert "windows plug → slug: the same order (s-wave not caught at the windows)" in \
+        sequence_text(forward, thesis)
+    late = dataclasses.replace(run, windows={11000.0: s, 14000.0: s})
+    assert "the same order from the slug on (our first window, 11000" in \
+        sequence_text(late, thesis)
+    back = dataclasses.replace(run, windows={4000.0: s, 8000.0: p})
+    assert sequence_text(back, thesis).endswith("another order")
+    assert sequence_text(forward, ()) == ""

@@ -77,6 +77,8 @@ class ThesisClass:
     text: str
     #: the thesis's time (c/p) of that class, when the class is a snapshot's
     time: float | None = None
+    #: the classes the thesis saw in turn before settling (its snapshots' order), if any
+    sequence: tuple[str, ...] = ()
 
 
 #: only what the digest states (§1.8 [L1149]-[L1159]; §4.11 cites [L1118] for the plug
@@ -86,7 +88,8 @@ THESIS: dict[str, ThesisClass] = {
     "5.6-5.10": ThesisClass("slug", "N = 50094, L/W = 1.4, W/d = 50: the energy plateaus at "
                             "t ≈ 11000 c/p but the structure keeps evolving (plug → one-hump "
                             "S-wave, birth of (1,1), [L1155]) until a slug forms at t ≈ 14000 "
-                            "c/p (digest §1.8, [L1149]-[L1159])", time=14000.0),
+                            "c/p (digest §1.8, [L1149]-[L1159])", time=14000.0,
+                            sequence=("plug", "s-wave", "slug")),
 }
 
 

@@ -129,6 +129,32 @@ def at_thesis_time(run: RunWaves, cls: str, time: float) -> list[str]:
     return out
 
 
+def sequence_text(run: RunWaves, sequence: tuple[str, ...]) -> str:
+    """The classes over the snapshot windows (our c/p, in time order; repeats merged) against
+    the thesis's ``sequence``: the same order when ours, without the classes the thesis does
+    not name ("mixed", "none"), is the thesis's from some class on."""
+    if not sequence or not run.windows:
+        return ""
+    ours: list[str] = []
+    for c in sorted(run.windows):
+        cls = _cls(run.windows[c].pattern)
+        if not ours or ours[-1] != cls:
+            ours.append(cls)
+    named = [c for c in ours if c in sequence]
+    ranks = [sequence.index(c) for c in named]
+    same = bool(named) and ranks == sorted(ranks) and named[-1] == sequence[-1]
+    first = min(run.windows)
+    unseen = [c for c in sequence[sequence.index(named[0]):] if c not in named] if named \
+        else []
+    return (f"; the thesis's sequence {' → '.join(sequence)}, ours over the snapshot windows "
+            f"{' → '.join(ours)}: " + (
+                "the same order" + (f" from the {named[0]} on (our first window, {first:.0f} "
+                                    "c/p, is past the earlier ones)"
+                                    if named[0] != sequence[0] else "")
+                + (f" ({', '.join(unseen)} not caught at the windows)" if unseen else "")
+                if same else "another order"))
+
+
 def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     """The structure class of ``box`` against the thesis's (digest) where known."""
     ref = (f"Fig {box.fig} (N = {box.n}, L/W = {box.aspect:.2g}, W/d = {box.width}, "
@@ -147,15 +173,18 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     if compared:
         # the thesis's class is a snapshot: compare at its time, under the readings measured
         readings = at_thesis_time(run, thesis.cls, thesis.time)
+        order = sequence_text(run, thesis.sequence)
         if readings:
             return Check(ref, statement, thesis_text, measured, REPRODUCED,
                          f"{thesis.cls} at t = {thesis.time:.0f} c/p with " +
-                         " and ".join(readings))
+                         " and ".join(readings) + (" (both readings agree: this row cannot "
+                                                   "tell which c/p the thesis counted)"
+                                                   if len(readings) == 2 else "") + order)
         which = ("under either reading of the thesis's c/p" if len(compared) == 2 else
                  f"at {compared[0]:.0f} of our c/p (the only reading whose window has frames)")
         return Check(ref, statement, thesis_text, measured, NOT_REPRODUCED,
                      f"no {thesis.cls} at t = {thesis.time:.0f} c/p {which} (classes above); "
-                     f"the whole production is {run.modes.pattern}")
+                     f"the whole production is {run.modes.pattern}" + order)
     if thesis:
         if found != thesis.cls:
             return Check(ref, statement, thesis_text, measured, NOT_REPRODUCED,
