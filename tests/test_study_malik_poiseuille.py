@@ -583,3 +583,34 @@ def test_contact_value_row_names_clustering_or_freezing_as_the_cause():
     dense = next(c for c in contact_checks({(0.5, 0.9, 0.9): run(0.6, 0.9, 13.0, 1.0)})
                  if c.statement.startswith("φ = 0.5"))
     assert dense.verdict == NOT_REPRODUCED and "above freezing (0.494)" in dense.reason
+
+
+def test_gr_shells_at_two_and_three_diameters():
+    """[L951]: g(r) of the centre bin peaks at 2 d and 3 d (after contact). A g(r) with
+    shells at 2 and 3 d in every β = 0 run is "reproduced"; one without its third shell
+    makes the row "partly" with the counts; a flat g(r) has no shell peaks."""
+    from demstudy.studies.malik2008.poiseuille_checks import gr_shell_checks, shell_peaks
+
+    edges = np.arange(0.0, 5.0001, 0.05)
+    r = 0.5 * (edges[1:] + edges[:-1])
+
+    def run(beta: float, shells: tuple[float, ...]) -> SimpleNamespace:
+        g = np.where(r < 1.0, 0.0, 1.0)
+        for c in (1.0, *shells):
+            g = g + np.where(r > 1.0, 0.3 * np.exp(-0.5 * ((r - c - 0.03) / 0.08) ** 2), 0.0)
+        gr = {"g": np.tile(g, (25, 1)), "g_err": np.full((25, r.size), 0.005), "r_edges": edges}
+        return SimpleNamespace(flow=Flow(0.1, 0.8, beta), gr=gr,
+                               centre_value=lambda key: (0.25, 0.001),
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    assert shell_peaks(run(0.0, (2.0, 3.0)).gr, 12) == pytest.approx([2.025, 3.025])
+    assert shell_peaks(run(0.0, ()).gr, 12) == []
+    (good,) = gr_shell_checks({(0.1, 0.0, 0.8): run(0.0, (2.0, 3.0)),
+                               (0.1, 0.99, 0.8): run(0.99, (2.0,))})
+    assert good.verdict == REPRODUCED and "both shells in 1 of 2 runs" in good.measured
+    (half,) = gr_shell_checks({(0.1, 0.0, 0.8): run(0.0, (2.0,)),
+                               (0.1, 0.99, 0.8): run(0.99, (2.0, 3.0))})
+    assert half.verdict == PARTLY and "the 3 d shell in 1" in half.reason
+    (none,) = gr_shell_checks({(0.1, 0.0, 0.8): run(0.0, ())})
+    assert none.verdict == NOT_REPRODUCED
