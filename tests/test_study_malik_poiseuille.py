@@ -614,3 +614,24 @@ def test_gr_shells_at_two_and_three_diameters():
     assert half.verdict == PARTLY and "the 3 d shell in 1" in half.reason
     (none,) = gr_shell_checks({(0.1, 0.0, 0.8): run(0.0, ())})
     assert none.verdict == NOT_REPRODUCED
+
+
+def test_sparse_wall_bins_at_phi_one_tenth():
+    """[L945], [L972]: the φ = 0.1 bins by the walls hold few particles. Wall bins at 17 %
+    of the mean φ are sparse; at 60 % they are not, and the row gives that range."""
+    from demstudy.studies.malik2008.poiseuille_checks import sparse_wall_checks
+
+    def run(beta: float, e: float, wall: float) -> SimpleNamespace:
+        phi = np.full(25, 0.1)
+        phi[[0, -1]] = wall
+        return SimpleNamespace(flow=Flow(0.1, e, beta),
+                               series=lambda key: (phi, np.full(25, 1e-4)),
+                               wall_value=lambda key: (wall, 1e-4))
+
+    (sparse,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.017)})
+    assert sparse.verdict == REPRODUCED and "below 50 % of the mean in 1 of 1" in sparse.measured
+    (mixed,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.017),
+                                   (0.1, 0.99, 0.99): run(0.99, 0.99, 0.062)})
+    assert mixed.verdict == PARTLY and "not sparse in β = 0.99, e = 0.99" in mixed.reason
+    assert "keep 64-64 % of the mean φ" in mixed.reason
+    assert sparse_wall_checks({})[0].verdict == NOT_RUN

@@ -49,7 +49,8 @@ Runs = dict[tuple[float, float, float], FlowData]  # (φ, β, e) -> run
 CHECKS: tuple[Callable[[Runs], list[Check]], ...] = (
     pc.steady_checks, pc.validation_checks, pc.dissipation_checks, pc.knudsen_checks,
     pc.vdf_checks, pc.vdf_elastic_limit_checks, pc.wall_dissipation_checks,
-    pc.contact_checks, pc.gr_shell_checks, pc.lambda_checks, pc.dense_checks, pc.wave_checks)
+    pc.contact_checks, pc.gr_shell_checks, pc.sparse_wall_checks, pc.lambda_checks,
+    pc.dense_checks, pc.wave_checks)
 
 
 def _known_flows(quick: bool) -> dict[str, Flow]:

@@ -632,6 +632,40 @@ def gr_shell_checks(data: Runs) -> list[Check]:
                   else verdict, reason.strip())]
 
 
+#: a wall bin is "sparse" below this fraction of the channel's mean φ
+SPARSE = 0.5
+
+
+def sparse_wall_checks(data: Runs) -> list[Check]:
+    """[L945], [L972]: at φ = 0.1 the bins by the walls hold few particles (their g(r) and
+    velocity correlations are 'negligible' for that reason). Sparse: the wall bins' φ (bins
+    1 and 25, Malik's wall value) below SPARSE × the channel's mean φ."""
+    ref, statement = "[L945], [L972]", ("φ = 0.1: the bins by the walls hold few particles "
+                                        "(their g(r) and correlations not reported)")
+    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.1]
+    if not ds:
+        return [_not_run(ref, statement, "sparse near-wall bins", "the φ = 0.1 runs")]
+    rows, sparse, ratios = [], [], {}
+    for d in ds:
+        f, _ef = d.series("phi")
+        wall, ewall = d.wall_value("phi")
+        ratio = wall / float(np.nanmean(f))
+        ratios[id(d)] = ratio
+        rows.append(f"{_tag(d)}: {pm(wall, ewall)} ({100 * ratio:.0f} % of the mean)")
+        if ratio < SPARSE:
+            sparse.append(d)
+    verdict = REPRODUCED if len(sparse) == len(ds) else PARTLY if sparse else NOT_REPRODUCED
+    dense = [d for d in ds if d not in sparse]
+    return [Check(ref, statement, "sparse near-wall bins",
+                  "wall bins' φ (bins 1, 25): " + "; ".join(rows)
+                  + f"; below {100 * SPARSE:.0f} % of the mean in {len(sparse)} of {len(ds)}",
+                  verdict, "" if not dense else
+                  "not sparse in " + ", ".join(_tag(d) for d in dense) + ": there the wall "
+                  f"bins keep {100 * min(ratios[id(d)] for d in dense):.0f}-"
+                  f"{100 * max(ratios[id(d)] for d in dense):.0f} % of the mean φ, a weaker "
+                  "contrast between the walls and the centre")]
+
+
 #: hard-sphere freezing: the fluid branch (Carnahan-Starling) ends here
 FREEZING = 0.494
 
