@@ -139,6 +139,16 @@ def load_flow(flow: Flow, path: Path, with_gr: bool = True) -> FlowData:
     return data
 
 
+def wall_gradient(u: np.ndarray, e: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """dU_x/dy at the walls from the profile ``u`` ± ``e`` on bin centres ``y`` (bins 1-2
+    and 24-25: the symmetric profile's two gradients have opposite signs, this is their
+    mean magnitude, positive for a flow faster at the centre) and its error, per √(d/g)."""
+    dy = float(y[1] - y[0])
+    value = 0.5 * ((u[1] - u[0]) + (u[-2] - u[-1])) / dy
+    err = 0.5 * math.sqrt(e[0] ** 2 + e[1] ** 2 + e[-1] ** 2 + e[-2] ** 2) / dy
+    return float(value), float(err)
+
+
 def contact_value(gr: dict[str, np.ndarray], b: int) -> tuple[float, float]:
     """g at contact in bin ``b`` (0-based): the first two shells beyond r = d extrapolated
     linearly to r = d (hard spheres: g jumps at d and falls off beyond)."""
