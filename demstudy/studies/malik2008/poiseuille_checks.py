@@ -361,12 +361,59 @@ def _core_text(dev: np.ndarray) -> str:
     return f"core a spike (dev > {100 * SPIKE:.0f} %)"
 
 
+def tails_core_deviation(kurtosis: float) -> float:
+    """How far below exp(-x²/2) at |x| = 1 a Student t of this kurtosis lies once scaled
+    by its σ and P(0) = 1 (ν = 4 + 6/(κ - 3)); 0 for κ ≤ 3. Heavy tails explain a core
+    deviation of about this size and no more."""
+    if not kurtosis > 3.0:
+        return 0.0
+    from scipy import stats
+
+    nu = 4.0 + 6.0 / (kurtosis - 3.0)
+    scale = math.sqrt(nu / (nu - 2.0))
+    ratio = stats.t.pdf(scale, nu) / stats.t.pdf(0.0, nu)
+    return float(1.0 - ratio / math.exp(-0.5))
+
+
+#: the share of a core deviation heavy tails must predict to be named its cause
+TAILS_SHARE = 0.7
+
+
+def _vdf_cause(d: FlowData, k: int, c: int, dev: float, kur: float, ker: float,
+               skew: float) -> tuple[str, str]:
+    """(cause, entry) of a core deviating by ``dev`` (> 10 %): component ``c`` of bin ``k``."""
+    entry = f"{_tag(d)} bin {k} {COMPONENTS[c]}"
+    if abs(skew) > SKEWED:
+        return ("skewed-x" if c == 0 else "skewed"), entry
+    if kur - 3 > 2 * ker and tails_core_deviation(kur) >= TAILS_SHARE * dev:
+        return "tails", f"{entry} (κ {kur:.2f}: {100 * tails_core_deviation(kur):.0f} % of " \
+                        f"{100 * dev:.0f} %)"
+    shape = "flat-topped" if _core_above(d, k - 1, c) else "peaked"
+    return "other", f"{entry} {shape}"
+
+
+#: the words for each cause of a core deviation, in the reason's order
+VDF_CAUSES = {
+    "skewed-x": "Streamwise C_x skewed (|skewness| > {s}): the VDF is asymmetric, its peak "
+                "displaced from the mean by slow particles from the walls, which the P(0) = 1 "
+                "scaling turns into a core deviation",
+    "skewed": "Skewed (|skewness| > {s}) across the flow: an asymmetric VDF, the P(0) = 1 "
+              "scaling turning it into a core deviation",
+    "tails": "Symmetric with heavy tails: σ-scaled, heavy tails narrow the core (a Student t of "
+             "the same kurtosis lies this far below exp(-x²/2) at |x| = 1), so a Gaussian "
+             "core and non-Gaussian tails cannot both hold to 10 %; the thesis judged by eye",
+    "other": "Neither skewed nor heavy-tailed enough (flat-topped: above exp(-x²/2) towards "
+             "|x| = 1; peaked: below), not explained here",
+}
+
+
 def vdf_checks(data: Runs) -> list[Check]:
     """A Gaussian core (P within 10 % of exp(-x²/2) for |x| ≤ 1, beyond 2σ) and non-Gaussian
     tails (kurtosis ≠ 3 beyond 2σ), per component. In the thesis's scaling (x = C/σ, P(0) =
     1) the two pull against each other: heavy tails narrow the σ-scaled core (a Student t of
-    kurtosis 4 lies 14 % below exp(-x²/2) at |x| = 1), so a deviating core is explained by
-    the component's own skewness or kurtosis, named in the reason."""
+    kurtosis 4 lies 14 % below exp(-x²/2) at |x| = 1). Each deviating core (run, bin,
+    component) is given one cause: its skewness, tails heavy enough to predict most of the
+    deviation (TAILS_SHARE), or none found."""
     out = []
     for phi in (0.01, 0.1, 0.5):
         bins = BINS_DENSE if phi == 0.5 else BINS
@@ -381,9 +428,7 @@ def vdf_checks(data: Runs) -> list[Check]:
             out.append(_not_run(ref, statement, "Gaussian core, tails", f"φ = {phi:g} runs"))
             continue
         rows, cores, tails, spikes = [], True, False, []
-        skewed: set[str] = set()
-        heavy: set[str] = set()  # symmetric components whose core deviates with κ ≠ 3
-        other: set[str] = set()  # deviating, neither skewed nor heavy-tailed
+        causes: dict[str, list[str]] = {key: [] for key in VDF_CAUSES}
         for d in ds:
             for k in bins:
                 dev, kur, ker, skew = vdf_shape(d, k - 1)
@@ -392,50 +437,33 @@ def vdf_checks(data: Runs) -> list[Check]:
                 if np.any(dev > SPIKE):
                     spikes.append(f"{_tag(d)} bin {k}")
                 else:
-                    for c, dv, ku, ke, sk in zip(COMPONENTS, dev, kur, ker, skew, strict=True):
-                        if dv <= 0.1:
-                            continue
-                        if abs(sk) > SKEWED:
-                            skewed.add(c)
-                        elif abs(ku - 3) > 2 * ke:
-                            heavy.add(c)
-                        else:
-                            shape = "flat-topped" if _core_above(d, k - 1,
-                                                                 COMPONENTS.index(c)) \
-                                else "peaked"
-                            other.add(f"{c} in bin {k} {shape}")
+                    for c in range(3):
+                        if dev[c] > 0.1:
+                            cause, entry = _vdf_cause(d, k, c, float(dev[c]), float(kur[c]),
+                                                      float(ker[c]), float(skew[c]))
+                            causes[cause].append(entry)
                 rows.append(f"{_tag(d)} bin {k}: {_core_text(dev)}, kurtosis "
                             + "/".join(pm(a, b, 1) for a, b in zip(kur, ker, strict=True))
                             + ", skewness " + "/".join(f"{x:.2f}" for x in skew))
         verdict = REPRODUCED if cores and tails else PARTLY if (cores or tails) \
             else NOT_REPRODUCED
+        named = [f"{VDF_CAUSES[key].format(s=SKEWED)}: {', '.join(entries)}"
+                 for key, entries in causes.items() if entries]
         reason = "" if verdict == REPRODUCED else (
-            "the core departs from the Gaussian by > 10 % beyond 2σ in some bins"
-            + (f": {'/'.join(sorted(skewed))} skewed (|skewness| > {SKEWED:g}; the VDF is "
-               "asymmetric, its peak displaced from the mean: slow particles from the walls, "
-               "which the P(0) = 1 scaling turns into a core deviation)"
-               if skewed else "")
-            + (f"{'; ' if skewed else ': '}{'/'.join(sorted(heavy))} symmetric but with "
-               "kurtosis ≠ 3: in the σ-scaled form the tails set the core's width (heavy tails "
-               "narrow it: a Student t of kurtosis 4 lies 14 % below exp(-x²/2) at |x| = 1; "
-               "light tails widen it), so a Gaussian core and non-Gaussian tails cannot both "
-               "hold to 10 %; the thesis judged by eye"
-               if heavy else "")
-            + (f"{'; ' if skewed or heavy else ': '}{', '.join(sorted(other))}: neither "
-               "skewed nor of kurtosis ≠ 3 beyond 2σ (flat-topped: above exp(-x²/2) towards "
-               "|x| = 1; peaked: below), not explained here" if other else "")
-            + "; " if (skewed or heavy or other) else "")
-        reason += ((f"in {', '.join(spikes)} the σ-scaled VDF is a spike narrower than the "
-                    "histogram's bins (the P(0) = 1 scaling fails): the bin moves nearly as a "
-                    "solid and a few fast particles set σ; " if spikes else "")
-                   + ("kurtosis consistent with 3 (Gaussian tails) " if not tails else ""))
+            ("The core departs from the Gaussian by > 10 % beyond 2σ in some bins. "
+             + ". ".join(named) + ". " if named else "")
+            + (f"In {', '.join(spikes)} the σ-scaled VDF is a spike narrower than the "
+               "histogram's bins (the P(0) = 1 scaling fails): the bin moves nearly as a "
+               "solid and a few fast particles set σ. " if spikes else "")
+            + ("Kurtosis consistent with 3 (Gaussian tails). " if not tails else ""))
+        reason = reason.strip()
         unsteady = [d for d in ds if not d.run_info()["steady"]]
         if unsteady:
             verdict = _cap(verdict, unsteady[0])
             reason += _steady_note(unsteady[0])
         out.append(Check(ref, statement, "Gaussian core; tails deviate",
                          "; ".join(rows) + " (core deviation, kurtosis and skewness of "
-                         "C_x/C_y/C_z)", verdict, reason.strip().removesuffix(";")))
+                         "C_x/C_y/C_z)", verdict, reason.strip()))
     return out
 
 
