@@ -631,17 +631,25 @@ def test_sparse_wall_bins_at_phi_one_tenth():
     of the mean φ are sparse; at 60 % they are not, and the row gives that range."""
     from demstudy.studies.malik2008.poiseuille_checks import sparse_wall_checks
 
-    def run(beta: float, e: float, wall: float) -> SimpleNamespace:
+    def run(beta: float, e: float, wall: float, steady: bool = True) -> SimpleNamespace:
         phi = np.full(25, 0.1)
         phi[[0, -1]] = wall
-        return SimpleNamespace(flow=Flow(0.1, e, beta),
+        return SimpleNamespace(flow=Flow(0.1, e, beta), y=np.arange(1.0, 50.0, 2.0),
                                series=lambda key: (phi, np.full(25, 1e-4)),
-                               wall_value=lambda key: (wall, 1e-4))
+                               wall_value=lambda key: (wall, 1e-4),
+                               run_info=lambda: {"steady": steady, "trend": 0.0 if steady
+                                                 else 0.3, "tc_fraction": 0.0, "tc": 1e-5})
 
+    # a uniform gas: the 2 d wall bins hold 3/4 of an inner bin's φ (centres d/2 off)
+    (uniform,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.075)})
+    assert uniform.verdict == NOT_REPRODUCED and "(100 % of a uniform gas's)" in \
+        uniform.measured
     (sparse,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.017)})
-    assert sparse.verdict == REPRODUCED and "below 50 % of the mean in 1 of 1" in sparse.measured
+    assert sparse.verdict == REPRODUCED and "below 50 % in 1 of 1" in sparse.measured
     (mixed,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.017),
                                    (0.1, 0.99, 0.99): run(0.99, 0.99, 0.062)})
     assert mixed.verdict == PARTLY and "not sparse in β = 0.99, e = 0.99" in mixed.reason
-    assert "keep 64-64 % of the mean φ" in mixed.reason
+    assert "keep 84 % of a uniform gas's φ" in mixed.reason
+    (unsteady,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.017, steady=False)})
+    assert unsteady.verdict == PARTLY and "not in steady state" in unsteady.reason
     assert sparse_wall_checks({})[0].verdict == NOT_RUN
