@@ -384,6 +384,11 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     assert "clock" not in same.reason  # the same collision rate: equal c/p is equal time
     faster = tc_dependence(base, dataclasses.replace(twin, rate=1.44 * base.rate))
     assert faster.verdict == REPRODUCED and "the collision clock runs ×1.44" in faster.reason
+    assert "collide more often" in faster.reason
+    slower = tc_dependence(base, dataclasses.replace(twin, rate=0.5 * base.rate))
+    assert "runs ×0.50" in slower.reason and "collide less often" in slower.reason
+    unknown_rate = tc_dependence(dataclasses.replace(base, rate=float("nan")), twin)
+    assert "clock" not in unknown_rate.reason
     other = dataclasses.replace(measure(_synthetic_run(tmp_path / "b.h5", plug, rate=250.0)),
                                 tc_fraction=0.004)
     differs = tc_dependence(base, other)
@@ -498,8 +503,10 @@ def test_the_sequence_of_classes_is_compared_with_the_thesis_order(tmp_path: Pat
     assert "windows plug → slug: the same order (s-wave not caught at the windows)" in \
         sequence_text(forward, thesis)
     late = dataclasses.replace(run, windows={11000.0: s, 14000.0: s})
-    assert "the same order from the slug on (our first window, 11000" in \
-        sequence_text(late, thesis)
+    assert ("the same order from the slug on (no window before 11000 c/p: whether the plug "
+            "and s-wave came first is not measured)") in sequence_text(late, thesis)
+    early = dataclasses.replace(run, windows={4000.0: p, 8000.0: p})
+    assert "the same order, but it stops at the plug" in sequence_text(early, thesis)
     back = dataclasses.replace(run, windows={4000.0: s, 8000.0: p})
     assert sequence_text(back, thesis).endswith("another order")
     assert sequence_text(forward, ()) == ""

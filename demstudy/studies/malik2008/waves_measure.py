@@ -53,6 +53,11 @@ class Modes:
     attrs: dict[str, Any]
 
     @property
+    def cls(self) -> str:
+        """The xy class alone (``pattern`` without "+ z")."""
+        return str(self.attrs.get("pattern", "?"))
+
+    @property
     def pattern(self) -> str:
         """The xy class (none / plug / s-wave / slug / mixed), "+ z" when the xz or yz plane
         has a dominant family varying along z (Malik's 3D structure)."""
@@ -152,9 +157,7 @@ class RunWaves:
     def window_changes(self) -> list[float]:
         """The snapshot windows (our c/p; all within the production) whose class, its first
         word, differs from the whole production's."""
-        whole = self.modes.pattern.split(" ")[0]
-        return [c for c, m in sorted(self.windows.items())
-                if m.pattern.split(" ")[0] != whole]
+        return [c for c, m in sorted(self.windows.items()) if m.cls != self.modes.cls]
 
     @property
     def max_drift(self) -> Drift | None:

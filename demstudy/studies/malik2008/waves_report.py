@@ -124,7 +124,7 @@ def at_thesis_time(run: RunWaves, cls: str, time: float) -> list[str]:
     out = []
     for label, ours in (("c/p = 2 N_pair/N", time), ("c/p = N_pair/N", 2.0 * time)):
         modes = run.windows.get(ours)
-        if modes is not None and modes.pattern.split(" ")[0] == cls:
+        if modes is not None and modes.cls == cls:
             out.append(f"{label} ({ours:.0f} of ours)")
     return out
 
@@ -137,22 +137,28 @@ def sequence_text(run: RunWaves, sequence: tuple[str, ...]) -> str:
         return ""
     ours: list[str] = []
     for c in sorted(run.windows):
-        cls = _cls(run.windows[c].pattern)
+        cls = run.windows[c].cls
         if not ours or ours[-1] != cls:
             ours.append(cls)
     named = [c for c in ours if c in sequence]
     ranks = [sequence.index(c) for c in named]
-    same = bool(named) and ranks == sorted(ranks) and named[-1] == sequence[-1]
+    ordered = bool(named) and ranks == sorted(ranks)
     first = min(run.windows)
     unseen = [c for c in sequence[sequence.index(named[0]):] if c not in named] if named \
         else []
+    if not ordered:
+        verdict = "another order"
+    else:
+        verdict = ("the same order" if named[-1] == sequence[-1] else
+                   f"the same order, but it stops at the {named[-1]}")
+        if named[0] != sequence[0]:
+            verdict += (f" from the {named[0]} on (no window before {first:.0f} c/p: whether "
+                        f"the {' and '.join(sequence[:sequence.index(named[0])])} came first "
+                        "is not measured)")
+        if unseen:
+            verdict += f" ({', '.join(unseen)} not caught at the windows)"
     return (f"; the thesis's sequence {' → '.join(sequence)}, ours over the snapshot windows "
-            f"{' → '.join(ours)}: " + (
-                "the same order" + (f" from the {named[0]} on (our first window, {first:.0f} "
-                                    "c/p, is past the earlier ones)"
-                                    if named[0] != sequence[0] else "")
-                + (f" ({', '.join(unseen)} not caught at the windows)" if unseen else "")
-                if same else "another order"))
+            f"{' → '.join(ours)}: {verdict}")
 
 
 def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
@@ -167,7 +173,7 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     windows = _windows_text(run)
     measured = (f"{run.modes.pattern}; {_modes_text(run)}; {_stationary_text(run)}"
                 + (f"; {windows}" if windows else ""))
-    found = run.modes.pattern.split(" ")[0]
+    found = run.modes.cls
     compared = [t for t in (thesis.time, 2.0 * thesis.time) if t in run.windows] \
         if thesis and thesis.time is not None else []
     if compared:
@@ -228,10 +234,6 @@ def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
     return check
 
 
-def _cls(pattern: str) -> str:
-    return pattern.split(" ")[0]
-
-
 def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -> Check:
     """The TC twin against its box at the default t_c (demstudy's own check; the thesis has
     no TC model): the class of the whole production and at every snapshot window both
@@ -254,7 +256,7 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -
             f"{r.path.name} ran at t_c = {r.tc:g}, not {t:g}" for t, r in ran))
     common = sorted(set(base.windows) & set(twin.windows))
     differ = [c for c in common
-              if _cls(base.windows[c].pattern) != _cls(twin.windows[c].pattern)]
+              if base.windows[c].cls != twin.windows[c].cls]
     texts = []
     for t, r in ((DEFAULT_TC, base), (tc, twin)):
         windows = ", ".join(f"{c:.0f} {r.windows[c].pattern}" for c in common)
@@ -266,7 +268,7 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -
     halves = zip(base.ke_halves, twin.ke_halves, strict=True)
     ke_apart = [i for i, ((a, ea), (b, eb)) in enumerate(halves)
                 if abs(a - b) > 2.0 * float(np.hypot(ea, eb)) + 0.05 * abs(a)]
-    same = _cls(base.modes.pattern) == _cls(twin.modes.pattern) and not differ
+    same = base.modes.cls == twin.modes.cls and not differ
     if not same:
         reasons = ["the class differs: " + (f"{base.modes.pattern} against "
                                             f"{twin.modes.pattern}" if not differ else
@@ -283,11 +285,11 @@ def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -
                                                         for i in ke_apart)
                        + " half differs by more than 2σ + 5 %: the TC model changes the "
                        "dissipation")
-    clock = twin.rate / base.rate
-    if not 0.8 < clock < 1.25:
+    clock = twin.rate / base.rate if base.rate > 0 else float("nan")
+    if math.isfinite(clock) and not 0.8 < clock < 1.25:
         # equal c/p is then not equal time: the dense clumps collide at another rate
         reasons.append(f"the collision clock runs ×{clock:.2f} at t_c = {tc:g} (the clumps "
-                       "collide more often when fewer collisions are elastic): the windows "
+                       "collide " + ("more" if clock > 1 else "less") + " often): the windows "
                        "compare at equal c/p, not at equal time")
     small = twin.tc_fraction < WARN_SHARE
     reasons.append(f"share at {tc:g}: {_share(twin)} " + (
@@ -337,6 +339,9 @@ def _unbalanced_reason(run: RunWaves, thesis_span: bool) -> str:
     still rises in time (the thesis's plateau at 11000 c/p for N = 50094 may be this).
     ``thesis_span``: the run is as long as the thesis's, so its structures are transients."""
     ratio, _ = run.balance
+    if not math.isfinite(ratio):
+        return ("the energy balance is unknown (too few production samples): the steady "
+                "state cannot be judged")
     if thesis_span:
         return _unbalanced_reason(run, False) + (
             "; this run spans the thesis's own c/p, so the thesis's snapshots (≤ 14000 c/p) "
@@ -348,6 +353,8 @@ def _unbalanced_reason(run: RunWaves, thesis_span: bool) -> str:
             "dissipation, the flow still accelerates (the production starts before the "
             "steady state)")
     clock = run.clock()
+    if not math.isfinite(clock.span):
+        return text + "; runs longer in time are needed"
     if not clock.speed_up > CLOCK_SPEED_UP:
         return text + (f"; the production ({run.eq_cpp:.0f}-{run.end_cpp:.0f} c/p) spans "
                        f"{clock.span:.0f} √(d/g), over which the KE/N still rises "
@@ -395,7 +402,7 @@ def peak_check(measured: Mapping[str, RunWaves]) -> Check:
     statement = "dense plugs and slugs reach a local solid fraction of about 0.58"
     if not measured:
         return Check(ref, statement, "≈ 0.58", "not run", NOT_RUN, "no run made")
-    tag = {n: n.split("-")[2] + ("-tc" if "-tc" in n else "") for n in measured}
+    tag = {n: n.removeprefix("waves-phi0.15-").removesuffix("-edmd") for n in measured}
     within = [n for n, r in measured.items() if _peak_range(r)[0] <= 0.58 <= _peak_range(r)[1]]
     text = ("densest cell column of the xy plane (depth-averaged), mean over the production "
             f"frames, on 2 d / {COARSE:g} d cells: " + "; ".join(
