@@ -349,3 +349,16 @@ def test_cli_records_option_analyses_kept_records_without_publishing(toy, tmp_pa
     report = (tmp_path / "fresh" / "toy.md").read_text()
     assert "1 from their records" in report and "| 1 | toy | cell-a" in report
     assert not (tmp_path / "fresh" / "runs").exists()
+
+
+def test_report_reasons_start_the_appended_notes_as_sentences():
+    """A check's reason that runs into an appended note (an unsteady run, a TC share) gets a
+    full stop before it; reasons that already have one, and table pipes, stay as they are."""
+    from demstudy.studies.report import _reason
+
+    assert _reason("longer runs needed The run (β = 0) is not steady") == \
+        "longer runs needed. The run (β = 0) is not steady"
+    assert _reason("not measured) The engine's TC model") == "not measured). The engine's TC model"
+    assert _reason("done. The run x") == "done. The run x"
+    assert _reason("The run first") == "The run first"
+    assert _reason("|κ - 3| falls;  The engine") == "\\|κ - 3\\| falls; The engine"

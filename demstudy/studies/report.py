@@ -7,6 +7,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 from __future__ import annotations
 
 import datetime as _dt
+import re
 from collections import Counter
 from typing import TYPE_CHECKING
 
@@ -18,6 +19,15 @@ if TYPE_CHECKING:
 
 def _cell(text: str) -> str:
     return " ".join(str(text).split()).replace("|", "\\|")
+
+
+#: the notes the checks append to a reason (unsteady run, TC share) start a sentence: a
+#: reason that ran up to them without a full stop gets one
+_NOTE = re.compile(r"(?<=[^.;:\s])\s+(?=The (?:run|engine)\b)")
+
+
+def _reason(text: str) -> str:
+    return _cell(_NOTE.sub(". ", str(text)))
 
 
 def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "") -> str:
@@ -63,7 +73,7 @@ def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "")
     for i, c in enumerate(checks, 1):
         verdict = f"**{c.verdict}**" if c.verdict != REPRODUCED else c.verdict
         lines.append(f"| {i} | {_cell(c.ref)} | {_cell(c.statement)} | {_cell(c.thesis)} | "
-                     f"{_cell(c.measured)} | {verdict} | {_cell(c.reason)} |")
+                     f"{_cell(c.measured)} | {verdict} | {_reason(c.reason)} |")
     lines.append("")
     if ana and ana.figures:
         lines += ["## Figures", ""]
