@@ -64,6 +64,8 @@ def _contour(fig: Figure, ax, run: RunWaves, plane: str, letter: str) -> None:
     ax.quiver(ca[::step_a], cb[::step_b], np.nan_to_num(ua[::step_a, ::step_b].T),
               np.nan_to_num(ub[::step_a, ::step_b].T), color="white", width=0.004)
     ax.set_aspect("equal")
+    # a flat plane (H = 10 against L = 150) has room for few ticks along its short side
+    ax.yaxis.set_major_locator(MaxNLocator(2 if ratio < 0.2 else 5))
     ax.set_xlabel(f"{plane[0]} (d)")
     ax.set_ylabel(f"{plane[1]} (d)")
     ax.set_title(f"({letter}) ν, {plane} plane at {run.snapshot.cpp:.0f} c/p; arrows: "
