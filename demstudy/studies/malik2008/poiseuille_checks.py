@@ -724,8 +724,7 @@ def _far_g(gr: dict[str, np.ndarray]) -> tuple[float, float]:
     sel = (r >= 4.0) & (r < 5.0)
     if not sel.any():
         return float("nan"), float("nan")
-    g, e = gr["g"][CENTRE_BIN - 1][sel], gr["g_err"][CENTRE_BIN - 1][sel]
-    return float(np.mean(g)), float(math.sqrt(np.sum(e ** 2)) / sel.sum())
+    return _mean(gr["g"][CENTRE_BIN - 1][sel], gr["g_err"][CENTRE_BIN - 1][sel])
 
 
 # ------------------------------------------------------------------ Λ
