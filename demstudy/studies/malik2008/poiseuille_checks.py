@@ -614,12 +614,17 @@ def contact_checks(data: Runs) -> list[Check]:
     return out
 
 
+def _shell_centres(gr: dict[str, np.ndarray]) -> np.ndarray:
+    """The centres of g(r)'s shells (r/d)."""
+    return 0.5 * (gr["r_edges"][1:] + gr["r_edges"][:-1])
+
+
 def shell_peaks(gr: dict[str, np.ndarray], b: int) -> list[float]:
     """The local maxima of bin ``b``'s g(r) beyond 1.5 d (the shells after contact) that
     stand out of the noise: prominence above 3 × the median error."""
     from scipy.signal import find_peaks
 
-    r = 0.5 * (gr["r_edges"][1:] + gr["r_edges"][:-1])
+    r = _shell_centres(gr)
     g, e = gr["g"][b], gr["g_err"][b]
     found, _ = find_peaks(g, prominence=3.0 * float(np.median(e[r > 1.0])))
     return [float(r[i]) for i in found if r[i] > 1.5]
@@ -720,7 +725,7 @@ FREEZING = 0.494
 def _far_g(gr: dict[str, np.ndarray]) -> tuple[float, float]:
     """The centre bin's g over 4-5 d and its error (1 when the bin holds no correlations
     beyond a few d)."""
-    r = 0.5 * (gr["r_edges"][1:] + gr["r_edges"][:-1])
+    r = _shell_centres(gr)
     sel = (r >= 4.0) & (r < 5.0)
     if not sel.any():
         return float("nan"), float("nan")
@@ -758,19 +763,22 @@ def lambda_checks(data: Runs) -> list[Check]:
             continue
         rough = [d for d in ds if d.flow.beta > SMOOTH_BETA]
         smooth = [d for d in ds if d.flow.beta <= SMOOTH_BETA]
+        means = {id(d): lambda_mean(d) for d in ds}
+
+        def off(runs: list[FlowData], means=means) -> list[float]:
+            return [abs(means[id(d)][0] - 1 / 3) for d in runs]
+
         rows, departs = [], []
         for d in ds:
-            m, em = lambda_mean(d)
+            m, em = means[id(d)]
             lam = d.stat("lambda")
             c, ec = lam["lambda"][CENTRE_BIN - 1], lam["lambda_err"][CENTRE_BIN - 1]
             if abs(m - 1 / 3) > 2 * em:
                 departs.append(d)
             rows.append(f"{_tag(d)}: mean {pm(m, em)}, centre {pm(c, ec)}")
         # a rough run's departure counts beyond what anisotropy alone gives the control
-        floor = max((abs(lambda_mean(d)[0] - 1 / 3) for d in smooth
-                     if d.run_info()["steady"]), default=0.0)
-        beyond = [d for d in rough if abs(lambda_mean(d)[0] - 1 / 3) - floor
-                  > 2 * lambda_mean(d)[1]]
+        floor = max(off([d for d in smooth if d.run_info()["steady"]]), default=0.0)
+        beyond = [d for d in rough if off([d])[0] - floor > 2 * means[id(d)][1]]
         steady = [d for d in ds if d.run_info()["steady"]]
         trend = _lambda_trend(steady)
         dropped = len(ds) - len(steady)
@@ -780,10 +788,6 @@ def lambda_checks(data: Runs) -> list[Check]:
                     + (f" ({dropped} unsteady run(s) left out of the trends)" if dropped
                        else ""))
         control = [d for d in smooth if d not in departs]
-
-        def off(runs: list[FlowData]) -> list[float]:
-            return [abs(lambda_mean(d)[0] - 1 / 3) for d in runs]
-
         rough_off = off([d for d in rough if d in departs])
         control_text = (f" Nearly smooth control (β ≤ {SMOOTH_BETA:g}, spin barely coupled): "
                         f"Λ̄ at 1/3 within 2σ in {len(control)} of {len(smooth)} runs"
@@ -880,7 +884,7 @@ def _second_shell(d: FlowData) -> tuple[str, bool]:
     gr = d.gr
     if "g" not in gr:
         return "", False
-    r = 0.5 * (gr["r_edges"][1:] + gr["r_edges"][:-1])
+    r = _shell_centres(gr)
     g = gr["g"][CENTRE_BIN - 1]
     near_root3 = (r > 1.65) & (r < 1.9)
     near_two = (r >= 1.9) & (r < 2.0)
