@@ -34,7 +34,8 @@ def _box_of(scene) -> tuple[int, int, int, int]:
 
 
 def test_cases_are_the_thesis_boxes_with_its_collision_parameters() -> None:
-    cases = [c for c in waves.cases(False) if c.name != waves.twin_name()]
+    twins = {waves.twin_name(b) for b in waves.twin_boxes()}
+    cases = [c for c in waves.cases(False) if c.name not in twins]
     scenes = {c.name: c.load() for c in cases}  # every scene validates
     e07 = {n: s for n, s in scenes.items() if s.contact.restitution == 0.7}
     assert {_box_of(s) for s in e07.values()} == THESIS_TABLE
@@ -78,17 +79,20 @@ def test_case_names_unique_and_the_wide_boxes_run_over_the_thesis_span() -> None
         assert case.name == f"waves-phi0.15-L{length}W{width}H{height}{e}{tc}-edmd"
 
 
-def test_the_tc_twin_is_its_box_at_a_smaller_tc_only() -> None:
-    """The TC twin runs the L42W30H30 box's scene over the same span, only the engine's t_c
-    smaller than its default; it is not part of --quick."""
+@pytest.mark.parametrize("tag", ["L42W30H30", "L90W30H30", "L150W50H10"])
+def test_each_tc_twin_is_its_box_at_a_smaller_tc_only(tag: str) -> None:
+    """Each TC twin runs its box's scene over the same span, only the engine's t_c smaller
+    than its default; no twin is part of --quick."""
     from demstudy.engines.edmd.core import DEFAULT_TC
 
     by_name = {c.name: c for c in waves.cases(False)}
-    twin = by_name["waves-phi0.15-L42W30H30-tc1e-06-edmd"]
-    box = by_name["waves-phi0.15-L42W30H30-edmd"]
+    twin = by_name[f"waves-phi0.15-{tag}-tc1e-06-edmd"]
+    box = by_name[f"waves-phi0.15-{tag}-edmd"]
     assert dict(twin.options) == {"tc": 1e-6} and 1e-6 < DEFAULT_TC
     assert twin.load() == box.load() and twin.scene == box.scene
+    assert not box.options
     assert not any("tc" in c.name for c in waves.cases(True))
+    assert sum("-tc" in n for n in by_name) == len(waves.TC_TWINS) == 3
 
 
 def test_quick_subset_is_small_and_short() -> None:
@@ -159,7 +163,8 @@ def test_classifier_homogeneous_gas_has_no_structure() -> None:
 @pytest.mark.parametrize("quick", [True, False])
 def test_missing_runs_give_not_run_checks(tmp_path: Path, quick: bool) -> None:
     ana = analyse_waves({}, tmp_path, quick)
-    boxes = {c.name for c in waves.cases(quick)} - {waves.twin_name()}
+    boxes = {c.name for c in waves.cases(quick)} - {waves.twin_name(b)
+                                                     for b in waves.twin_boxes()}
     per_box = [c for c in ana.checks if c.ref.startswith("Fig 5.") and "digest §4.11" in c.ref]
     assert len(per_box) == len(boxes)
     assert all(c.verdict == NOT_RUN and "forecast" in c.reason for c in per_box)
@@ -354,11 +359,17 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
 
     agreed = Check("TC model", "", "", "", REPRODUCED)
     lifted = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
-                       agreed, True)
+                       agreed, ["L42W30H30"])
     assert lifted.verdict == REPRODUCED and "the share does not matter here" in lifted.reason
     other = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
-                      None, True)
+                      None, ["L42W30H30"])
     assert other.verdict == PARTLY and "this box's share is not tested" in other.reason
+    assert "TC twin of L42W30H30 at t_c = 1e-06 kept its class" in other.reason
+    two = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                    None, ["L42W30H30", "L90W30H30"])
+    assert "TC twins of L42W30H30, L90W30H30 at t_c = 1e-06 kept their class" in two.reason
+    alone = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
+    assert alone.verdict == PARTLY and "twin" not in alone.reason
 
 
 def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
@@ -371,6 +382,8 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     from demstudy.studies.malik2008.waves_measure import measure
     from demstudy.studies.malik2008.waves_report import tc_dependence
 
+    box = waves.twin_boxes()[1]
+
     def slug(x, y):
         return 0.1 + 0.9 * _blob(x, y, 0.5 * SIZE[0], Y_C, sx=6.0)
 
@@ -378,38 +391,39 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     base = dataclasses.replace(measure(_synthetic_run(tmp_path / "a.h5", slug, rate=250.0)),
                                tc_fraction=0.06)
     twin = dataclasses.replace(base, tc_fraction=0.004)
-    same = tc_dependence(base, twin)
+    same = tc_dependence(box, base, twin)
     assert same.verdict == REPRODUCED and "share at 1e-06: 0.4 % < 5 %" in same.reason
+    assert same.ref.startswith("TC model, L90W30H30") and "L90W30H30 (N = " in same.statement
     assert "TC share 6.0 %" in same.measured and "TC share 0.4 %" in same.measured
     assert "clock" not in same.reason  # the same collision rate: equal c/p is equal time
-    faster = tc_dependence(base, dataclasses.replace(twin, rate=1.44 * base.rate))
+    faster = tc_dependence(box, base, dataclasses.replace(twin, rate=1.44 * base.rate))
     assert faster.verdict == REPRODUCED and "the collision clock runs ×1.44" in faster.reason
     assert "collide more often" in faster.reason
-    slower = tc_dependence(base, dataclasses.replace(twin, rate=0.5 * base.rate))
+    slower = tc_dependence(box, base, dataclasses.replace(twin, rate=0.5 * base.rate))
     assert "runs ×0.50" in slower.reason and "collide less often" in slower.reason
-    unknown_rate = tc_dependence(dataclasses.replace(base, rate=float("nan")), twin)
+    unknown_rate = tc_dependence(box, dataclasses.replace(base, rate=float("nan")), twin)
     assert "clock" not in unknown_rate.reason
     other = dataclasses.replace(measure(_synthetic_run(tmp_path / "b.h5", plug, rate=250.0)),
                                 tc_fraction=0.004)
-    differs = tc_dependence(base, other)
+    differs = tc_dependence(box, base, other)
     assert differs.verdict == NOT_REPRODUCED and "the class differs" in differs.reason
     c = max(other.windows)  # one snapshot window a plug, the production still a slug
     window = dataclasses.replace(twin, windows={**twin.windows, c: other.windows[c]})
-    once = tc_dependence(base, window)
+    once = tc_dependence(box, base, window)
     assert once.verdict == NOT_REPRODUCED and f"the class differs: at {c:.0f} c/p" in once.reason
     (m1, e1), (m2, e2) = base.ke_halves
     hotter = dataclasses.replace(twin, ke_halves=((m1, e1), (1.5 * m2, e2)))
-    apart = tc_dependence(base, hotter)
+    apart = tc_dependence(box, base, hotter)
     assert apart.verdict == PARTLY and "second half differs" in apart.reason
-    shared = tc_dependence(base, dataclasses.replace(twin, tc_fraction=0.08))
+    shared = tc_dependence(box, base, dataclasses.replace(twin, tc_fraction=0.08))
     assert shared.verdict == PARTLY and "≥ 5 %" in shared.reason
-    unknown = tc_dependence(base, dataclasses.replace(twin, tc_fraction=float("nan")))
+    unknown = tc_dependence(box, base, dataclasses.replace(twin, tc_fraction=float("nan")))
     assert unknown.verdict == PARTLY and "share at 1e-06: unknown" in unknown.reason
-    wrong = tc_dependence(base, dataclasses.replace(twin, tc=1e-5))
+    wrong = tc_dependence(box, base, dataclasses.replace(twin, tc=1e-5))
     assert wrong.verdict == NOT_RUN and "ran at t_c = 1e-05, not 1e-06" in wrong.reason
-    assert tc_dependence(dataclasses.replace(base, tc=1e-5),
+    assert tc_dependence(box, dataclasses.replace(base, tc=1e-5),
                          dataclasses.replace(twin, tc=1e-6)).verdict == REPRODUCED
-    missing = tc_dependence(base, None, "results file unreadable")
+    missing = tc_dependence(box, base, None, "results file unreadable")
     assert missing.verdict == NOT_RUN and "unreadable" in missing.reason
 
 

@@ -33,11 +33,14 @@ QUICK_RUN = {"run": {"equilibration": 120.0, "production": 100.0, "sample_interv
 THESIS_SPAN = {"run": {"unit": "collisions", "equilibration": 1000.0, "production": 14000.0,
                        "sample_interval": 200.0}}
 
-#: the TC-model twin (not in the thesis): the cheapest W = 30 box again at t_c = 10⁻⁶ √(d/g)
-#: instead of the engine's default 10⁻⁵. At the default its slug made 6 % of the pair
-#: collisions elastic (the thesis's collisions all dissipate): does the structure depend on
-#: the engine's TC model? Same span, so the same snapshot windows compare.
-TC_TWIN = ("L42W30H30", 1e-6)
+#: the TC-model twins (not in the thesis): boxes run again at t_c = 10⁻⁶ √(d/g) instead of the
+#: engine's default 10⁻⁵, over the same span, so the same snapshot windows compare. At the
+#: default L42W30H30's slug made 6 % of the pair collisions elastic, L90W30H30's 17.7 % and
+#: L150W50H10's 15-18 % (the thesis's collisions all dissipate): does the structure depend on
+#: the engine's TC model? The cheapest W = 30 box, the W = 30 slug with the largest share and
+#: the flat W = 50 plane; ≈ 10-25 min each on one core here.
+TC_TWINS = ("L42W30H30", "L90W30H30", "L150W50H10")
+TC_TWIN_TC = 1e-6
 
 
 def on_thesis_span(box: Box) -> bool:
@@ -45,18 +48,20 @@ def on_thesis_span(box: Box) -> bool:
     return box.width >= 30
 
 
-def twin_box() -> Box:
-    return next(b for b in BOXES if b.tag == TC_TWIN[0] and b.restitution == 0.7)
+def twin_boxes() -> list[Box]:
+    """The boxes (at the thesis's e = 0.7) that have a TC twin, in ``TC_TWINS``'s order."""
+    return [next(b for b in BOXES if b.tag == tag and b.restitution == 0.7)
+            for tag in TC_TWINS]
 
 
-def twin_name() -> str:
-    """The twin's case name: the box's with ``-tc<t_c>`` before the engine."""
-    return f"{twin_box().name.removesuffix('-edmd')}-tc{TC_TWIN[1]:g}-edmd"
+def twin_name(box: Box) -> str:
+    """The TC twin's case name: the box's with ``-tc<t_c>`` before the engine."""
+    return f"{box.name.removesuffix('-edmd')}-tc{TC_TWIN_TC:g}-edmd"
 
 
 def cases(quick: bool) -> list[Case]:
     """Every box of the thesis's table as shipped (the e study overrides e only; W ≥ 30:
-    over the thesis's span, ``THESIS_SPAN``) and the TC twin (``TC_TWIN``); ``quick``: the
+    over the thesis's span, ``THESIS_SPAN``) and the TC twins (``TC_TWINS``); ``quick``: the
     boxes of ``QUICK`` with short runs."""
     out = []
     for box in BOXES:
@@ -70,15 +75,16 @@ def cases(quick: bool) -> list[Case]:
         out.append(Case(box.name, box.scene, sections=sections, quick=is_quick,
                         quick_sections=QUICK_RUN if is_quick else {}))
     if not quick:
-        out.append(Case(twin_name(), twin_box().scene, sections=THESIS_SPAN,
-                        options={"tc": TC_TWIN[1]}))
+        out += [Case(twin_name(box), box.scene, sections=THESIS_SPAN,
+                     options={"tc": TC_TWIN_TC}) for box in twin_boxes()]
     return out
 
 
 def derive(name: str, path: Path) -> dict[str, tuple[dict, dict]]:
     """What a study record keeps of box run ``name`` in place of its frames (the modes, the
     peak densities, the last frame: waves_measure.derive)."""
-    if name != twin_name() and not any(box.name == name for box in BOXES):
+    twins = {twin_name(box) for box in twin_boxes()}
+    if name not in twins and not any(box.name == name for box in BOXES):
         return {}
     from .waves_measure import derive as derive_waves
 

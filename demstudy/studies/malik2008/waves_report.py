@@ -28,7 +28,7 @@ from ..base import (
     Figure,
     pm,
 )
-from .waves import TC_TWIN, on_thesis_span, twin_box, twin_name
+from .waves import TC_TWIN_TC, on_thesis_span, twin_boxes, twin_name
 from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
 from .waves_measure import COARSE, DRIFT_SIGMAS, SNAPSHOTS, WINDOW, RunWaves, measure
@@ -208,45 +208,47 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
 
 
 def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
-              twin_agrees: bool = False) -> Check:
+              agreed: Sequence[str] = ()) -> Check:
     """``check`` of a run whose pair collisions the engine's TC model made elastic in a large
     share (> WARN_SHARE; the thesis has no TC model): at most "partly", the share in the
     reason (the dense clumps dissipate less than e says). ``own_twin``: the TC row of this
     box's own twin at a smaller t_c; when it is "reproduced" (same class and KE, small share)
-    the share is shown not to matter and the verdict is not capped. ``twin_agrees``: the
-    twin of another box agreed, which the reason mentions (it does not lift the cap)."""
+    the share is shown not to matter and the verdict is not capped. ``agreed``: the tags of
+    other boxes whose twins agreed, which the reason mentions (they do not lift the cap)."""
     if not run.tc_fraction > WARN_SHARE:
         return check
     share = (f"The engine's TC model made {100 * run.tc_fraction:.1f} % of the pair "
              "collisions elastic (t_c = 10⁻⁵ √(d/g); the thesis has no TC model)")
     if own_twin is not None and own_twin.verdict == REPRODUCED:
-        check.reason = (check.reason + f" {share}, but its twin at t_c = {TC_TWIN[1]:g} "
+        check.reason = (check.reason + f" {share}, but its twin at t_c = {TC_TWIN_TC:g} "
                         "gives the same class and KE with a small share (row \"TC model\"): "
                         "the share does not matter here.").strip()
         return check
     check.reason = (check.reason + f" {share}: the dense clumps dissipate less than e says, "
-                    "inconclusive" + (f" (the TC twin of {twin_box().tag} at t_c = "
-                                      f"{TC_TWIN[1]:g} kept its class, row \"TC model\"; "
-                                      "this box's share is not tested)" if twin_agrees
-                                      else "") + ".").strip()
+                    "inconclusive" + (f" (the TC twin{'s' * (len(agreed) > 1)} of "
+                                      f"{', '.join(agreed)} at t_c = {TC_TWIN_TC:g} kept "
+                                      f"{'their' if len(agreed) > 1 else 'its'} class, "
+                                      "rows \"TC model\"; this box's share is not tested)"
+                                      if agreed else "") + ".").strip()
     if check.verdict in (REPRODUCED, NOT_REPRODUCED):
         check.verdict = PARTLY
     return check
 
 
-def tc_dependence(base: RunWaves | None, twin: RunWaves | None, why: str = "") -> Check:
-    """The TC twin against its box at the default t_c (demstudy's own check; the thesis has
-    no TC model): the class of the whole production and at every snapshot window both
-    sampled, the KE of each half, and the share at the smaller t_c. ``why``: the cause when
-    a run is missing (unreadable, failed)."""
-    box, tc = twin_box(), TC_TWIN[1]
-    ref = "TC model (demstudy; not in the thesis)"
+def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
+                  why: str = "") -> Check:
+    """The TC twin of ``box`` against the box at the default t_c (demstudy's own check; the
+    thesis has no TC model): the class of the whole production and at every snapshot window
+    both sampled, the KE of each half, and the share at the smaller t_c. ``why``: the cause
+    when a run is missing (unreadable, failed)."""
+    tc = TC_TWIN_TC
+    ref = f"TC model, {box.tag} (demstudy; not in the thesis)"
     statement = (f"the structure of {box.tag} (N = {box.n}) does not depend on the "
                  f"event-driven engine's t_c ({DEFAULT_TC:g} against {tc:g} √(d/g)), and the "
                  "TC-elastic share is small at the smaller t_c")
     thesis = "— (the thesis's collisions all dissipate: no TC model)"
     if base is None or twin is None:
-        absent = [n for n, r in ((box.name, base), (twin_name(), twin)) if r is None]
+        absent = [n for n, r in ((box.name, base), (twin_name(box), twin)) if r is None]
         return Check(ref, statement, thesis, "not run", NOT_RUN,
                      "run missing: " + ", ".join(absent) + (f" ({why})" if why else ""))
     ran = [(t, r) for t, r in ((DEFAULT_TC, base), (tc, twin))
@@ -491,10 +493,12 @@ reading, and the report names the reading that agrees.
 **TC model.** The engine makes a pair collision elastic (e = 1, no tangential impulse)
 when either partner collided less than t_c earlier (Luding & McNamara's TC model against
 inelastic collapse; the thesis has none). At the default t_c = 10⁻⁵ √(d/g) this made
-3-13 % of the W = 30/50 boxes' pair collisions elastic, so L42W30H30 is run again at
-t_c = 10⁻⁶ over the same span (case waves-phi0.15-L42W30H30-tc1e-06-edmd): the "TC model"
-row compares the class over the production and at each snapshot window, the KE of each
-half and the share.
+6-18 % of the W = 30/50 boxes' pair collisions elastic, so L42W30H30, L90W30H30 and
+L150W50H10 are run again at t_c = 10⁻⁶ over the same span (cases
+waves-phi0.15-<box>-tc1e-06-edmd): each "TC model" row compares the class over the
+production and at each snapshot window, the KE of each half and the share. A box whose own
+twin agrees keeps its verdicts; the others' are capped at "partly" when their share is
+above 5 %.
 
 **Peak density.** The densest cell column of the xy plane in each production frame (mean
 over the frames), on the 2 d grid and on ≈ 5 d columns, since the thesis's cells are not
@@ -523,13 +527,16 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
              "collisions": max([2.0 * r.wall_seconds / (r.n * r.cpp[-1]) for r in timed
                                 if r.cpp[-1] > 0], default=COST_PER_COLLISION)}
     table = dict(measured)
-    tc_row = None
-    if not quick:
-        twin = _measure_twin(runs, failed)
-        tc_row = tc_dependence(measured.get(twin_box().name), twin,
-                               failed.get(twin_name()) or failed.get(twin_box().name, ""))
+    tc_rows: dict[str, Check] = {}
+    for box in [] if quick else twin_boxes():
+        twin = _measure_twin(box, runs, failed)
+        tc_rows[box.name] = tc_dependence(box, measured.get(box.name), twin,
+                                          failed.get(twin_name(box))
+                                          or failed.get(box.name, ""))
         if twin is not None:
-            table[twin_name()] = twin
+            table[twin_name(box)] = twin
+    agreed = [b.tag for b in twin_boxes()
+              if b.name in tc_rows and tc_rows[b.name].verdict == REPRODUCED]
     for box in boxes:
         run = measured.get(box.name)
         if run is None:
@@ -537,8 +544,8 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
                                           "run missing; " + _forecast(box, quick, costs)))
             continue
         for check in (class_check(box, run), steady_check(box, run)):
-            ana.checks.append(tc_caveat(check, run, tc_row if box == twin_box() else None,
-                                        tc_row is not None and tc_row.verdict == REPRODUCED))
+            ana.checks.append(tc_caveat(check, run, tc_rows.get(box.name),
+                                        [t for t in agreed if t != box.tag]))
         path = run_figure(run, box, out / f"{box.name.removesuffix('-edmd')}.png")
         ana.figures.append(Figure(path, f"Fig {box.fig}'s form: N = {box.n} in {box.tag}, "
                                         f"e = {box.restitution:g}: positions, density "
@@ -546,8 +553,7 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
                                         "and mode amplitudes against collisions per "
                                         "particle (class " + run.modes.pattern + ")"))
     diagram = [b for b in boxes if b.restitution == RESTITUTION and b.height == b.width]
-    if tc_row is not None:
-        ana.checks.append(tc_row)
+    ana.checks += tc_rows.values()
     ana.checks.append(peak_check(measured))
     ana.checks += _phase_checks(boxes, diagram, measured)
     thesis = [(b, THESIS[b.fig].cls, "digest") for b in diagram if b.fig in THESIS]
@@ -564,14 +570,15 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     return ana
 
 
-def _measure_twin(runs: Mapping[str, Path], failed: dict[str, str]) -> RunWaves | None:
-    path = runs.get(twin_name())
+def _measure_twin(box: Box, runs: Mapping[str, Path],
+                  failed: dict[str, str]) -> RunWaves | None:
+    path = runs.get(twin_name(box))
     if path is None:
         return None
     try:
         return measure(Path(path))
     except (OSError, KeyError, ValueError, BadInputFile) as exc:
-        failed[twin_name()] = f"results file unreadable for the mode analysis: {exc}"
+        failed[twin_name(box)] = f"results file unreadable for the mode analysis: {exc}"
         return None
 
 
