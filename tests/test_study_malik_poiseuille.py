@@ -19,6 +19,7 @@ from demstudy.studies.malik2008 import poiseuille
 from demstudy.studies.malik2008.poiseuille_cases import (
     QUICK,
     SOFT,
+    SOFT_FLOWS,
     THESIS_SYSTEM,
     Flow,
     case_of,
@@ -37,7 +38,10 @@ def test_case_names_unique_and_quick_is_the_named_subset():
     assert len(names) == len(set(names))
     assert {c.name for c in quick} == {f.name for f in QUICK}
     assert {c.name for c in quick} <= set(names)
-    assert [c.name for c in full if c.engine != "edmd"] == [SOFT.name]  # the soft check
+    # the soft checks: LAMMPS and LIGGGHTS
+    assert [(c.name, c.engine) for c in full if c.engine != "edmd"] == [
+        ("poiseuille-phi0.01-b0.99-e0.8-lammps", "lammps"),
+        ("poiseuille-phi0.01-b0.99-e0.8-liggghts", "liggghts")]
     # the thesis's grid: 3 β × 4 e at φ = 0.01 and at φ = 0.1, one dense flow
     assert sum("phi0.01-" in n and n.endswith("-edmd") for n in names) == 12
     assert sum("phi0.1-" in n for n in names) == 12
@@ -48,7 +52,7 @@ def test_case_names_unique_and_quick_is_the_named_subset():
 def test_scenes_validate_with_the_thesis_n_box_e_beta_and_25_bins(quick):
     for case in cases(quick):
         flow = next(f for f in (QUICK if quick else
-                                [*poiseuille._known_flows(False).values(), SOFT])
+                                [*poiseuille._known_flows(False).values(), *SOFT_FLOWS])
                     if f.name == case.name)
         scene = case.load(quick)
         n, box = THESIS_SYSTEM[flow.phi]
@@ -250,16 +254,18 @@ def test_a_vdf_spike_is_named_a_spike_not_a_skewed_core():
 
 
 # ------------------------------------------------------------------ soft cross-check
-def test_the_soft_case_is_the_hard_flow_in_lammps_shorter_at_ten_steps_per_contact():
+@pytest.mark.parametrize("engine", ["lammps", "liggghts"])
+def test_each_soft_case_is_the_hard_flow_shorter_at_ten_steps_per_contact(engine):
+    flow = next(f for f in SOFT_FLOWS if f.engine == engine)
     by_name = {c.name: c for c in cases(False)}
-    soft, hard = by_name[SOFT.name], by_name[SOFT.name.replace("lammps", "edmd")]
+    soft, hard = by_name[flow.name], by_name[flow.name.replace(engine, "edmd")]
     s, h = soft.load(), hard.load()
-    assert soft.engine == "lammps" and s.soft.steps_per_contact == 10
+    assert soft.engine == engine and s.soft.steps_per_contact == 10
     assert (s.particles.count, s.box.size, s.contact, s.walls) == \
         (h.particles.count, h.box.size, h.contact, h.walls)
     assert "freepath" not in s.measure.statistics  # the collision log is the event engine's
     assert s.run.equilibration + s.run.production < h.run.equilibration + h.run.production
-    assert SOFT.name not in {c.name for c in cases(True)}
+    assert flow.name not in {c.name for c in cases(True)}
 
 
 def _hotter(path, factor: float, drop_collisions: bool = True):
@@ -307,6 +313,14 @@ def test_soft_check_verdicts_follow_the_difference_and_the_noise(tiny_run):
     noisy = soft_check(load_flow(flow, path, with_gr=False), _hotter(path, 1.0))
     assert noisy.verdict == PARTLY and "would not show" in noisy.reason
     assert soft_check(hard, None).verdict == NOT_RUN
+    # the LIGGGHTS row: its engine and model in the reference, its own case name when missing
+    ligg = next(f for f in SOFT_FLOWS if f.engine == "liggghts")
+    row = soft_check(hard, _hotter(record, 1.02), ligg)
+    assert row.verdict == REPRODUCED and row.ref.startswith("soft-contact cross-check "
+                                                             "(LIGGGHTS, hooke/stiffness")
+    absent = soft_check(None, None, ligg)
+    assert absent.verdict == NOT_RUN and ligg.name in absent.reason
+    assert flow.name in absent.reason  # the hard run's name, from the soft one's
 
 
 def test_a_damaged_soft_run_is_not_run_with_the_cause(tiny_run, tmp_path):
@@ -314,8 +328,12 @@ def test_a_damaged_soft_run_is_not_run_with_the_cause(tiny_run, tmp_path):
     bad = tmp_path / f"{SOFT.name}.h5"
     bad.write_bytes(b"not hdf5")
     ana = poiseuille.analyse({flow.name: path, SOFT.name: bad}, tmp_path, quick=False)
-    row = next(c for c in ana.checks if c.ref.startswith("soft-contact cross-check"))
-    assert row.verdict == NOT_RUN and SOFT.name in row.reason
+    rows = [c for c in ana.checks if c.ref.startswith("soft-contact cross-check")]
+    assert [r.ref.split(",")[0] for r in rows] == ["soft-contact cross-check (LAMMPS",
+                                                   "soft-contact cross-check (LIGGGHTS"]
+    assert rows[0].verdict == NOT_RUN and SOFT.name in rows[0].reason
+    assert rows[0].reason.count("unreadable") == 1
+    assert rows[1].verdict == NOT_RUN and "liggghts" in rows[1].reason  # not run at all
 
 
 def test_coldest_beta_is_judged_on_the_mass_weighted_temperature():

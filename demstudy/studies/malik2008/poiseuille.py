@@ -19,7 +19,7 @@ from ...errors import BadInputFile
 from ...io.results import read_results
 from ..base import NOT_RUN, UNITS_NOTE, Analysis, Check, Figure
 from . import poiseuille_checks as pc
-from .poiseuille_cases import BETAS, QUICK, RESTITUTIONS, SOFT, Flow, cases, flows
+from .poiseuille_cases import BETAS, QUICK, RESTITUTIONS, SOFT_FLOWS, Flow, cases, flows
 from .poiseuille_data import (
     BINS,
     BINS_DENSE,
@@ -68,18 +68,18 @@ def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
     return out
 
 
-def soft_row(data: Runs, runs: Mapping[str, Path]) -> Check:
-    """The soft cross-check's row (full study only): its run read without g(r) and compared
-    with the hard run; an unreadable file or profiles that do not compare give "not run"
-    with the cause, never an exception."""
-    hard = data.get((SOFT.phi, SOFT.beta, SOFT.e))
-    path = runs.get(SOFT.name)
+def soft_row(data: Runs, runs: Mapping[str, Path], flow: Flow) -> Check:
+    """The row of soft cross-check ``flow`` (full study only): its run read without g(r)
+    and compared with the hard run; an unreadable file or profiles that do not compare give
+    "not run" with the cause, never an exception."""
+    hard = data.get((flow.phi, flow.beta, flow.e))
+    path = runs.get(flow.name)
     if path is None or not Path(path).is_file():
-        return soft_check(hard, None)
+        return soft_check(hard, None, flow)
     try:
-        return soft_check(hard, load_flow(SOFT, Path(path), with_gr=False))
+        return soft_check(hard, load_flow(flow, Path(path), with_gr=False), flow)
     except (OSError, KeyError, ValueError, BadInputFile) as exc:  # NotComparable: ValueError
-        return soft_unreadable(f"unreadable or not comparable: {exc}")
+        return soft_unreadable(f"unreadable or not comparable: {exc}", flow)
 
 
 def _percent(fraction: float) -> str:
@@ -111,7 +111,7 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     checks = [c for check in CHECKS for c in check(data)]
     pc.tc_caveats(checks, data)
     if not quick:
-        checks.append(soft_row(data, runs))
+        checks += [soft_row(data, runs, flow) for flow in SOFT_FLOWS]
     for c in checks:  # a statement without runs says so, never crashes
         if c.verdict == NOT_RUN and not c.reason:
             c.reason = "its runs are not in this run of the study"
@@ -227,7 +227,7 @@ def _over_e(ds: list[FlowData], name: str, phi: float, b: float,
 
 def sections(data: Runs, runs: Mapping[str, Path], quick: bool) -> list[tuple[str, str]]:
     """The report's text: what ran, for how long against the thesis, what did not run."""
-    known = [*_known_flows(quick), *([] if quick else [SOFT.name])]
+    known = [*_known_flows(quick), *([] if quick else [f.name for f in SOFT_FLOWS])]
     made = sorted(n for n in known if n in runs)
     missing = sorted(n for n in known if n not in runs)
     lines = [UNITS_NOTE, "",
@@ -260,10 +260,11 @@ def sections(data: Runs, runs: Mapping[str, Path], quick: bool) -> list[tuple[st
               f"{collisions_text(list(data.values()))} (table).", "",
               f"Made: {len(made)} of {len(known)} runs. Not run: "
               + (", ".join(missing) if missing else "none") + ".", "",
-              "Soft cross-check (LAMMPS, the scene's stiffness, constant β by the tangential "
-              "spring): the φ = 0.01, β = 0.99, e = 0.8 flow at 10 steps per contact over "
-              "200 + 400 √(d/g) (case " + SOFT.name + "; the scene's 2500 √(d/g) at 50 steps "
-              "per contact is forecast at 3.7 h on one core); φ = 0.1 and 0.5 are left to the "
+              "Soft cross-checks (LAMMPS and LIGGGHTS, the scene's stiffness, constant β by "
+              "the tangential spring): the φ = 0.01, β = 0.99, e = 0.8 flow at 10 steps per "
+              "contact over 200 + 400 √(d/g) (cases " + ", ".join(f.name for f in SOFT_FLOWS)
+              + "; the scene's 2500 √(d/g) at 50 steps per contact is forecast at 3.7 h on "
+              "one core in LAMMPS); φ = 0.1 and 0.5 are left to the "
               "event-driven engine (the cost study forecasts Malik's φ = 0.1 box at 65 h in "
               "LAMMPS, docs/accuracy-cost.md)."]
     return [("Poiseuille flows (Malik Ch. 3-4): runs", "\n".join(lines)),

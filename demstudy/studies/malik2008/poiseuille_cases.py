@@ -88,21 +88,25 @@ def flows() -> list[Flow]:
     return out
 
 
-#: the soft cross-check (LAMMPS): φ = 0.01, the cheapest flow, at Fig 2.11's β = 0.99, e = 0.8
-#: (β through the tangential spring), the scene's stiffness (k_n = 1.6·10⁶: δ ≤ 1 % at a
-#: 20 √(gd) impact) at 10 steps per contact, which the cost study found within its noise for
-#: the φ = 0.1 Poiseuille flow (k* = 10⁶: 2.4 % against a 2.3 % floor, docs/accuracy-cost.md).
+#: the soft cross-checks (LAMMPS, LIGGGHTS): φ = 0.01, the cheapest flow, at Fig 2.11's
+#: β = 0.99, e = 0.8 (β through the tangential spring), the scene's stiffness (k_n = 1.6·10⁶:
+#: δ ≤ 1 % at a 20 √(gd) impact) at 10 steps per contact, which the cost study found within
+#: its noise for the φ = 0.1 Poiseuille flow (k* = 10⁶: 2.4 % against a 2.3 % floor,
+#: docs/accuracy-cost.md).
 #: 200 + 400 √(d/g): the event-driven run plateaus by ≈ 150 √(d/g); the scene's 2500 at the
-#: default 50 steps per contact would take 3.7 h (forecast), this ≈ 25 min.
+#: default 50 steps per contact would take 3.7 h (forecast), this ≈ 25 min in LAMMPS. LIGGGHTS
+#: runs the same scene (hooke/stiffness: k_n, k_t and the damping set directly, the same
+#: β spring), ≈ ×0.6 LAMMPS's time per step here (a 4 √(d/g) pilot of each, under load).
 SOFT = Flow(0.01, 0.8, 0.99, engine="lammps")
+SOFT_FLOWS = (SOFT, Flow(0.01, 0.8, 0.99, engine="liggghts"))
 SOFT_SECTIONS = {"run": {"equilibration": 200.0, "production": 400.0, "sample_interval": 4.0},
                  "soft": {"steps_per_contact": 10}}
 QUICK = (Flow(0.01, 0.8, 0.99), Flow(0.01, 0.8, -0.99), Flow(0.5, *DENSE))
 
 
 def cases(quick: bool) -> list[Case]:
-    """Full study: every flow (event-driven) and the soft cross-check ``SOFT``; quick:
-    ``QUICK`` only, shortened."""
+    """Full study: every flow (event-driven) and the soft cross-checks ``SOFT_FLOWS``;
+    quick: ``QUICK`` only, shortened."""
     if quick:
         return [case_of(f, quick=True) for f in QUICK]
-    return [case_of(f, quick=f in QUICK) for f in flows()] + [case_of(SOFT)]
+    return [case_of(f, quick=f in QUICK) for f in flows()] + [case_of(f) for f in SOFT_FLOWS]

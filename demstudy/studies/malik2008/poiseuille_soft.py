@@ -1,7 +1,7 @@
-"""The soft-contact cross-check of the Poiseuille part: LAMMPS's soft spheres against the
-event-driven hard spheres in one of Malik's flows (``poiseuille_cases.SOFT``: φ = 0.01,
-β = 0.99, e = 0.8), profile by profile with both runs' statistical errors
-(:func:`demstudy.comparison.compare_pair`), and what each cost.
+"""The soft-contact cross-checks of the Poiseuille part: LAMMPS's and LIGGGHTS's soft spheres
+against the event-driven hard spheres in one of Malik's flows (``poiseuille_cases.SOFT_FLOWS``:
+φ = 0.01, β = 0.99, e = 0.8), profile by profile with both runs' statistical errors
+(:func:`demstudy.comparison.compare_pair`), and what each cost; one row per soft engine.
 
 Tolerance: the soft run reproduces the hard one when every field's debiased relative L2
 difference (the difference with the noise taken out, resolved or not) is at most
@@ -20,7 +20,7 @@ import math
 
 from ...comparison.core import compare_pair
 from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check
-from .poiseuille_cases import SOFT, SOFT_SECTIONS
+from .poiseuille_cases import SOFT, SOFT_SECTIONS, Flow
 from .poiseuille_data import FlowData
 
 FIELDS = ("solid_fraction", "velocity[x]", "temperature", "rotational_temperature", "spin[z]")
@@ -36,27 +36,33 @@ def _cost(d: FlowData) -> tuple[float, float]:
                                                     else 0.0)
 
 
-def _header() -> tuple[str, str, str]:
-    ref = (f"soft-contact cross-check (LAMMPS, hooke, the scene's k_n, "
+#: each soft engine's contact model as its deck writes it
+MODELS = {"lammps": ("LAMMPS", "hooke"), "liggghts": ("LIGGGHTS", "hooke/stiffness")}
+
+
+def _header(flow: Flow) -> tuple[str, str, str]:
+    engine, model = MODELS[flow.engine]
+    ref = (f"soft-contact cross-check ({engine}, {model}, the scene's k_n, "
            f"{SOFT_SECTIONS['soft']['steps_per_contact']} steps per contact)")
-    statement = (f"soft spheres give the hard spheres' flow (φ = {SOFT.phi:g}, β = "
-                 f"{SOFT.beta:g}, e = {SOFT.e:g}): φ, U_x, T, θ and ω_z across the channel")
+    statement = (f"soft spheres give the hard spheres' flow (φ = {flow.phi:g}, β = "
+                 f"{flow.beta:g}, e = {flow.e:g}): φ, U_x, T, θ and ω_z across the channel")
     return ref, statement, "— (the hard-sphere limit; the thesis is event-driven)"
 
 
-def soft_unreadable(why: str) -> Check:
+def soft_unreadable(why: str, flow: Flow = SOFT) -> Check:
     """The row when the soft run (or its comparison) cannot be read: "not run", why."""
-    return Check(*_header(), "not run", NOT_RUN, f"{SOFT.name}: {why}")
+    return Check(*_header(flow), "not run", NOT_RUN, f"{flow.name}: {why}")
 
 
-def soft_check(hard: FlowData | None, soft: FlowData | None) -> Check:
-    """The row of the soft cross-check (``hard``: the event-driven run of ``SOFT``'s flow);
-    raises ``NotComparable`` (a ValueError) when the runs' profiles do not compare."""
+def soft_check(hard: FlowData | None, soft: FlowData | None, flow: Flow = SOFT) -> Check:
+    """The row of the soft cross-check of ``flow`` (a soft engine's; ``hard``: the
+    event-driven run of the same flow); raises ``NotComparable`` (a ValueError) when the
+    runs' profiles do not compare."""
     run = SOFT_SECTIONS["run"]
-    ref, statement, thesis = _header()
+    ref, statement, thesis = _header(flow)
     if hard is None or soft is None:
-        absent = [n for n, d in ((SOFT.name.replace("lammps", "edmd"), hard),
-                                 (SOFT.name, soft)) if d is None]
+        absent = [n for n, d in ((flow.name.removesuffix(flow.engine) + "edmd", hard),
+                                 (flow.name, soft)) if d is None]
         return Check(ref, statement, thesis, "not run", NOT_RUN,
                      "run missing: " + ", ".join(absent))
     comp = compare_pair(hard.res, soft.res, fields=list(FIELDS))
