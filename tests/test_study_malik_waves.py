@@ -370,6 +370,17 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     assert "TC twins of L42W30H30, L90W30H30 at t_c = 1e-06 kept their class" in two.reason
     alone = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
     assert alone.verdict == PARTLY and "twin" not in alone.reason
+    # the box's own twin measured and disagreeing: said so, by its row's name, capped
+    from demstudy.studies.base import NOT_REPRODUCED
+
+    for verdict, said in ((NOT_REPRODUCED, "changes the class, so the structure depends"),
+                          (PARTLY, "keeps the class, but its KE or share differ")):
+        own = Check("TC model, L90W30H30 (demstudy; not in the thesis)", "", "", "", verdict)
+        capped = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                           own, ["L42W30H30"])
+        assert capped.verdict == PARTLY and said in capped.reason
+        assert '(row "TC model, L90W30H30")' in capped.reason
+        assert "not tested" not in capped.reason
 
 
 def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:

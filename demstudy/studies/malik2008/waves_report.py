@@ -219,17 +219,26 @@ def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
         return check
     share = (f"The engine's TC model made {100 * run.tc_fraction:.1f} % of the pair "
              "collisions elastic (t_c = 10⁻⁵ √(d/g); the thesis has no TC model)")
+    # the twin's row by its name (its reference up to the parenthesis)
+    row = f"row \"{own_twin.ref.split(' (')[0]}\"" if own_twin is not None else ""
     if own_twin is not None and own_twin.verdict == REPRODUCED:
         check.reason = (check.reason + f" {share}, but its twin at t_c = {TC_TWIN_TC:g} "
-                        "gives the same class and KE with a small share (row \"TC model\"): "
-                        "the share does not matter here.").strip()
+                        f"gives the same class and KE with a small share ({row}): the share "
+                        "does not matter here.").strip()
         return check
-    check.reason = (check.reason + f" {share}: the dense clumps dissipate less than e says, "
-                    "inconclusive" + (f" (the TC twin{'s' * (len(agreed) > 1)} of "
-                                      f"{', '.join(agreed)} at t_c = {TC_TWIN_TC:g} kept "
-                                      f"{'their' if len(agreed) > 1 else 'its'} class, "
-                                      "rows \"TC model\"; this box's share is not tested)"
-                                      if agreed else "") + ".").strip()
+    if own_twin is not None and own_twin.verdict in (PARTLY, NOT_REPRODUCED):
+        found = ("changes the class, so the structure depends on the engine's TC model"
+                 if own_twin.verdict == NOT_REPRODUCED else "keeps the class, but its KE or "
+                 "share differ, so an effect of the TC model is not ruled out")
+        check.reason = (check.reason + f" {share}: its twin at t_c = {TC_TWIN_TC:g} {found} "
+                        f"({row}).").strip()
+    else:
+        tested = ("" if not agreed else
+                  f" (the TC twin{'s' * (len(agreed) > 1)} of {', '.join(agreed)} at t_c = "
+                  f"{TC_TWIN_TC:g} kept {'their' if len(agreed) > 1 else 'its'} class, rows "
+                  "\"TC model\"; this box's share is not tested)")
+        check.reason = (check.reason + f" {share}: the dense clumps dissipate less than e "
+                        f"says, inconclusive{tested}.").strip()
     if check.verdict in (REPRODUCED, NOT_REPRODUCED):
         check.verdict = PARTLY
     return check
