@@ -16,6 +16,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from ...comparison.core import compare_pair
@@ -61,7 +62,7 @@ def soft_check(hard: FlowData | None, soft: FlowData | None, flow: Flow = SOFT) 
     run = SOFT_SECTIONS["run"]
     ref, statement, thesis = _header(flow)
     if hard is None or soft is None:
-        absent = [n for n, d in ((flow.name.removesuffix(flow.engine) + "edmd", hard),
+        absent = [n for n, d in ((dataclasses.replace(flow, engine="edmd").name, hard),
                                  (flow.name, soft)) if d is None]
         return Check(ref, statement, thesis, "not run", NOT_RUN,
                      "run missing: " + ", ".join(absent))
