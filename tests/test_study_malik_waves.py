@@ -377,7 +377,7 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
                           (PARTLY, "keeps the class, but its KE or share differ")):
         own = Check("TC model, L90W30H30 (demstudy; not in the thesis)", "", "", "", verdict)
         capped = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
-                           own, ["L42W30H30"])
+                           own, ["L42W30H30"], "L90W30H30")
         assert capped.verdict == PARTLY and said in capped.reason
         assert '(row "TC model, L90W30H30")' in capped.reason
         assert "not tested" not in capped.reason

@@ -207,8 +207,14 @@ def class_check(box: Box, run: RunWaves | None, missing: str = "") -> Check:
     return Check(ref, statement, thesis_text, measured, PARTLY, why)
 
 
+def tc_row(tag: str) -> str:
+    """The name of the TC twin's row of box ``tag`` (the report's first column up to the
+    parenthesis); the rows that cite the twin name it by this."""
+    return f"TC model, {tag}"
+
+
 def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
-              agreed: Sequence[str] = ()) -> Check:
+              agreed: Sequence[str] = (), tag: str = "") -> Check:
     """``check`` of a run whose pair collisions the engine's TC model made elastic in a large
     share (> WARN_SHARE; the thesis has no TC model): at most "partly", the share in the
     reason (the dense clumps dissipate less than e says). ``own_twin``: the TC row of this
@@ -219,8 +225,7 @@ def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
         return check
     share = (f"The engine's TC model made {100 * run.tc_fraction:.1f} % of the pair "
              "collisions elastic (t_c = 10⁻⁵ √(d/g); the thesis has no TC model)")
-    # the twin's row by its name (its reference up to the parenthesis)
-    row = f"row \"{own_twin.ref.split(' (')[0]}\"" if own_twin is not None else ""
+    row = f"row \"{tc_row(tag)}\""
     if own_twin is not None and own_twin.verdict == REPRODUCED:
         check.reason = (check.reason + f" {share}, but its twin at t_c = {TC_TWIN_TC:g} "
                         f"gives the same class and KE with a small share ({row}): the share "
@@ -251,7 +256,7 @@ def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
     both sampled, the KE of each half, and the share at the smaller t_c. ``why``: the cause
     when a run is missing (unreadable, failed)."""
     tc = TC_TWIN_TC
-    ref = f"TC model, {box.tag} (demstudy; not in the thesis)"
+    ref = f"{tc_row(box.tag)} (demstudy; not in the thesis)"
     statement = (f"the structure of {box.tag} (N = {box.n}) does not depend on the "
                  f"event-driven engine's t_c ({DEFAULT_TC:g} against {tc:g} √(d/g)), and the "
                  "TC-elastic share is small at the smaller t_c")
@@ -554,7 +559,7 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
             continue
         for check in (class_check(box, run), steady_check(box, run)):
             ana.checks.append(tc_caveat(check, run, tc_rows.get(box.name),
-                                        [t for t in agreed if t != box.tag]))
+                                        [t for t in agreed if t != box.tag], box.tag))
         path = run_figure(run, box, out / f"{box.name.removesuffix('-edmd')}.png")
         ana.figures.append(Figure(path, f"Fig {box.fig}'s form: N = {box.n} in {box.tag}, "
                                         f"e = {box.restitution:g}: positions, density "
