@@ -362,3 +362,27 @@ def test_report_reasons_start_the_appended_notes_as_sentences():
     assert _reason("done. The run x") == "done. The run x"
     assert _reason("The run first") == "The run first"
     assert _reason("|κ - 3| falls;  The engine") == "\\|κ - 3\\| falls; The engine"
+
+
+def test_the_report_tallies_the_thesis_statements_apart_from_demstudys_own_checks(tmp_path):
+    """The heading counts the thesis's statements by verdict ("no thesis value" among them:
+    a measurement with nothing to compare to) and demstudy's own checks (engine cross-checks,
+    model dependence) apart, and the legend explains every verdict."""
+    from demstudy.studies.base import NO_THESIS_VALUE, NOT_REPRODUCED, PARTLY, VERDICTS
+    from demstudy.studies.report import render
+    from demstudy.studies.runner import StudyRun
+
+    checks = [Check("a", "s", "1", "1", REPRODUCED), Check("b", "s", "1", "3", NOT_REPRODUCED),
+              Check("c", "s", "-", "2", NO_THESIS_VALUE, "not in the digest"),
+              Check("d", "soft = hard", "-", "x", PARTLY, "noisy", own=True),
+              Check("e", "t_c", "-", "y", REPRODUCED, own=True)]
+    study = types.SimpleNamespace(title="T", summary="S", reference="R", name="toy")
+    text = render(StudyRun(study, tmp_path, analysis=Analysis(checks=checks)), False, "m")
+    heading = next(line for line in text.splitlines() if line.startswith("## Statements"))
+    assert heading == ("## Statements of the thesis checked (1 reproduced, 1 not reproduced, "
+                       "1 no thesis value; and 2 of demstudy's own checks: 1 reproduced, "
+                       "1 partly)")
+    legend = text.split(heading)[1].split("| # |")[0]
+    assert all(f"*{v}*" in legend for v in VERDICTS)
+    with pytest.raises(ValueError, match="allowed are reproduced, partly"):
+        Check("x", "s", "1", "1", "inconclusive")

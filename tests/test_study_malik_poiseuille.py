@@ -670,4 +670,21 @@ def test_sparse_wall_bins_at_phi_one_tenth():
     assert "keep 84 % of a uniform gas's φ" in mixed.reason
     (unsteady,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.017, steady=False)})
     assert unsteady.verdict == PARTLY and "not in steady state" in unsteady.reason
+    # an unsteady run weakens an agreement, not a mismatch; every unsteady run is named
+    (drifting,) = sparse_wall_checks({(0.1, 0.0, 0.8): run(0.0, 0.8, 0.075, steady=False),
+                                      (0.1, 0.99, 0.99): run(0.99, 0.99, 0.062, steady=False)})
+    assert drifting.verdict == NOT_REPRODUCED
+    assert "The runs β = 0, e = 0.8 (trend" in drifting.reason
+    assert "β = 0.99, e = 0.99 (trend" in drifting.reason and "are not in steady state" in \
+        drifting.reason
     assert sparse_wall_checks({})[0].verdict == NOT_RUN
+
+
+def test_the_vdf_bins_are_the_theses_per_volume_fraction() -> None:
+    """Digest §4.6: φ = 0.01 shows the shear-layer bins 4 and 21 and the centre 13; φ = 0.1
+    bins 1, 4, 13; φ = 0.5 bins 1, 3, 13 (1 at y = 0, 25 at y = W)."""
+    from demstudy.studies.malik2008.poiseuille_data import vdf_bins
+
+    assert vdf_bins(0.01) == (4, 13, 21)
+    assert vdf_bins(0.1) == (1, 4, 13)
+    assert vdf_bins(0.5) == (1, 3, 13)

@@ -303,7 +303,7 @@ def test_the_class_at_the_thesis_snapshot_time_under_either_reading(tmp_path: Pa
     thesis's 14000 c/p read as ours the window holds a plug; read as N_pair/N (28000 of
     ours) a slug: the N = 50094 box's statement (slug at 14000) is reproduced under the
     second reading and says which. Windows without frames are absent; a record keeps them."""
-    from demstudy.studies.base import NOT_REPRODUCED, REPRODUCED
+    from demstudy.studies.base import NO_THESIS_VALUE, NOT_REPRODUCED, REPRODUCED
     from demstudy.studies.malik2008.waves_boxes import BOXES
     from demstudy.studies.malik2008.waves_measure import measure
     from demstudy.studies.malik2008.waves_report import class_check
@@ -329,15 +329,20 @@ def test_the_class_at_the_thesis_snapshot_time_under_either_reading(tmp_path: Pa
     plug = lambda x, y: 0.15 + 0.85 * np.exp(-0.5 * ((y - Y_C) / 2.0) ** 2)  # noqa: E731
     never = class_check(box, measure(_synthetic_run(tmp_path / "plug.h5", plug, rate=250.0)))
     assert never.verdict == NOT_REPRODUCED and "under either reading" in never.reason
+    # a box whose class the thesis does not state: the measurement, and nothing compared
+    other = next(b for b in BOXES if b.fig == "5.13")
+    unstated = class_check(other, run)
+    assert unstated.verdict == NO_THESIS_VALUE and unstated.thesis == "not in the digest"
+    assert unstated.measured.startswith(run.modes.pattern)
 
 
 def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> None:
-    """A box run whose pair collisions the TC model made elastic in a large share (20 %):
-    its class verdict is at most "partly", with the share in the reason; 1 % changes
-    nothing."""
+    """A box run whose pair collisions the TC model made elastic in a large share (20 %): an
+    agreement becomes "partly", a mismatch stays "not reproduced", the share in the reason
+    either way; 1 % changes nothing."""
     import dataclasses
 
-    from demstudy.studies.base import PARTLY, REPRODUCED
+    from demstudy.studies.base import NOT_REPRODUCED, PARTLY, REPRODUCED
     from demstudy.studies.malik2008.waves_boxes import BOXES
     from demstudy.studies.malik2008.waves_measure import measure
     from demstudy.studies.malik2008.waves_report import class_check, tc_caveat
@@ -359,8 +364,9 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
 
     agreed = Check("TC model", "", "", "", REPRODUCED)
     lifted = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
-                       agreed, ["L42W30H30"])
-    assert lifted.verdict == REPRODUCED and "the share does not matter here" in lifted.reason
+                       agreed, ["L42W30H30"], "L70W50H50")
+    assert lifted.verdict == REPRODUCED and "the share does not change the structure" in \
+        lifted.reason and '(row "TC model, L70W50H50")' in lifted.reason
     other = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
                       None, ["L42W30H30"])
     assert other.verdict == PARTLY and "this box's share is not tested" in other.reason
@@ -370,8 +376,21 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     assert "TC twins of L42W30H30, L90W30H30 at t_c = 1e-06 kept their class" in two.reason
     alone = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
     assert alone.verdict == PARTLY and "twin" not in alone.reason
+    # another box's twin that changed the class is named beside the ones that agreed
+    both = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                     None, ["L42W30H30"], "L70W50H50", ["L150W50H10"])
+    assert "kept its class; that of L150W50H10 did not" in both.reason
+    only_bad = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                         None, [], "L70W50H50", ["L150W50H10"])
+    assert "the TC twin of L150W50H10 at t_c = 1e-06 changed the class" in only_bad.reason
+    # a mismatch stays a mismatch: the TC share is named as one possible cause
+    never = measure(_synthetic_run(tmp_path / "plug.h5", lambda x, y: 0.15 + 0.85 * np.exp(
+        -0.5 * ((y - Y_C) / 2.0) ** 2), rate=250.0))
+    missed = class_check(box, never)
+    assert missed.verdict == NOT_REPRODUCED
+    kept = tc_caveat(missed, dataclasses.replace(never, tc_fraction=0.2))
+    assert kept.verdict == NOT_REPRODUCED and "a weaker test either way" in kept.reason
     # the box's own twin measured and disagreeing: said so, by its row's name, capped
-    from demstudy.studies.base import NOT_REPRODUCED
 
     for verdict, said in ((NOT_REPRODUCED, "changes the class, so the structure depends"),
                           (PARTLY, "keeps the class, but its KE or share differ")):
@@ -426,6 +445,13 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     hotter = dataclasses.replace(twin, ke_halves=((m1, e1), (1.5 * m2, e2)))
     apart = tc_dependence(box, base, hotter)
     assert apart.verdict == PARTLY and "second half differs" in apart.reason
+    # 4 % hotter, but 4σ: within 2σ + 5 %, "reproduced", and the reason gives both numbers
+    err = 0.01 * m2 / np.sqrt(2)  # both halves' errors 1 % / √2: the difference is 4σ
+    close = tc_dependence(box, dataclasses.replace(base, ke_halves=((m1, e1), (m2, err))),
+                          dataclasses.replace(twin, ke_halves=((m1, e1), (1.04 * m2, err))))
+    assert same.own and close.own
+    assert close.verdict == REPRODUCED
+    assert "KE/N halves differ by at most 4.0 % (4.0σ) (within 2σ + 5 %)" in close.reason
     shared = tc_dependence(box, base, dataclasses.replace(twin, tc_fraction=0.08))
     assert shared.verdict == PARTLY and "≥ 5 %" in shared.reason
     unknown = tc_dependence(box, base, dataclasses.replace(twin, tc_fraction=float("nan")))
@@ -535,3 +561,42 @@ def test_the_sequence_of_classes_is_compared_with_the_thesis_order(tmp_path: Pat
     back = dataclasses.replace(run, windows={4000.0: s, 8000.0: p})
     assert sequence_text(back, thesis).endswith("another order")
     assert sequence_text(forward, ()) == ""
+
+
+def test_when_both_readings_show_the_class_the_earlier_snapshots_tell_them_apart() -> None:
+    """N = 50094's slug "forms at ≈ 14000 c/p": a run with S-waves until 10000 of our c/p and
+    a slug from 11000 shows the slug at 14000 under both readings of the thesis's clock, but
+    its first slug is at the thesis's 11000 read as 2 N_pair/N and at 8000 read as N_pair/N
+    (our 16000): the first reading fits better, and the text says so."""
+    import types
+
+    from demstudy.studies.malik2008.waves_report import first_seen_text, method_text
+
+    def at(c):
+        return types.SimpleNamespace(cls="s-wave" if c < 11000 else "slug")
+
+    run = types.SimpleNamespace(windows={c: at(c) for c in waves_measure_windows()})
+    text = first_seen_text(run, "slug", 14000.0)
+    assert "read as 2 N_pair/N the first slug is at the thesis's 11000 c/p" in text
+    assert "read as N_pair/N the first slug is at the thesis's 8000 c/p" in text
+    assert "the 2 N_pair/N reading fits better" in text
+    never = types.SimpleNamespace(windows={c: types.SimpleNamespace(cls="plug")
+                                           for c in waves_measure_windows()})
+    assert first_seen_text(never, "slug", 14000.0) == ""
+
+    # the method's numbers come from the runs: 7000 √(d/g) at 200-1000 c/p per √(d/g)
+    from demstudy.studies.malik2008.waves_boxes import BOXES
+
+    wide = [b for b in BOXES if b.width >= 30][:2]
+    measured = {b.name: types.SimpleNamespace(rate=r, tc_fraction=f)
+                for b, r, f in zip(wide, (200.0, 1000.0), (0.03, 0.12), strict=True)}
+    method = method_text(measured)
+    assert "1.4e+06-7.0e+06 c/p" in method and "×47-233 the cost" in method
+    assert "3.0-12.0 % of the W = 30/50 boxes' pair collisions" in method
+    assert "{" not in method
+
+
+def waves_measure_windows() -> list[float]:
+    from demstudy.studies.malik2008.waves_measure import SNAPSHOTS
+
+    return sorted({*SNAPSHOTS, *(2.0 * t for t in SNAPSHOTS)})

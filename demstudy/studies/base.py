@@ -19,8 +19,25 @@ from typing import Any
 REPRODUCED = "reproduced"
 NOT_REPRODUCED = "not reproduced"
 PARTLY = "partly"
+#: demstudy measured it, but the thesis (as far as the digest gives it) states no value or
+#: class to compare with: the row shows the measurement and what it could not test
+NO_THESIS_VALUE = "no thesis value"
 NOT_RUN = "not run"  # the case was not in this (quick) run of the study
-VERDICTS = (REPRODUCED, PARTLY, NOT_REPRODUCED, NOT_RUN)
+VERDICTS = (REPRODUCED, PARTLY, NOT_REPRODUCED, NO_THESIS_VALUE, NOT_RUN)
+
+#: what each verdict means, printed above every report's table
+VERDICT_LEGEND = (
+    "Verdicts: *reproduced* when demstudy's value agrees with the thesis's within the "
+    "statistical errors (2σ) plus the precision of the thesis's own statement (a value read "
+    "off a figure, a qualitative trend); *partly* when part of the statement agrees and part "
+    "does not, or when it agrees but the run is a weakened test (not steady, or an "
+    "approximation of demstudy's, such as the event-driven TC model, changed more of the "
+    "physics than its warning level); *not reproduced* when demstudy's value disagrees "
+    "beyond the errors (the reason gives the cause found, including demstudy's own "
+    "approximations and unsteady runs); *no thesis value* when the thesis states nothing "
+    "to compare with (demstudy's value is still shown); *not run* when the run is missing. "
+    "demstudy's own checks (not statements of the thesis: engine cross-checks, model "
+    "dependence) are tallied apart.")
 
 UNITS_NOTE = ("Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise "
               "a wall speed sets the time unit).")
@@ -78,6 +95,9 @@ class Check:
     measured: str
     verdict: str
     reason: str = ""
+    #: demstudy's own check (a cross-check of engines, a model's influence), not a statement
+    #: of the thesis: the report tallies it apart
+    own: bool = False
 
     def __post_init__(self) -> None:
         if self.verdict not in VERDICTS:

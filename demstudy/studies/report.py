@@ -11,7 +11,7 @@ import re
 from collections import Counter
 from typing import TYPE_CHECKING
 
-from .base import REPRODUCED, UNITS_NOTE, VERDICTS
+from .base import REPRODUCED, UNITS_NOTE, VERDICT_LEGEND, VERDICTS
 
 if TYPE_CHECKING:
     from .runner import StudyRun
@@ -30,11 +30,18 @@ def _reason(text: str) -> str:
     return _cell(_NOTE.sub(". ", str(text)))
 
 
+def _tally(checks: list) -> str:
+    count = Counter(c.verdict for c in checks)
+    return ", ".join(f"{count[v]} {v}" for v in VERDICTS if count[v])
+
+
 def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "") -> str:
     study, ana = result.study, result.analysis
     checks = ana.checks if ana else []
-    count = Counter(c.verdict for c in checks)
-    tally = ", ".join(f"{count[v]} {v}" for v in VERDICTS if count[v])
+    tally = _tally([c for c in checks if not c.own])
+    own = [c for c in checks if c.own]
+    if own:
+        tally += f"; and {len(own)} of demstudy's own checks: {_tally(own)}"
     quick_text = (" This is the **quick** version (short runs, fewer cases): its verdicts "
                   "are indicative only; the full study is `demstudy study "
                   f"{study.name}`." if quick else "")
@@ -63,9 +70,7 @@ def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "")
         "",
         f"## Statements of the thesis checked ({tally or 'none'})",
         "",
-        "Verdict: *reproduced* when demstudy's value agrees with the thesis's within the "
-        "statistical errors (2σ) plus the precision of the thesis's own statement (a value "
-        "read off a figure, a qualitative trend); otherwise the reason found is given.",
+        VERDICT_LEGEND,
         "",
         "| # | thesis | statement | thesis value | demstudy | verdict | reason |",
         "|---|---|---|---|---|---|---|",

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -21,12 +22,11 @@ from ...engines.edmd.tc_share import WARN_SHARE
 from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, pm, within
 from .poiseuille_cases import BETAS, RESTITUTIONS
 from .poiseuille_data import (
-    BINS,
-    BINS_DENSE,
     CENTRE_BIN,
     FlowData,
     carnahan_starling,
     contact_value,
+    vdf_bins,
     wall_gradient,
 )
 
@@ -58,24 +58,38 @@ def _tc_large(d: FlowData) -> bool:
     return d.run_info()["tc_fraction"] > WARN_SHARE
 
 
-def _steady_note(d: FlowData) -> str:
-    info = d.run_info()
-    return "" if info["steady"] else (f" The run ({_tag(d)}) is not in steady state (kinetic "
-                                      f"energy trend {info['trend']:.2g}): inconclusive, "
-                                      "\"partly\" either way.")
+def _unsteady(ds: FlowData | Sequence[FlowData]) -> list[FlowData]:
+    return [d for d in (ds if isinstance(ds, (list, tuple)) else [ds])
+            if not d.run_info()["steady"]]
 
 
-def _cap(verdict: str, d: FlowData) -> str:
-    """"partly" from a run that did not reach its plateau: its numbers can neither confirm
-    nor refute a statement about the steady flow."""
-    return PARTLY if verdict in (REPRODUCED, NOT_REPRODUCED) and not d.run_info()["steady"] \
-        else verdict
+def _steady_note(ds: FlowData | Sequence[FlowData]) -> str:
+    """Every run of ``ds`` (the runs a row uses) that did not reach its plateau, by name with
+    its kinetic-energy trend (the fitted change over the production over its mean; |trend| ≥
+    ``demstudy.analysis.steady.STEADY_LIMIT`` counts as unsteady): their values are of a
+    transient."""
+    bad = _unsteady(ds)
+    if not bad:
+        return ""
+    runs = ", ".join(f"{_tag(d)} (trend {d.run_info()['trend']:.2g})" for d in bad)
+    their = "their" if len(bad) > 1 else "its"
+    return (f" The run{'s' * (len(bad) > 1)} {runs} {'are' if len(bad) > 1 else 'is'} not "
+            f"in steady state: a transient's values ({their} fluctuations, taken about each "
+            "bin's run mean, include the mean flow's drift), a weaker test either way.")
+
+
+def _cap(verdict: str, ds: FlowData | Sequence[FlowData]) -> str:
+    """"partly" for an agreement found in runs that did not reach their plateau (a weaker
+    test); a disagreement stays "not reproduced", its reason naming the unsteady runs (one
+    possible cause) by ``_steady_note``."""
+    return PARTLY if verdict == REPRODUCED and _unsteady(ds) else verdict
 
 
 def tc_caveats(checks: list[Check], data: Runs) -> None:
     """Every statement about a φ whose runs the TC model changed (more than WARN_SHARE of
-    their pair collisions made elastic; the thesis has none) is capped at "partly", with the
-    share and t_c in its reason; the plateau statements, about the runs' length, are not."""
+    their pair collisions made elastic; the thesis has none) gets the share and t_c in its
+    reason, and an agreement is weakened to "partly" (a mismatch stays "not reproduced",
+    the TC model one possible cause); the plateau statements, about the runs' length, not."""
     for phi in sorted({p for p, _b, _e in data}):
         large = [d for (p, _b, _e), d in sorted(data.items()) if p == phi and _tc_large(d)]
         if not large:
@@ -84,14 +98,14 @@ def tc_caveats(checks: list[Check], data: Runs) -> None:
                            f"{d.run_info()['tc']:g} √(d/g))" for d in large)
         note = (f" The engine's TC model made a large share of the pair collisions elastic "
                 f"({shares}; the thesis has no TC model): the flow dissipates less than e "
-                "says, inconclusive.")
+                "says, a weaker test either way.")
         pattern = re.compile(rf"^φ = {re.escape(f'{phi:g}')}[:,]")
         for c in checks:
             if (c.verdict == NOT_RUN or not pattern.match(c.statement)
                     or "plateau of the kinetic energy" in c.statement):
                 continue
             c.reason = (c.reason + note).strip()
-            if c.verdict in (REPRODUCED, NOT_REPRODUCED):
+            if c.verdict == REPRODUCED:  # a weaker test; a mismatch stays one (TC: a cause)
                 c.verdict = PARTLY
 
 
@@ -100,7 +114,7 @@ def steady_checks(data: Runs) -> list[Check]:
     out = []
     for phi in (0.01, 0.1, 0.5):
         ds = [d for (p, _b, _e), d in sorted(data.items()) if p == phi]
-        ref, statement = "§1.8 [L583], [L652]", f"φ = {phi:g}: statistics taken in the " \
+        ref, statement = "digest §1.8 [L583], [L652]", f"φ = {phi:g}: statistics taken in the " \
                                                  "steady state (plateau of the kinetic energy)"
         if not ds:
             out.append(_not_run(ref, statement, "plateau reached", f"the φ = {phi:g} runs"))
@@ -127,7 +141,7 @@ def validation_checks(data: Runs) -> list[Check]:
              ("temps", "T and θ larger near the walls", _temperatures))
     out = []
     for _key, statement, fn in items:
-        ref = "§3.5 [L595]-[L613], Fig 2.11; Figs 3.3-3.7"
+        ref = "digest §3.5 [L595]-[L613], Fig 2.11; Figs 3.3-3.7"
         full = f"φ = 0.01, β = 0.99, e = 0.8: {statement}"
         if d is None:
             out.append(_not_run(ref, full, statement, "the φ = 0.01, β = 0.99, e = 0.8 run"))
@@ -244,10 +258,10 @@ def dissipation_checks(data: Runs) -> list[Check]:
         out.append(Check(ref, statement, "lowest T for β = 0",
                          f"mass-weighted mean T* (the system's temperature): "
                          f"{'; '.join(rows)}; holds at {held} of {tested} e",
-                         _cap(verdict, unsteady[0]) if unsteady else verdict,
+                         _cap(verdict, unsteady) if unsteady else verdict,
                          (("" if held == tested else "β = 0 is not the coldest beyond 2σ at "
                                                      "every e tested")
-                          + missing + (_steady_note(unsteady[0]) if unsteady else "")
+                          + missing + (_steady_note(unsteady) if unsteady else "")
                           ).strip().removeprefix("; ")))
     return out
 
@@ -416,11 +430,11 @@ def vdf_checks(data: Runs) -> list[Check]:
     deviation (TAILS_SHARE), or none found."""
     out = []
     for phi in (0.01, 0.1, 0.5):
-        bins = BINS_DENSE if phi == 0.5 else BINS
+        bins = vdf_bins(phi)
         ds = [d for (p, _b, e), d in sorted(data.items())
               if p == phi and e == (0.9 if phi == 0.5 else RESTITUTIONS[phi][0])]
-        ref = {0.01: "§4.6, Figs 3.12-3.17", 0.1: "§4.6, Figs 4.7-4.9",
-               0.5: "§4.6, Fig 4.18"}[phi]
+        ref = {0.01: "digest §4.6, Figs 3.12-3.17", 0.1: "digest §4.6, Figs 4.7-4.9",
+               0.5: "digest §4.6, Fig 4.18"}[phi]
         statement = (f"φ = {phi:g}, bins {', '.join(map(str, bins))}: VDFs with a Gaussian "
                      "core and non-Gaussian tails (visual in the thesis)")
         ds = [d for d in ds if "malik_P" in d.stat("vdf")]
@@ -459,8 +473,8 @@ def vdf_checks(data: Runs) -> list[Check]:
         reason = reason.strip()
         unsteady = [d for d in ds if not d.run_info()["steady"]]
         if unsteady:
-            verdict = _cap(verdict, unsteady[0])
-            reason += _steady_note(unsteady[0])
+            verdict = _cap(verdict, unsteady)
+            reason += _steady_note(unsteady)
         out.append(Check(ref, statement, "Gaussian core; tails deviate",
                          "; ".join(rows) + " (core deviation, kurtosis and skewness of "
                          "C_x/C_y/C_z)", verdict, reason.strip()))
@@ -507,8 +521,8 @@ def vdf_elastic_limit_checks(data: Runs) -> list[Check]:
         reason = "" if held == tested else (
             f"|κ - 3| does not fall beyond 2σ at {tested - held} of {tested} β")
         if unsteady:
-            verdict = _cap(verdict, unsteady[0])
-            reason += _steady_note(unsteady[0])
+            verdict = _cap(verdict, unsteady)
+            reason += _steady_note(unsteady)
         out.append(Check(ref, statement, "VDF → Gaussian as e → 1",
                          "mean |κ - 3| of C_x/C_y/C_z: " + "; ".join(rows)
                          + f"; holds at {held} of {tested} β", verdict, reason.strip()))
@@ -561,8 +575,8 @@ def contact_checks(data: Runs) -> list[Check]:
     out = []
     for phi in (0.01, 0.1, 0.5):
         ds = [d for (p, _b, _e), d in sorted(data.items()) if p == phi and d.gr]
-        ref = {0.01: "§4.7, Figs 3.18-3.20", 0.1: "§4.7, Fig 4.10",
-               0.5: "§4.7, Fig 4.17"}[phi]
+        ref = {0.01: "digest §4.7, Figs 3.18-3.20", 0.1: "digest §4.7, Fig 4.10",
+               0.5: "digest §4.7, Fig 4.17"}[phi]
         statement = (f"φ = {phi:g}, bin 13: g(r) contact value vs Enskog's χ "
                      "(Carnahan-Starling at the bin's φ)")
         if not ds:
@@ -607,10 +621,10 @@ def contact_checks(data: Runs) -> list[Check]:
         out.append(Check(ref, statement, "contact value ≈ χ_CS(φ) (no value in the thesis)",
                          "; ".join(rows) + f"; agree (2σ + 10 %) in {held} of {len(ds)}; "
                          f"pooled g(d+)/χ_CS = {pm(*pooled)}{spread}",
-                         _cap(verdict, unsteady[0]),
+                         _cap(verdict, unsteady),
                          ("" if verdict == REPRODUCED else
                           "the contact value departs from Enskog-CS: " + "; ".join(causes)
-                          + ".") + _steady_note(unsteady[0])))
+                          + ".") + _steady_note(unsteady)))
     return out
 
 
@@ -661,12 +675,17 @@ def gr_shell_checks(data: Runs) -> list[Check]:
         + ", ".join(f"{_tag(d)} (bin φ {p:.2f})" for d, p in lacking)
         + ": the outer shells of a fluid at φ ≲ 0.3 are weak (g within ≈ 10 % of 1), so "
         "longer runs or wider bins would be needed to resolve them")
+    # the digest's erratum 4: the thesis's r may be in radii (then its peaks are at d, the
+    # contact, and 1.5 d); this row reads diameters and says so
+    reason = (reason + ("; " if reason else "") + "r read in diameters; the digest (erratum "
+              "4) notes the thesis's r may be in radii, which would put its peaks at d (the "
+              "contact peak, present in every run) and 1.5 d")
     unsteady = [d for d in ds if not d.run_info()["steady"]]
     return [Check(ref, statement, "peaks at r/d = 2, 3",
                   "centre-bin g(r) peaks beyond 1.5 d (r/d): " + "; ".join(rows)
                   + f"; both shells in {len(both)} of {len(ds)} runs",
-                  _cap(verdict, unsteady[0]) if unsteady else verdict,
-                  (reason + (_steady_note(unsteady[0]) if unsteady else "")).strip())]
+                  _cap(verdict, unsteady) if unsteady else verdict,
+                  (reason + (_steady_note(unsteady) if unsteady else "")).strip())]
 
 
 #: a wall bin is "sparse" below this fraction of a uniform gas's φ there
@@ -706,8 +725,8 @@ def sparse_wall_checks(data: Runs) -> list[Check]:
                   "wall bins' φ (bins 1, 25) against a uniform gas's there (the centres stay "
                   "d/2 off the wall): " + "; ".join(rows)
                   + f"; below {100 * SPARSE:.0f} % in {len(sparse)} of {len(ds)}",
-                  _cap(verdict, unsteady[0]) if unsteady else verdict,
-                  (reason + (_steady_note(unsteady[0]) if unsteady else "")).strip())]
+                  _cap(verdict, unsteady) if unsteady else verdict,
+                  (reason + (_steady_note(unsteady) if unsteady else "")).strip())]
 
 
 def uniform_wall_share(n_bins: int, width: float) -> float:
@@ -753,8 +772,8 @@ def lambda_checks(data: Runs) -> list[Check]:
     for phi in (0.01, 0.1, 0.5):
         ds = [d for (p, _b, _e), d in sorted(data.items()) if p == phi
               and "lambda" in d.stat("lambda")]
-        ref = {0.01: "§4.8 [L819]-[L837], Fig 3.21", 0.1: "§4.8, Fig 4.11",
-               0.5: "§4.8, Fig 4.20"}[phi]
+        ref = {0.01: "digest §4.8 [L819]-[L837], Fig 3.21", 0.1: "digest §4.8, Fig 4.11",
+               0.5: "digest §4.8, Fig 4.20"}[phi]
         statement = (f"φ = {phi:g}: orientational correlation Λ(y) departs from the "
                      "molecular value 1/3 for rough spheres; its variation with β and e "
                      "(insets)")
@@ -800,7 +819,9 @@ def lambda_checks(data: Runs) -> list[Check]:
                               else "") + ": anisotropic translational and rotational "
                            "fluctuations move Λ off 1/3 even without a spin-translation "
                            "correlation, so a departure alone does not prove the roughness "
-                           "coupling.")
+                           "coupling; and the walls (e_w = β_w = 1, perfectly rough) couple "
+                           "spin and translation in every wall collision even here: a "
+                           "spin-free control would need β = β_w = -1.")
                         if smooth else "")
         if not rough:
             out.append(Check(ref, statement, thesis, measured, NOT_RUN,
@@ -813,14 +834,14 @@ def lambda_checks(data: Runs) -> list[Check]:
         within_floor = ", ".join(_tag(d) for d in rough if d in departs and d not in beyond)
         unsteady = [d for d in rough if not d.run_info()["steady"]]
         out.append(Check(ref, statement, thesis, measured,
-                         _cap(verdict, unsteady[0]) if unsteady else verdict,
+                         _cap(verdict, unsteady) if unsteady else verdict,
                          (("" if verdict == REPRODUCED else
                            (f"Λ̄ consistent with 1/3 (2σ) for {near}. " if near else "")
                            + (f"Off 1/3, but not by 2σ more than the steady smooth control "
                               f"({floor:.2g}), for {within_floor}: anisotropy, not roughness, "
                               "may explain it." if within_floor else ""))
                           + control_text
-                          + (_steady_note(unsteady[0]) if unsteady else "")).strip()))
+                          + (_steady_note(unsteady) if unsteady else "")).strip()))
     return out
 
 

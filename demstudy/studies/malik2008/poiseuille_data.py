@@ -23,9 +23,17 @@ from ...io.results import Results, read_results
 from ..records import derived
 from .poiseuille_cases import Flow
 
-#: Malik's bins (1-based) shown in the VDF and g(r) figures (φ = 0.5: 1, 3, 13)
+#: Malik's bins (1-based) shown in the g(r) figures and the φ = 0.1 VDFs (φ = 0.5: 1, 3, 13)
 BINS = (1, 4, 13)
 BINS_DENSE = (1, 3, 13)
+#: the φ = 0.01 VDFs' bins: the shear-layer bins 4 and 21 and the centre 13 (digest §4.6,
+#: [L746]); φ = 0.1 and 0.5 show theirs at BINS and BINS_DENSE
+BINS_DILUTE_VDF = (4, 13, 21)
+
+
+def vdf_bins(phi: float) -> tuple[int, ...]:
+    """The bins (1 at y = 0, 13 the centre, 25 at y = W) whose VDFs the thesis shows at φ."""
+    return BINS_DILUTE_VDF if phi == 0.01 else BINS_DENSE if phi == 0.5 else BINS
 CENTRE_BIN = 13
 
 

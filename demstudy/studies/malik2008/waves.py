@@ -28,8 +28,9 @@ QUICK_RUN = {"run": {"equilibration": 120.0, "production": 100.0, "sample_interv
 #: (digest §1.8, [L1149]-[L1159], [L1297]-[L1305]); 30000 is its last snapshot's time even
 #: if it counted N_pair/N (then our 28000). Frames every 200 N_pair/N (400 c/p): 70 in
 #: production, the plug → S-wave → slug sequence of N = 50094 in ≈ 25 of them. The shipped
-#: scenes' lengths (2000-3000 + 4000-5000 √(d/g) ≈ 2·10⁵ c/p) cost ×8 more, CPU-days at
-#: W = 50: a run of them says what becomes of the structures long after the thesis stopped.
+#: scenes' lengths (2000-3000 + 4000-5000 √(d/g)) are 10⁶-10⁷ c/p at these boxes' measured
+#: 170-1300 c/p per √(d/g), ×40-300 the cost (the report's method section computes it from
+#: the runs): a run of them would say what becomes of the structures long after the thesis.
 THESIS_SPAN = {"run": {"unit": "collisions", "equilibration": 1000.0, "production": 14000.0,
                        "sample_interval": 200.0}}
 
