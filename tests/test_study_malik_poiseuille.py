@@ -251,6 +251,13 @@ def test_a_vdf_spike_is_named_a_spike_not_a_skewed_core():
     assert "bin 13: core a spike" in check.measured
     assert "β = 0.9, e = 0.9 bin 13 the σ-scaled VDF is a spike" in check.reason
     assert "C_x is skewed" not in check.reason and check.verdict == NOT_REPRODUCED
+    # the same spike with light tails (κ 1.8, a uniform's): the bin's mean drifted over the
+    # run; the row says so instead of blaming a few fast particles
+    vdf["kurtosis"] = np.full((25, 6), 1.8)
+    drift = next(c for c in vdf_checks({(0.5, 0.9, 0.9): d}) if c.statement.startswith("φ = 0.5"))
+    assert "bin 13 (kurtosis down to 1.8)" in drift.reason
+    assert "drift of the bin's mean velocity" in drift.reason
+    assert "a few fast particles set σ" not in drift.reason
 
 
 # ------------------------------------------------------------------ soft cross-check
@@ -445,7 +452,8 @@ def test_elastic_walls_cannot_dissipate_so_the_wall_dissipation_claim_fails():
         wall = SimpleNamespace(restitution=restitution,
                                tangential=SimpleNamespace(model="beta", beta=1.0))
         ts = {"dissipated_energy": np.array([0.0, 99.0]), "gravity_work": np.array([0.0, 100.0]),
-              "wall_work_lower": np.zeros(2), "wall_work_upper": np.zeros(2)}
+              "wall_work_lower": np.zeros(2), "wall_work_upper": np.zeros(2),
+              "kinetic_energy": np.array([2.0, 2.7]), "rotational_energy": np.array([1.0, 1.2])}
         return SimpleNamespace(flow=Flow(0.01, 0.8, 0.0),
                                res=SimpleNamespace(scene=SimpleNamespace(walls=[wall, wall]),
                                                    timeseries=ts))
@@ -453,6 +461,9 @@ def test_elastic_walls_cannot_dissipate_so_the_wall_dissipation_claim_fails():
     (row,) = wall_dissipation_checks({(0.01, 0.0, 0.8): run(1.0)})
     assert row.verdict == NOT_REPRODUCED and "dissipate nothing" in row.reason
     assert "dissipation/gravity's work 0.9900" in row.measured
+    # the rest of gravity's work is the energy the flow gained: the budget closes
+    assert "energy gained since t = 0 0.0090" in row.measured
+    assert "the budget closes to 1e-03" in row.measured  # 100 - 99 - 0.9 = 0.1 of 100
     (lossy,) = wall_dissipation_checks({(0.01, 0.0, 0.8): run(0.9)})
     assert lossy.verdict == PARTLY and "not separated" in lossy.reason
     (none,) = wall_dissipation_checks({(0.01, 0.99, 0.8): run(1.0)})
@@ -606,6 +617,7 @@ def test_contact_value_row_names_clustering_or_freezing_as_the_cause():
                            (0.1, 0.0, 0.8): run(0.2, 0.0, chi, 1.0)})
     row = next(c for c in rows if c.statement.startswith("φ = 0.1"))
     assert row.verdict == PARTLY and "agree (2σ + 10 %) in 1 of 2" in row.measured
+    assert row.own  # the thesis shows g(r) but states no contact value: demstudy's check
     assert "g stays above 1 at 4-5 d in β = 0.99, e = 0.8 1.08" in row.reason
     assert "β = 0, e = 0.8" not in row.reason and "pooled g(d+)/χ_CS = " in row.measured
     dense = next(c for c in contact_checks({(0.5, 0.9, 0.9): run(0.6, 0.9, 13.0, 1.0)})

@@ -17,7 +17,8 @@ STUDY = Study(
     name="campbell1982",
     title="Campbell (1982): chute and Couette flows of rough discs, reproduced",
     reference="C. S. Campbell, *Shear Flows of Granular Materials*, PhD thesis, Caltech "
-              "(1982); digest ../shared/reference/campbell1982.md",
+              "(1982); digest shared/reference/campbell1982.md, beside this repository "
+              "(../shared from its root), not in it",
     summary="Campbell's 2D chutes (20°, 30°, 40° and a depth series) and Couette cells "
             "(rough and no-slip walls, with his servo and at fixed gap) rerun with hard discs "
             "in the event-driven engine (the reference) and soft discs in LAMMPS where the "

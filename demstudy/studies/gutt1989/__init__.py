@@ -25,7 +25,8 @@ STUDY = Study(
     title="Gutt (1989): continuum theory with spin, three-slip walls, Couette flow and lattice "
           "grain dynamics",
     reference="G. M. Gutt, *The Physics of Granular Systems*, PhD thesis (1989); digest "
-              "../shared/reference/gutt1989.md",
+              "shared/reference/gutt1989.md, beside this repository (../shared from its "
+              "root), not in it",
     summary="Gutt's Ch. 1 model problems (uniform cooling, vibrating plates, Couette with "
             "spin) and Ch. 2 three-slip Couette solution solved with demstudy.theory and "
             "checked against the trends the thesis states; the Ch. 2 Couette solution "

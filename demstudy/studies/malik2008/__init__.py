@@ -16,7 +16,8 @@ STUDY = Study(
     name="malik2008",
     title="Malik (2008): 3D granular Poiseuille flow and density waves, reproduced",
     reference="S. Malik, *Density Waves and Fluctuations in 3D Granular Poiseuille Flow*, "
-              "thesis, JNCASR Bangalore (2008); digest ../shared/reference/malik2008.md",
+              "thesis, JNCASR Bangalore (2008); digest shared/reference/malik2008.md, beside "
+              "this repository (../shared from its root), not in it",
     summary="Malik's gravity-driven Poiseuille flows of rough inelastic spheres (φ ≈ 0.01, "
             "0.1, 0.5 over β and e) and the density waves at φ ≈ 0.15 in his boxes, rerun "
             "with hard spheres in the event-driven engine (the reference) and soft spheres "

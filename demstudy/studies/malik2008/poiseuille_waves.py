@@ -56,4 +56,6 @@ def s_wave_text(r: dict[str, tuple[float, float]]) -> str:
     text = ", ".join(f"R{k} = {m:.3g} ± {e:.2g}" for k, (m, e) in
                      (("(1,±1) S-wave", r["11"]), ("(1,0) slug", r["10"]),
                       ("(0,1) plug", r["01"])))
-    return text + " (shot noise of independent particles = 1)"
+    return text + (" (R(k_x, k_y) = |FFT of the xy cell counts at that mode|² / N, the "
+                   "(1, 1) and (1, -1) modes averaged; shot noise of independent particles "
+                   "= 1)")

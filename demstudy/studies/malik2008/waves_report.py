@@ -497,8 +497,8 @@ def peak_check(measured: Mapping[str, RunWaves]) -> Check:
 
 def _run_table(measured: Mapping[str, RunWaves]) -> str:
     head = ("| case | N | c/p analysed | c/p per √(d/g) | class | dominant xy | stationary | "
-            "max drift | dissipation/input | peak ν (2 d / 5 d cells) | close-packed | "
-            "TC elastic fraction | wall s |\n"
+            "max drift | dissipation/input | peak φ (2 d / 5 d cells) | close-packed | "
+            "TC elastic fraction | engine wall time (s) |\n"
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     rows = []
     for name, run in measured.items():
