@@ -160,5 +160,7 @@ def _raise_failures(failures: list[str]) -> None:
     if failures:
         from ..errors import EngineError
 
-        raise EngineError("cost ladder: runs failed (finished ones are kept; rerun to "
-                          "resume):\n  " + "\n  ".join(failures))
+        # shared by the cost ladder and the studies: the message names neither
+        raise EngineError("runs failed (finished ones are kept; the same command again "
+                          "resumes the others from their checkpoints):\n  "
+                          + "\n  ".join(failures))
