@@ -119,3 +119,35 @@ def test_missing_runs_give_not_run_checks(accelerating, tmp_path):
     assert run and all(c.ref.startswith("C3") for c in run)
     assert all(f.path.is_file() for f in some.figures)
     assert len(all_checks({}, False)) == len(empty.checks)
+
+
+def test_the_slip_is_compared_with_the_fit_at_the_first_strips_height(accelerating):
+    """The measured slip is the first strip's u/u_max (disc centres at y ≈ d/2); Campbell's
+    fit F(y/H) gives 0.20 at the base plane and 0.32 at y = d/2 in a 12.3 d bed: the row
+    compares at the strip's height and shows both."""
+    from demstudy.studies.campbell1982.chute_checks import c1_slip, fit_at_first_strip
+
+    run = dataclasses.replace(summarise("chute-40-flat", accelerating), depth=12.28,
+                              slip=0.32, slip_err=0.01)
+    assert fit_at_first_strip(run) == pytest.approx(0.3233, abs=1e-4)
+    assert fit_at_first_strip(dataclasses.replace(run, depth=1e9)) == pytest.approx(0.2018,
+                                                                                   abs=1e-4)
+    row = c1_slip({"chute-30-bumpy": run})
+    assert row.verdict == REPRODUCED and "F(0) = 0.20 at the base plane" in row.measured
+    low = c1_slip({"chute-30-bumpy": dataclasses.replace(run, slip=0.20)})
+    assert low.verdict == NOT_REPRODUCED  # 0.20 at y = d/2 is below the fit there
+
+
+def test_own_checks_are_tallied_apart_and_the_soft_rows_name_what_failed(accelerating):
+    """The stress-route, TC and soft-contact rows are demstudy's own checks; a soft run that
+    is not steady says so by name (the same rule for LAMMPS and LIGGGHTS)."""
+    from demstudy.studies.campbell1982.chute_checks import soft_cross_check, tc_independence
+
+    run = dataclasses.replace(summarise("chute-40-flat", accelerating), angle=30.0,
+                              trend=0.05, ratio=math.tan(math.radians(30)), ratio_err=0.003)
+    drifting = dataclasses.replace(run, trend=0.6, ratio=0.50)
+    runs = {"chute-30-bumpy": run, "chute-30-bumpy-liggghts": drifting}
+    row = soft_cross_check(runs, "liggghts")
+    assert row.own and row.verdict != REPRODUCED
+    assert "the soft run is not steady (trend +0.60" in row.reason
+    assert tc_independence({}).own and soft_cross_check({}, "lammps").own

@@ -278,6 +278,11 @@ def _distributions(out: RunSummary, res: Any, walls: tuple[float, float]) -> Non
             if key in out.arrays:
                 out.values[f"approach_share_sj_{length}"] = _approach_share(
                     out.arrays[key], np.zeros_like(theta), theta)
+        # the listing's reading (QRH = S·C/(2R), S from √(⟨u'²⟩+⟨v'²⟩)), in its own angle
+        # convention: θ_code = 90° − θ maps the approach quadrant 90°-180° onto itself
+        if "sj_listing_C" in out.arrays:
+            out.values["approach_share_sj_listing"] = _approach_share(
+                out.arrays["sj_listing_C"], np.zeros_like(theta), theta)
         out.values["collisions"] = (float(np.sum(pairs)), 0.0)
     st = res.groups.get("statistics/structure")
     if st is not None and "normal" in st:
