@@ -384,5 +384,9 @@ def test_the_report_tallies_the_thesis_statements_apart_from_demstudys_own_check
                        "1 partly)")
     legend = text.split(heading)[1].split("| # |")[0]
     assert all(f"*{v}*" in legend for v in VERDICTS)
+    assert "| 4 (own) | d |" in text and "| 1 | a |" in text
+    alone = render(StudyRun(study, tmp_path, analysis=Analysis(checks=checks[3:])), False, "m")
+    assert "## Statements of the thesis checked (2 of demstudy's own checks: 1 reproduced, " \
+        "1 partly)" in alone
     with pytest.raises(ValueError, match="allowed are reproduced, partly"):
         Check("x", "s", "1", "1", "inconclusive")

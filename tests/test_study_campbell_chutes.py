@@ -149,5 +149,14 @@ def test_own_checks_are_tallied_apart_and_the_soft_rows_name_what_failed(acceler
     runs = {"chute-30-bumpy": run, "chute-30-bumpy-liggghts": drifting}
     row = soft_cross_check(runs, "liggghts")
     assert row.own and row.verdict != REPRODUCED
-    assert "the soft run is not steady (trend +0.60" in row.reason
+    assert "its base is not balanced (force ratio 0.500" in row.reason
+    # a balanced base but a drifting energy: named too, and no agreement
+    rising = dataclasses.replace(run, trend=0.9, trend_err=0.01)
+    row = soft_cross_check({"chute-30-bumpy": run, "chute-30-bumpy-lammps": rising}, "lammps")
+    assert row.verdict != REPRODUCED and "kinetic energy still drifts (trend 0.90" in row.reason
+    assert "base is not balanced" not in row.reason
     assert tc_independence({}).own and soft_cross_check({}, "lammps").own
+    from demstudy.studies.campbell1982.chute_checks import c1_stresses
+    from demstudy.studies.campbell1982.couette_checks import lammps_cross_check
+
+    assert c1_stresses({}).own and lammps_cross_check({}, "a", "b").own

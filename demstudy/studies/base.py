@@ -37,7 +37,8 @@ VERDICT_LEGEND = (
     "approximations and unsteady runs); *no thesis value* when the thesis states nothing "
     "to compare with (demstudy's value is still shown); *not run* when the run is missing. "
     "demstudy's own checks (not statements of the thesis: engine cross-checks, model "
-    "dependence) are tallied apart.")
+    "dependence, consistency with theory where the thesis gives no value) are marked "
+    "\"(own)\" and tallied apart.")
 
 UNITS_NOTE = ("Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise "
               "a wall speed sets the time unit).")

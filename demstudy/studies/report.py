@@ -41,7 +41,8 @@ def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "")
     tally = _tally([c for c in checks if not c.own])
     own = [c for c in checks if c.own]
     if own:
-        tally += f"; and {len(own)} of demstudy's own checks: {_tally(own)}"
+        tally = "; and ".join(t for t in (tally, f"{len(own)} of demstudy's own checks: "
+                                                 f"{_tally(own)}") if t)
     quick_text = (" This is the **quick** version (short runs, fewer cases): its verdicts "
                   "are indicative only; the full study is `demstudy study "
                   f"{study.name}`." if quick else "")
@@ -77,7 +78,8 @@ def render(result: StudyRun, quick: bool, machine: str, figure_prefix: str = "")
     ]
     for i, c in enumerate(checks, 1):
         verdict = f"**{c.verdict}**" if c.verdict != REPRODUCED else c.verdict
-        lines.append(f"| {i} | {_cell(c.ref)} | {_cell(c.statement)} | {_cell(c.thesis)} | "
+        number = f"{i} (own)" if c.own else str(i)  # demstudy's own check, tallied apart
+        lines.append(f"| {number} | {_cell(c.ref)} | {_cell(c.statement)} | {_cell(c.thesis)} | "
                      f"{_cell(c.measured)} | {verdict} | {_reason(c.reason)} |")
     lines.append("")
     if ana and ana.figures:

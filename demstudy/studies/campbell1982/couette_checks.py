@@ -20,17 +20,19 @@ from .couette_measure import RunSummary
 Runs = dict[str, RunSummary]
 
 
-def not_run(ref: str, statement: str, thesis: str, needs: Sequence[str]) -> Check:
+def not_run(ref: str, statement: str, thesis: str, needs: Sequence[str],
+            own: bool = False) -> Check:
     return Check(ref, statement, thesis, "n/a", NOT_RUN,
-                 f"needs the run(s) {', '.join(needs)}, not in this run of the study")
+                 f"needs the run(s) {', '.join(needs)}, not in this run of the study", own=own)
 
 
 def guarded(ref: str, statement: str, thesis: str, runs: Runs, needs: Sequence[str],
-            body: Callable[[list[RunSummary]], Check]) -> Check:
-    """``body`` on the needed runs, or a NOT_RUN check naming the missing ones."""
+            body: Callable[[list[RunSummary]], Check], own: bool = False) -> Check:
+    """``body`` on the needed runs, or a NOT_RUN check naming the missing ones (``own``:
+    demstudy's own check, as ``body``'s is)."""
     missing = [n for n in needs if n not in runs]
     if missing:
-        return not_run(ref, statement, thesis, missing)
+        return not_run(ref, statement, thesis, missing, own)
     return body([runs[n] for n in needs])
 
 
@@ -367,4 +369,4 @@ def lammps_cross_check(runs: Runs, edmd: str, lammps: str) -> Check:
                      f"against {ratios[1]:.2f} in LAMMPS (Campbell: 0.40); edmd's T depends "
                      "on t_c here (13 % of collisions elastic; causes section); soft contacts "
                      "(k_n, Coulomb-capped tangential spring) and the servo's time interval")
-    return guarded(ref, statement, "", runs, [edmd, lammps], body)
+    return guarded(ref, statement, "", runs, [edmd, lammps], body, own=True)

@@ -34,6 +34,8 @@ BINS_DILUTE_VDF = (4, 13, 21)
 def vdf_bins(phi: float) -> tuple[int, ...]:
     """The bins (1 at y = 0, 13 the centre, 25 at y = W) whose VDFs the thesis shows at φ."""
     return BINS_DILUTE_VDF if phi == 0.01 else BINS_DENSE if phi == 0.5 else BINS
+
+
 CENTRE_BIN = 13
 
 

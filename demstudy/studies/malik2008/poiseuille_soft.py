@@ -99,7 +99,9 @@ def soft_check(hard: FlowData | None, soft: FlowData | None, flow: Flow = SOFT) 
                        f"{100 * TOLERANCE:.0f} %: a difference of that size would not show")
     if unknown:
         reasons.append(f"not compared: {', '.join(unknown)}")
-    small = [f for f in fields if f.name not in unknown and f not in apart and f.resolved]
+    apart_names = {f.name for f in apart}
+    small = [f for f in fields if f.name not in unknown and f.name not in apart_names
+             and f.resolved]
     if small:  # real, but within the tolerance: named, so the reader sees where soft differs
         reasons.append("resolved but within the tolerance: " + ", ".join(
             f"{f.name} {100 * f.rel_l2_debiased:.1f} % (max |z| {f.max_z:.1f})"
