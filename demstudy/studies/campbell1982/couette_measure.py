@@ -273,16 +273,13 @@ def _distributions(out: RunSummary, res: Any, walls: tuple[float, float]) -> Non
                     out.arrays[key] = w @ np.nan_to_num(np.asarray(ang[key], float)) / w.sum()
         out.values["approach_share"] = _approach_share(out.arrays["p_text"],
                                                        out.arrays["p_text_err"], theta)
-        for length in ("R", "C"):
-            key = f"sj_text_{length}"
+        # Savage-Jeffrey's approach share with S, with the text's S' = S·C/R and with the
+        # listing's QRH = S·C/(2R) (S from √(⟨u'²⟩+⟨v'²⟩), its own angle convention:
+        # θ_code = 90° − θ maps the approach quadrant 90°-180° onto itself)
+        for key, name in (("sj_text_R", "R"), ("sj_text_C", "C"), ("sj_listing_C", "listing")):
             if key in out.arrays:
-                out.values[f"approach_share_sj_{length}"] = _approach_share(
+                out.values[f"approach_share_sj_{name}"] = _approach_share(
                     out.arrays[key], np.zeros_like(theta), theta)
-        # the listing's reading (QRH = S·C/(2R), S from √(⟨u'²⟩+⟨v'²⟩)), in its own angle
-        # convention: θ_code = 90° − θ maps the approach quadrant 90°-180° onto itself
-        if "sj_listing_C" in out.arrays:
-            out.values["approach_share_sj_listing"] = _approach_share(
-                out.arrays["sj_listing_C"], np.zeros_like(theta), theta)
         out.values["collisions"] = (float(np.sum(pairs)), 0.0)
     st = res.groups.get("statistics/structure")
     if st is not None and "normal" in st:

@@ -253,16 +253,15 @@ def dissipation_checks(data: Runs) -> list[Check]:
         verdict = REPRODUCED if held == tested else PARTLY if held else NOT_REPRODUCED
         if untested and verdict == REPRODUCED:  # the e not run could still break it
             verdict = PARTLY
-        unsteady = [d for d in used if not d.run_info()["steady"]]
         missing = (f"; not tested at e = {', '.join(untested)} (β = 0 and another β not both "
                    "run)" if untested else "")
         out.append(Check(ref, statement, "lowest T for β = 0",
                          f"mass-weighted mean T* (the system's temperature): "
                          f"{'; '.join(rows)}; holds at {held} of {tested} e",
-                         _cap(verdict, unsteady) if unsteady else verdict,
+                         _cap(verdict, used),
                          (("" if held == tested else "β = 0 is not the coldest beyond 2σ at "
                                                      "every e tested")
-                          + missing + (_steady_note(unsteady) if unsteady else "")
+                          + missing + _steady_note(used)
                           ).strip().removeprefix("; ")))
     return out
 
@@ -491,10 +490,8 @@ def vdf_checks(data: Runs) -> list[Check]:
                "as a block), not by thermal motion. " if drifts else "")
             + ("Kurtosis consistent with 3 (Gaussian tails). " if not tails else ""))
         reason = reason.strip()
-        unsteady = [d for d in ds if not d.run_info()["steady"]]
-        if unsteady:
-            verdict = _cap(verdict, unsteady)
-            reason += _steady_note(unsteady)
+        verdict = _cap(verdict, ds)
+        reason += _steady_note(ds)
         out.append(Check(ref, statement, "Gaussian core; tails deviate",
                          "; ".join(rows) + " (per C_x/C_y/C_z: core dev = the largest "
                          "relative departure of P(C/σ) from exp(-x²/2) over |x| ≤ 1 beyond "
@@ -539,12 +536,10 @@ def vdf_elastic_limit_checks(data: Runs) -> list[Check]:
                                 f"two e at one β (φ = {phi:g})"))
             continue
         verdict = REPRODUCED if held == tested else PARTLY if held else NOT_REPRODUCED
-        unsteady = [d for d in used if not d.run_info()["steady"]]
         reason = "" if held == tested else (
             f"|κ - 3| does not fall beyond 2σ at {tested - held} of {tested} β")
-        if unsteady:
-            verdict = _cap(verdict, unsteady)
-            reason += _steady_note(unsteady)
+        verdict = _cap(verdict, used)
+        reason += _steady_note(used)
         out.append(Check(ref, statement, "VDF → Gaussian as e → 1",
                          "mean |κ - 3| of C_x/C_y/C_z: " + "; ".join(rows)
                          + f"; holds at {held} of {tested} β", verdict, reason.strip()))
@@ -622,7 +617,6 @@ def contact_checks(data: Runs) -> list[Check]:
             out.append(_not_run(ref, statement, "χ(φ) (CS)", f"φ = {phi:g} runs", own=True))
             continue
         rows, held, ratios, far_high, frozen = [], 0, [], [], []
-        unsteady = [d for d in ds if not d.run_info()["steady"]] or [ds[0]]
         for d in ds:
             g, eg = contact_value(d.gr, CENTRE_BIN - 1)
             f = d.centre_value("phi")[0]
@@ -660,10 +654,10 @@ def contact_checks(data: Runs) -> list[Check]:
         out.append(Check(ref, statement, "contact value ≈ χ_CS(φ) (no value in the thesis)",
                          "; ".join(rows) + f"; agree (2σ + 10 %) in {held} of {len(ds)}; "
                          f"pooled g(d+)/χ_CS = {pm(*pooled)}{spread}",
-                         _cap(verdict, unsteady),
+                         _cap(verdict, ds),
                          ("" if verdict == REPRODUCED else
                           "the contact value departs from Enskog-CS: " + "; ".join(causes)
-                          + ".") + _steady_note(unsteady),
+                          + ".") + _steady_note(ds),
                          own=True))  # the thesis shows g(r) but states no contact value
     return out
 
@@ -720,12 +714,11 @@ def gr_shell_checks(data: Runs) -> list[Check]:
     reason = (reason + ("; " if reason else "") + "r read in diameters; the digest (erratum "
               "4) notes the thesis's r may be in radii, which would put its peaks at d (the "
               "contact peak, present in every run) and 1.5 d")
-    unsteady = [d for d in ds if not d.run_info()["steady"]]
     return [Check(ref, statement, "peaks at r/d = 2, 3",
                   "centre-bin g(r) peaks beyond 1.5 d (r/d): " + "; ".join(rows)
                   + f"; both shells in {len(both)} of {len(ds)} runs",
-                  _cap(verdict, unsteady) if unsteady else verdict,
-                  (reason + (_steady_note(unsteady) if unsteady else "")).strip())]
+                  _cap(verdict, ds),
+                  (reason + _steady_note(ds)).strip())]
 
 
 #: a wall bin is "sparse" below this fraction of a uniform gas's φ there
@@ -756,7 +749,6 @@ def sparse_wall_checks(data: Runs) -> list[Check]:
     high = max((ratios[id(d)] for d in dense), default=0.0)
     share = f"{100 * low:.0f}" + (f"-{100 * high:.0f}" if round(100 * high) > round(100 * low)
                                    else "")
-    unsteady = [d for d in ds if not d.run_info()["steady"]]
     reason = ("" if not dense else
               "not sparse in " + ", ".join(_tag(d) for d in dense) + ": there the wall bins "
               f"keep {share} % of a uniform gas's φ, a weaker contrast between the walls and "
@@ -765,8 +757,8 @@ def sparse_wall_checks(data: Runs) -> list[Check]:
                   "wall bins' φ (bins 1, 25) against a uniform gas's there (the centres stay "
                   "d/2 off the wall): " + "; ".join(rows)
                   + f"; below {100 * SPARSE:.0f} % in {len(sparse)} of {len(ds)}",
-                  _cap(verdict, unsteady) if unsteady else verdict,
-                  (reason + (_steady_note(unsteady) if unsteady else "")).strip())]
+                  _cap(verdict, ds),
+                  (reason + _steady_note(ds)).strip())]
 
 
 def uniform_wall_share(n_bins: int, width: float) -> float:
@@ -872,16 +864,15 @@ def lambda_checks(data: Runs) -> list[Check]:
             if beyond else NOT_REPRODUCED
         near = ", ".join(_tag(d) for d in rough if d not in departs)
         within_floor = ", ".join(_tag(d) for d in rough if d in departs and d not in beyond)
-        unsteady = [d for d in rough if not d.run_info()["steady"]]
         out.append(Check(ref, statement, thesis, measured,
-                         _cap(verdict, unsteady) if unsteady else verdict,
+                         _cap(verdict, rough),
                          (("" if verdict == REPRODUCED else
                            (f"Λ̄ consistent with 1/3 (2σ) for {near}. " if near else "")
                            + (f"Off 1/3, but not by 2σ more than the steady smooth control "
                               f"({floor:.2g}), for {within_floor}: anisotropy, not roughness, "
                               "may explain it." if within_floor else ""))
                           + control_text
-                          + (_steady_note(unsteady) if unsteady else "")).strip()))
+                          + _steady_note(rough)).strip()))
     return out
 
 
