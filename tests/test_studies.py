@@ -137,6 +137,44 @@ def test_a_lower_bound_makes_the_study_forecast_one(toy, tmp_path, monkeypatch):
     assert LOWER_BOUND_NOTE in lines
 
 
+def test_a_finished_run_of_the_same_kind_turns_a_lower_bound_into_an_estimate(
+        toy, tmp_path, monkeypatch):
+    """A made run of the study whose own lower bound fell short ×3 scales the lower bound
+    of a run of the same kind (engine, walls, drive, φ, run unit) to an estimate, naming
+    the run; a made run of another kind (a chute: gravity) leaves the lower bound."""
+    import h5py
+
+    import demstudy.api as api
+    from demstudy.scene import load_scene, scene_to_toml
+    from demstudy.studies.runner import LOWER_BOUND_NOTE, tasks_of
+
+    def plan(scene, **kw):
+        return {"forecast_seconds": 30.0, "forecast_kind": "lower bound"}
+
+    monkeypatch.setattr(api, "run", plan)
+    made = tasks_of(TOY, False, tmp_path)[0]  # cell-a
+    made.path.parent.mkdir(parents=True)
+
+    def finished(scene_toml: str) -> list[str]:
+        with h5py.File(made.path, "w") as f:
+            f.attrs.update({"engine": "edmd", "forecast_kind": "lower bound",
+                            "forecast_seconds": 30.0, "wall_seconds": 90.0,
+                            "scene_toml": scene_toml})
+        lines: list[str] = []
+        run_study("toy", out=tmp_path, dry_run=True, workers=1, echo=lines.append,
+                  only=["cell-b"])
+        return lines
+
+    lines = finished(made.scene_toml)
+    assert lines[1].startswith("forecast: 90 s on 1 worker(s)"), lines
+    assert any(s.endswith("cell-b (edmd): about 90 s (its lower bound 30 s × 3.00: what "
+                          "cell-a, N = 40, took against its own lower bound)") for s in lines)
+    assert LOWER_BOUND_NOTE not in lines
+    lines = finished(scene_to_toml(load_scene("campbell1982/chute-20")))
+    assert lines[1].startswith("forecast: probably more than 30 s"), lines
+    assert LOWER_BOUND_NOTE in lines
+
+
 def test_a_failed_case_does_not_stop_the_others_nor_the_analysis(toy, tmp_path, monkeypatch):
     bad = Study("toy", TOY.title, TOY.reference, TOY.summary,
                 lambda q: [Case("cell-a", "campbell1982/couette-rough", sections=SHORT),
@@ -148,6 +186,18 @@ def test_a_failed_case_does_not_stop_the_others_nor_the_analysis(toy, tmp_path, 
     assert res.made == ["cell-a"] and res.failed == ["cell-b"]
     assert [c.verdict for c in res.analysis.checks] == [REPRODUCED, NOT_RUN]
     assert "1 failed (cell-b)" in res.report.read_text()
+
+
+def test_a_stopped_run_is_listed_without_the_single_runs_resume_advice():
+    """A sweep's command has no --resume (it resumes by itself): the failures list keeps what
+    stopped the run and drops the per-run advice, other errors stay whole."""
+    from demstudy.accuracy.execute import _failure
+    from demstudy.errors import EngineError, RunStopped
+
+    stopped = RunStopped("stopped (Ctrl-C) at t = 12.5 after a checkpoint: run the same "
+                         "command again with --resume to continue")
+    assert _failure("big", stopped) == "big: stopped (Ctrl-C) at t = 12.5 after a checkpoint"
+    assert _failure("bad", EngineError("x: y")) == "bad: x: y"
 
 
 def test_publish_copies_the_figures_and_rewrites_their_links(toy, tmp_path):

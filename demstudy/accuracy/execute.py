@@ -116,7 +116,7 @@ def execute(tasks: list[Task], workers: int = 1, dask: Any = None,
             try:
                 finished(run_task(task))
             except Exception as exc:  # noqa: BLE001 - reported together below
-                failures.append(f"{task.spec.name}: {exc}")
+                failures.append(_failure(task.spec.name, exc))
     else:
         context = multiprocessing.get_context(_start_method())
         with ProcessPoolExecutor(max_workers=workers, mp_context=context,
@@ -126,7 +126,7 @@ def execute(tasks: list[Task], workers: int = 1, dask: Any = None,
                 try:
                     finished(future.result())
                 except Exception as exc:  # noqa: BLE001
-                    failures.append(f"{futures[future].spec.name}: {exc}")
+                    failures.append(_failure(futures[future].spec.name, exc))
     _raise_failures(failures)
     return records
 
@@ -144,7 +144,7 @@ def _on_dask(tasks: list[Task], dask: Any, on_done) -> list[dict]:
             try:
                 record = future.result()
             except Exception as exc:  # noqa: BLE001
-                failures.append(f"{futures[future].spec.name}: {exc}")
+                failures.append(_failure(futures[future].spec.name, exc))
                 continue
             records.append(record)
             if on_done is not None:
@@ -154,6 +154,16 @@ def _on_dask(tasks: list[Task], dask: Any, on_done) -> list[dict]:
             client.close()
     _raise_failures(failures)
     return records
+
+
+def _failure(name: str, exc: BaseException) -> str:
+    """One line of the failures list. A run stopped with a checkpoint says so without the
+    single run's "--resume" advice: a sweep's command takes no --resume, it resumes itself."""
+    from ..errors import RunStopped
+
+    if isinstance(exc, RunStopped):
+        return f"{name}: {str(exc).split(': run the same command')[0]}"
+    return f"{name}: {exc}"
 
 
 def _raise_failures(failures: list[str]) -> None:
