@@ -105,6 +105,15 @@ class Check:
             raise ValueError(f"verdict {self.verdict!r}: allowed are {', '.join(VERDICTS)}")
 
 
+def not_run(ref: str, statement: str, thesis: str, needs: str | Sequence[str],
+            own: bool = False) -> Check:
+    """The row of a statement whose run(s) are not in this run of the study (a quick study,
+    ``--only``, a failed run): ``needs`` names them, as case names or in words."""
+    what = needs if isinstance(needs, str) else "the run(s) " + ", ".join(needs)
+    return Check(ref, statement, thesis, "n/a", NOT_RUN,
+                 f"needs {what}, not in this run of the study", own=own)
+
+
 @dataclass
 class Figure:
     """A figure the study wrote: its file and a one-line caption."""

@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, pm, within
+from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, not_run, pm, within
 from .chute_measure import ChuteRun, basal_layer, centre_plug
 
 NU_SQUARE = math.pi / 4
@@ -25,12 +25,6 @@ BUMPY_NOTE = ("bumpy base (random bumps of diameter d, spacing 1.2 d): Campbell'
               "sticking base has no steady dense flow above ≈ 25° (row 'flat base')")
 
 
-def missing(ref: str, statement: str, thesis: str, names: Sequence[str],
-            own: bool = False) -> Check:
-    return Check(ref, statement, thesis, "—", NOT_RUN,
-                 f"run(s) {', '.join(names)} not in this run of the study", own=own)
-
-
 def needs(*names: str, own: bool = False):
     """Decorator: the check gets the ChuteRuns named; NOT_RUN when one is missing (``own``:
     demstudy's own check, as the check's own row is)."""
@@ -38,7 +32,7 @@ def needs(*names: str, own: bool = False):
         def check(runs: Mapping[str, ChuteRun]) -> Check:
             if any(n not in runs for n in names):
                 ref, statement, thesis = fn.__doc__.split(" | ")[:3]
-                return missing(ref.strip(), statement.strip(), thesis.strip(),
+                return not_run(ref.strip(), statement.strip(), thesis.strip(),
                                [n for n in names if n not in runs], own)
             return fn(*(runs[n] for n in names))
         check.__doc__ = fn.__doc__
@@ -92,7 +86,7 @@ def c1_flat(runs: Mapping[str, ChuteRun]) -> Check:
     thesis = "converged"
     names = [f"chute-{a}-flat" for a in (24, 26, 30)]
     if "chute-30-flat" not in runs:
-        return missing(ref, statement, thesis, ["chute-30-flat"])
+        return not_run(ref, statement, thesis, ["chute-30-flat"])
     flat = [runs[n] for n in names if n in runs]
     text = "; ".join(f"{r.angle:g}°: dense phase (t = 25-200) ratio "
                      f"{pm(r.ratio_dense, r.ratio_dense_err)} vs tan α {r.tan_alpha:.3f}, "
@@ -229,7 +223,7 @@ def c2_plug(runs: Mapping[str, ChuteRun]) -> Check:
     ref, statement = "C2; Fig 3.14, L1107, L203, H12", "at 20° a central plug forms with ν > π/4"
     thesis = "ν > π/4 = 0.785 in the centre"
     if "chute-20-flat" not in runs:
-        return missing(ref, statement, thesis, ["chute-20-flat"])
+        return not_run(ref, statement, thesis, ["chute-20-flat"])
     parts, plug = [], []
     for name in ("chute-20-flat", "chute-20-bumpy"):
         if name in runs:
@@ -259,7 +253,7 @@ def c2_converged(runs: Mapping[str, ChuteRun]) -> Check:
     statement = "the 20° chute converges to a steady flow around the plug"
     thesis = "converged"
     if "chute-20-flat" not in runs:
-        return missing(ref, statement, thesis, ["chute-20-flat"])
+        return not_run(ref, statement, thesis, ["chute-20-flat"])
     parts = []
     for name in ("chute-20-flat", "chute-20-bumpy"):
         if name in runs:
@@ -300,7 +294,7 @@ def c3_accelerates(runs: Mapping[str, ChuteRun]) -> Check:
     ref, statement = "C3; L1051, H10", "the 40° chute (10 × 4) does not converge: it accelerates"
     thesis = "non-converged, accelerating"
     if "chute-40-flat" not in runs:
-        return missing(ref, statement, thesis, ["chute-40-flat"])
+        return not_run(ref, statement, thesis, ["chute-40-flat"])
     rs = [runs[n] for n in ("chute-40-flat", "chute-40-bumpy") if n in runs]
     text = "; ".join(f"{r.base} base: {convergence(r)}" for r in rs)
     accel = [r.trend > 0.2 and not r.balanced for r in rs]
@@ -317,7 +311,7 @@ def c3_basal_layer(runs: Mapping[str, ChuteRun]) -> Check:
     statement = "the accelerating 40° bed rides on a low-density basal (lubricating) layer"
     thesis = "low-density basal layer"
     if "chute-40-flat" not in runs:
-        return missing(ref, statement, thesis, ["chute-40-flat"])
+        return not_run(ref, statement, thesis, ["chute-40-flat"])
     parts, ok, met = [], [], []
     for name in ("chute-40-flat", "chute-40-bumpy", "chute-30-bumpy"):
         if name in runs:
@@ -338,7 +332,7 @@ def _series_steady(runs: Mapping[str, ChuteRun], names: Sequence[str], ref: str,
                    statement: str, thesis: str, base: str) -> Check:
     present = [runs[n] for n in names if n in runs]
     if len(present) < len(names):
-        return missing(ref, statement, thesis, [n for n in names if n not in runs])
+        return not_run(ref, statement, thesis, [n for n in names if n not in runs])
     text = "; ".join(f"{r.rows}×{r.columns}, {r.angle:g}°: {convergence(r)}" for r in present)
     steady = [r.steady for r in present]
     verdict = REPRODUCED if all(steady) else PARTLY if any(steady) else NOT_REPRODUCED
@@ -364,7 +358,7 @@ def c4_depths(runs: Mapping[str, ChuteRun]) -> Check:
 def _unsteady(runs: Mapping[str, ChuteRun], name: str, ref: str, statement: str, thesis: str,
               base: str) -> Check:
     if name not in runs:
-        return missing(ref, statement, thesis, [name])
+        return not_run(ref, statement, thesis, [name])
     r = runs[name]
     verdict = REPRODUCED if not r.steady else NOT_REPRODUCED
     reason = base + (". " + why_not_steady(r) if not r.steady else
@@ -447,7 +441,7 @@ def _spread_text(spread: Mapping[str, float]) -> str:
 def _little_effect(runs: Mapping[str, ChuteRun], ref: str, statement: str, thesis: str,
                    names: Sequence[str], base: str) -> Check:
     if "chute-30-bumpy" not in runs or any(n not in runs for n in names):
-        return missing(ref, statement, thesis,
+        return not_run(ref, statement, thesis,
                        [n for n in ("chute-30-bumpy", *names) if n not in runs])
     a, spread = runs["chute-30-bumpy"], seed_spread(runs)
     texts, oks = [f"reference {a.label}: u_max {pm(a.u_max, a.u_max_err)}, KE/N "
@@ -477,7 +471,7 @@ def width_doubling(runs: Mapping[str, ChuteRun]) -> Check:
 
 def c7_c8(runs: Mapping[str, ChuteRun], name: str, ref: str, statement: str) -> Check:
     if name not in runs:
-        return missing(ref, statement, "converged profile", [name])
+        return not_run(ref, statement, "converged profile", [name])
     r = runs[name]
     return Check(ref, statement, "converged profile (compared with experiments)",
                  convergence(r), steady_verdict(r),
@@ -496,7 +490,7 @@ def tc_independence(runs: Mapping[str, ChuteRun]) -> Check:
     thesis = "— (Campbell's collisions are binary, no TC model)"
     names = ["chute-30-bumpy-tc1e-4", "chute-30-bumpy", "chute-30-bumpy-tc1e-6"]
     if any(n not in runs for n in names):
-        return missing(ref, statement, thesis, [n for n in names if n not in runs], own=True)
+        return not_run(ref, statement, thesis, [n for n in names if n not in runs], own=True)
     a = runs["chute-30-bumpy"]
     texts = [f"t_c {r.tc:g}: TC share {100 * r.tc_share:.1f} %, u_max {pm(r.u_max, r.u_max_err)}"
              f", KE/N {pm(r.energy_mean, r.energy_err)}, H {r.depth:.2f}, ratio "
@@ -520,7 +514,7 @@ def soft_cross_check(runs: Mapping[str, ChuteRun], engine: str = "lammps") -> Ch
     thesis = "— (the hard-disc limit)"
     name = f"chute-30-bumpy-{engine}"
     if name not in runs or "chute-30-bumpy" not in runs:
-        return missing(ref, statement, thesis, [name], own=True)
+        return not_run(ref, statement, thesis, [name], own=True)
     a, b = runs["chute-30-bumpy"], runs[name]
     spread = seed_spread(runs)
     level, text = _same(a, b, spread)

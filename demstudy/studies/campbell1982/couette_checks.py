@@ -14,16 +14,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, pm
+from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Check, not_run, pm
 from .couette_measure import RunSummary
 
 Runs = dict[str, RunSummary]
-
-
-def not_run(ref: str, statement: str, thesis: str, needs: Sequence[str],
-            own: bool = False) -> Check:
-    return Check(ref, statement, thesis, "n/a", NOT_RUN,
-                 f"needs the run(s) {', '.join(needs)}, not in this run of the study", own=own)
 
 
 def guarded(ref: str, statement: str, thesis: str, runs: Runs, needs: Sequence[str],

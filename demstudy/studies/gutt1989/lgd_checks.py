@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Analysis, Check, pm
+from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Analysis, Check, not_run, pm
 from . import lgd_figures as figs
 from . import lgd_measure as m
 
@@ -30,11 +30,6 @@ CIRCULAR, RADIAL, LINEAR_R2 = 0.05, 0.8, 0.95
 COUETTE_WINDOW = 256
 #: the thesis's speed (digest §3.15 [derived]) and the native core's (docs/benchmarks.md)
 THESIS_RATE, NATIVE_RATES = 1.96e5, (4.2e7, 5.4e7)
-
-
-def not_run(ref: str, statement: str, thesis: str, case: str) -> Check:
-    return Check(ref, statement, thesis, "n/a", NOT_RUN,
-                 f"{case} was not run in this run of the study")
 
 
 def _ratio_err(a: float, ea: float, b: float, eb: float) -> tuple[float, float]:
@@ -48,7 +43,7 @@ def code_test(runs: Mapping[str, m.LgdRun]) -> Check:
     ref = "L1031, §3.15 code test"
     st = "no grain or momentum is lost (Gutt: 1-20 grains in 10 problems across NCUBE nodes)"
     if not runs:
-        return not_run(ref, st, "none lost", "no LGD case")
+        return not_run(ref, st, "none lost", "an LGD case")
     rows, lost, worst_free, worst_g = [], [], 0.0, 0.0
     for name, run in runs.items():
         b = m.momentum_balance(run)

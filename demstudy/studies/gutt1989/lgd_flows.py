@@ -34,11 +34,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Analysis, Check, pm
+from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Analysis, Check, not_run, pm
 from . import lgd_figures as figs
 from . import lgd_measure as m
 from . import lgd_paths
-from .lgd_checks import not_run
 
 LINEAR_RATE, SIDE_SLOW, STAGNANT, STATIC_NODES = 0.25, 0.5, 0.5, 0.9
 #: thesis values (digest §3.15, L1119-L1127): band width, σ/p, final σ over g·N/N_wall

@@ -26,10 +26,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Analysis, Check
+from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Analysis, Check, not_run
 from . import lgd_figures as figs
 from . import lgd_measure as m
-from .lgd_checks import not_run
 
 INSIDE_MARGIN = 0.5  # d: a grain centre this deep inside the obstacle's node hull is inside
 FLIGHT_SAMPLES, FLIGHT_TOL, FLIGHT_MIN_MOVE = 4, 0.01, 1.5  # intervals, √(gd), d

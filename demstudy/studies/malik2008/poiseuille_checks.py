@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...engines.edmd.tc_share import WARN_SHARE
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, pm, within
+from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, not_run, pm, within
 from .poiseuille_cases import BETAS, RESTITUTIONS
 from .poiseuille_data import (
     CENTRE_BIN,
@@ -32,11 +32,6 @@ from .poiseuille_data import (
 
 Runs = dict[tuple[float, float, float], FlowData]
 REF = (0.01, 0.99, 0.8)  # Fig 2.11's parameters (φ, β, e), rerun with Ch. 3's N = 2744
-
-
-def _not_run(ref: str, statement: str, thesis: str, what: str, own: bool = False) -> Check:
-    return Check(ref, statement, thesis, "n/a", NOT_RUN, f"needs {what}, not in this run",
-                 own=own)
 
 
 def _ratio(a: float, ea: float, b: float, eb: float) -> tuple[float, float]:
@@ -118,7 +113,7 @@ def steady_checks(data: Runs) -> list[Check]:
         ref, statement = "digest §1.8 [L583], [L652]", f"φ = {phi:g}: statistics taken in the " \
                                                  "steady state (plateau of the kinetic energy)"
         if not ds:
-            out.append(_not_run(ref, statement, "plateau reached", f"the φ = {phi:g} runs"))
+            out.append(not_run(ref, statement, "plateau reached", f"the φ = {phi:g} runs"))
             continue
         steady = [d for d in ds if d.run_info()["steady"]]
         bad = ", ".join(_tag(d) for d in ds if d not in steady)
@@ -145,7 +140,7 @@ def validation_checks(data: Runs) -> list[Check]:
         ref = "digest §3.5 [L595]-[L613], Fig 2.11; Figs 3.3-3.7"
         full = f"φ = 0.01, β = 0.99, e = 0.8: {statement}"
         if d is None:
-            out.append(_not_run(ref, full, statement, "the φ = 0.01, β = 0.99, e = 0.8 run"))
+            out.append(not_run(ref, full, statement, "the φ = 0.01, β = 0.99, e = 0.8 run"))
             continue
         measured, verdict, reason = fn(d)
         others = [x for (p, _b, _e), x in data.items() if p == 0.01 and x is not d]
@@ -247,7 +242,7 @@ def dissipation_checks(data: Runs) -> list[Check]:
             rows.append(f"e = {e:g}: " + ", ".join(f"β = {b:g}: {pm(*means[b])}"
                                                    for b in runs))
         if not tested:
-            out.append(_not_run(ref, statement, "lowest T for β = 0",
+            out.append(not_run(ref, statement, "lowest T for β = 0",
                                 f"β = 0 and another β at one e (φ = {phi:g})"))
             continue
         verdict = REPRODUCED if held == tested else PARTLY if held else NOT_REPRODUCED
@@ -274,7 +269,7 @@ def knudsen_checks(data: Runs) -> list[Check]:
     statement = ("φ = 0.01: Kn = λ/W > 0.1 across the channel, the transitional regime "
                  "(free paths relative to the local mean flow)")
     if not ds:
-        out.append(_not_run(ref, statement, "Kn > 0.1", "the φ = 0.01 runs"))
+        out.append(not_run(ref, statement, "Kn > 0.1", "the φ = 0.01 runs"))
     else:
         lows, lab_lows, rows = [], [], []
         for d in ds:
@@ -307,7 +302,7 @@ def _plug_knudsen(data: Runs) -> Check:
                                           "plug (read: centre Kn < 0.01, lowest of the three β)")
     runs = {b: data.get((0.1, b, 0.7)) for b in BETAS}
     if runs[0.0] is None:
-        return _not_run(ref, statement, "Kn ≪ 0.1 in the plug", "the φ = 0.1, e = 0.7 runs")
+        return not_run(ref, statement, "Kn ≪ 0.1 in the plug", "the φ = 0.1, e = 0.7 runs")
     def holds(key: str) -> tuple[bool, dict[float, tuple[float, float]]]:
         kn = {b: r.centre_value(key) for b, r in runs.items() if r is not None}
         k0, e0 = kn[0.0]
@@ -444,7 +439,7 @@ def vdf_checks(data: Runs) -> list[Check]:
                      "core and non-Gaussian tails (visual in the thesis)")
         ds = [d for d in ds if "malik_P" in d.stat("vdf")]
         if not ds:
-            out.append(_not_run(ref, statement, "Gaussian core, tails", f"φ = {phi:g} runs"))
+            out.append(not_run(ref, statement, "Gaussian core, tails", f"φ = {phi:g} runs"))
             continue
         rows, cores, tails, spikes, drifts = [], True, False, [], []
         causes: dict[str, list[str]] = {key: [] for key in VDF_CAUSES}
@@ -532,7 +527,7 @@ def vdf_elastic_limit_checks(data: Runs) -> list[Check]:
             rows.append(f"β = {beta:g}: e = {e_lo:g} {pm(a, ea)} → e = {e_hi:g} {pm(b, eb)}"
                         + ("" if ok else " (not beyond 2σ)"))
         if not tested:
-            out.append(_not_run(ref, statement, "VDF → Gaussian as e → 1",
+            out.append(not_run(ref, statement, "VDF → Gaussian as e → 1",
                                 f"two e at one β (φ = {phi:g})"))
             continue
         verdict = REPRODUCED if held == tested else PARTLY if held else NOT_REPRODUCED
@@ -561,7 +556,7 @@ def wall_dissipation_checks(data: Runs) -> list[Check]:
     statement = "β = 0: the walls dissipate much energy (wall-particle collisions)"
     runs = [d for (p, b, e), d in sorted(data.items()) if b == 0.0]
     if not runs:
-        return [_not_run(ref, statement, "large wall dissipation", "a β = 0 run")]
+        return [not_run(ref, statement, "large wall dissipation", "a β = 0 run")]
     elastic, budgets = [], []
     for d in runs:
         walls = d.res.scene.walls
@@ -614,7 +609,7 @@ def contact_checks(data: Runs) -> list[Check]:
         statement = (f"φ = {phi:g}, bin 13: g(r) contact value vs Enskog's χ "
                      "(Carnahan-Starling at the bin's φ)")
         if not ds:
-            out.append(_not_run(ref, statement, "χ(φ) (CS)", f"φ = {phi:g} runs", own=True))
+            out.append(not_run(ref, statement, "χ(φ) (CS)", f"φ = {phi:g} runs", own=True))
             continue
         rows, held, ratios, far_high, frozen = [], 0, [], [], []
         for d in ds:
@@ -687,7 +682,7 @@ def gr_shell_checks(data: Runs) -> list[Check]:
                                           "(the shells after contact)")
     ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.1 and d.gr]
     if not ds:
-        return [_not_run(ref, statement, "peaks at 2 d, 3 d", "the φ = 0.1 runs")]
+        return [not_run(ref, statement, "peaks at 2 d, 3 d", "the φ = 0.1 runs")]
     rows, both, lacking, counts = [], [], [], [0, 0]
     for d in ds:
         peaks = shell_peaks(d.gr, CENTRE_BIN - 1)
@@ -733,7 +728,7 @@ def sparse_wall_checks(data: Runs) -> list[Check]:
                                         "(their g(r) and correlations not reported)")
     ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.1]
     if not ds:
-        return [_not_run(ref, statement, "sparse near-wall bins", "the φ = 0.1 runs")]
+        return [not_run(ref, statement, "sparse near-wall bins", "the φ = 0.1 runs")]
     rows, sparse, ratios = [], [], {}
     for d in ds:
         f, _ef = d.series("phi")
@@ -810,7 +805,7 @@ def lambda_checks(data: Runs) -> list[Check]:
                      "molecular value 1/3 for rough spheres; its variation with β and e "
                      "(insets)")
         if not ds:
-            out.append(_not_run(ref, statement, "Λ ≠ 1/3", f"φ = {phi:g} runs"))
+            out.append(not_run(ref, statement, "Λ ≠ 1/3", f"φ = {phi:g} runs"))
             continue
         rough = [d for d in ds if d.flow.beta > SMOOTH_BETA]
         smooth = [d for d in ds if d.flow.beta <= SMOOTH_BETA]
@@ -898,7 +893,7 @@ def dense_checks(data: Runs) -> list[Check]:
     ref, statement = "[L996]-[L1050], Figs 4.15-4.16; §6", \
         "φ = 0.5: a liquid-like dense core (0.494 < φ < 0.64) flowing as a plug"
     if d is None:
-        return [_not_run(ref, statement, "liquid-like core, plug", "the φ = 0.5 run")]
+        return [not_run(ref, statement, "liquid-like core, plug", "the φ = 0.5 run")]
     f, ef = d.series("phi")
     core = slice(9, 16)  # bins 10-16
     fc, efc = _mean(f[core], ef[core])
@@ -958,7 +953,7 @@ def wave_checks(data: Runs) -> list[Check]:
     d = data.get((0.1, 0.99, 0.7))
     ref, statement = "Fig 4.5 [L925]", "φ = 0.1, β = 0.99, e = 0.7: an S-shaped density wave"
     if d is None:
-        return [_not_run(ref, statement, "S-wave seen", "the φ = 0.1, β = 0.99, e = 0.7 run")]
+        return [not_run(ref, statement, "S-wave seen", "the φ = 0.1, β = 0.99, e = 0.7 run")]
     from .poiseuille_waves import mode_ratios, s_wave_text
 
     r = mode_ratios(d)
