@@ -220,6 +220,24 @@ def test_check_verdicts_and_number_formatting():
     assert within(1.0, 0.0, 1.1, tolerance=0.11) and not within(1.0, 0.0, 1.2, tolerance=0.11)
 
 
+def test_a_selection_that_selects_nothing_is_refused_naming_what_is_allowed(toy, tmp_path):
+    """A typo in --only or --engine would run nothing and report success: refused (exit 2
+    on the command line), naming the option, the value and what the study has."""
+    from demstudy.errors import BadOption
+
+    for kw, words in (({"only": ["cell-z"]}, "--only = 'cell-z': matches no case of toy; "
+                       "its cases are cell-a, cell-b"),
+                      ({"engines": ["bogus"]}, "--engine = 'bogus': allowed are"),
+                      ({"engines": ["lgd"]}, "no case of toy runs in it; its cases use edmd"),
+                      ({"only": ["cell-b"], "quick": True}, "matches no case of toy (quick)"),
+                      ({"analyse_only": True, "records": tmp_path / "none"},
+                       "--records")):
+        with pytest.raises(BadOption) as info:
+            run_study("toy", out=tmp_path, dry_run=True, echo=lambda s: None, **kw)
+        assert words in str(info.value), (kw, str(info.value))
+    assert not (tmp_path / "runs").exists()
+
+
 def test_cli_refuses_an_unknown_study_and_bad_workers_with_exit_2():
     for args in (["nope"], ["campbell1982", "--workers", "0"]):
         proc = subprocess.run([sys.executable, "-m", "demstudy.cli", "study", *args],

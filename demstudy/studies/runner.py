@@ -247,6 +247,33 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
+def _check_selection(study: Study, quick: bool, engines: Sequence[str] | None,
+                     only: Sequence[str] | None) -> None:
+    """Refuse (exit 2) an engine that does not exist or that none of the study's cases use,
+    and an ``--only`` text that matches no case: a typo would otherwise run nothing and
+    report success."""
+    from ..engines import backend_names
+
+    cases = list(study.cases(quick))
+    used = sorted({c.engine for c in cases})
+    for engine in engines or ():
+        if engine not in backend_names():
+            raise BadOption("--engine", engine, f"allowed are {', '.join(backend_names())}")
+        if engine not in used:
+            raise BadOption("--engine", engine, f"no case of {study.name}"
+                            f"{' (quick)' if quick else ''} runs in it; its cases use "
+                            f"{', '.join(used)}")
+    names = [c.name for c in cases]
+    for text in only or ():
+        if not any(text in n for n in names):
+            raise BadOption("--only", text, f"matches no case of {study.name}"
+                            f"{' (quick)' if quick else ''}; its cases are {', '.join(names)}")
+    if engines and only and not any(c.engine in engines and any(t in c.name for t in only)
+                                    for c in cases):
+        raise BadOption("--only", ", ".join(only), f"matches no case of {study.name} that "
+                        f"runs in {', '.join(engines)}")
+
+
 def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
               workers: int = 1, dask: Any = None, dry_run: bool = False,
               engines: Sequence[str] | None = None, only: Sequence[str] | None = None,
@@ -266,6 +293,10 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         raise BadOption("--workers", workers, "a whole number >= 1 is allowed")
     out = Path(out) if out is not None else Path("results") / "studies" / (
         study.name + ("-quick" if quick else ""))
+    _check_selection(study, quick, engines, only)
+    if analyse_only and records is not None and not Path(records).is_dir():
+        raise BadOption("--records", str(records), "a folder of run records is needed with "
+                        "--analyse-only (it does not exist)")
     started = time.perf_counter()
     tasks = tasks_of(study, quick, out, engines, only)
     result = StudyRun(study, out)
