@@ -221,8 +221,9 @@ def test_check_verdicts_and_number_formatting():
 
 
 def test_a_selection_that_selects_nothing_is_refused_naming_what_is_allowed(toy, tmp_path):
-    """A typo in --only or --engine would run nothing and report success: refused (exit 2
-    on the command line), naming the option, the value and what the study has."""
+    """A typo in --only or --engine would run nothing and report success, --analyse-only
+    with no made run a report of nothing: refused (exit 2 on the command line), naming the
+    option, the value and what the study has."""
     from demstudy.errors import BadOption
 
     for kw, words in (({"only": ["cell-z"]}, "--only = 'cell-z': matches no case of toy; "
@@ -230,10 +231,10 @@ def test_a_selection_that_selects_nothing_is_refused_naming_what_is_allowed(toy,
                       ({"engines": ["bogus"]}, "--engine = 'bogus': allowed are"),
                       ({"engines": ["lgd"]}, "no case of toy runs in it; its cases use edmd"),
                       ({"only": ["cell-b"], "quick": True}, "matches no case of toy (quick)"),
-                      ({"analyse_only": True, "records": tmp_path / "none"},
-                       "--records")):
+                      ({"analyse_only": True}, f"no made run of toy in {tmp_path}/runs/")):
         with pytest.raises(BadOption) as info:
-            run_study("toy", out=tmp_path, dry_run=True, echo=lambda s: None, **kw)
+            run_study("toy", out=tmp_path, dry_run=not kw.get("analyse_only"),
+                      echo=lambda s: None, **kw)
         assert words in str(info.value), (kw, str(info.value))
     assert not (tmp_path / "runs").exists()
 

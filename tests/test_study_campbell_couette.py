@@ -20,7 +20,7 @@ from demstudy.studies.base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, V
 from demstudy.studies.campbell1982 import couette
 from demstudy.studies.campbell1982 import couette_checks as ck
 from demstudy.studies.campbell1982.couette_cases import _run, fixed_case, nu_tag, spacing_for
-from demstudy.studies.campbell1982.couette_measure import LISTING_FACTOR
+from demstudy.studies.campbell1982.couette_measure import LISTING_FACTOR, RunSummary
 from demstudy.theory import savage_jeffrey
 
 
@@ -121,10 +121,49 @@ def test_trend_verdicts() -> None:
     assert ck.trend_verdict([(1.0, 0.1), (0.5, 0.1)])[0] == NOT_REPRODUCED
 
 
+def _cell(name: str, s: float, plug: bool) -> RunSummary:
+    """A fixed-gap cell's summary: S and a u/U_T profile over y/H, uniform shear or a plug
+    (flat centre, dilute wall bins)."""
+    y = np.linspace(0.05, 0.95, 10)
+    u = np.clip((y - 0.5) * 4, -0.5, 0.5) if plug else y - 0.5
+    u = np.where(np.abs(y - 0.5) < 0.2, 0.0, u) if plug else u
+    nu = np.full(10, 0.75)
+    if plug:
+        nu[[0, -1]] = 0.5
+    return RunSummary(name, values={"S_text": (s, 0.05), "nu": (0.75, 0.001)},
+                      arrays={"u_over_ut": u, "y_over_h": y, "nu": nu,
+                              "centre": np.abs(y - 0.5) < 0.25})
+
+
+def test_the_larger_cell_stands_in_for_the_layered_dense_one() -> None:
+    """S(ν) and the plug: the 10 × 4 cell at ν = 0.75 keeps its start lattice; where the
+    20 × 8 cell in its place gives the thesis's trend or plug the row is "partly" and says so,
+    where it does not either the row stays "not reproduced"; without it nothing changes."""
+    names, nus = ["a", "b", "c"], [0.35, 0.55, 0.75]
+    runs = {"a": _cell("a", 1.2, False), "b": _cell("b", 1.1, False),
+            "c": _cell("c", 0.9, False)}
+    assert ck.s_trend(runs, names, nus).verdict == NOT_REPRODUCED
+    assert ck.s_trend(runs, names, nus, "big").verdict == NOT_REPRODUCED  # absent
+    runs["big"] = _cell("big", 0.5, False)
+    low = ck.s_trend(runs, names, nus, "big")
+    assert low.verdict == NOT_REPRODUCED and "not rising either" in low.reason
+    runs["a"] = _cell("a", 1.0, False)
+    runs["big"] = _cell("big", 3.0, False)
+    up = ck.s_trend(runs, names, nus, "big")
+    assert up.verdict == PARTLY and "20 × 8 cell at ν = 0.75: 3.000 ± 0.050" in up.measured
+    plug = ck.plug(runs, "c", 0.75, "big")
+    assert plug.verdict == NOT_REPRODUCED and "shears through too" in plug.reason
+    runs["big"] = _cell("big", 3.0, True)
+    plug = ck.plug(runs, "c", 0.75, "big")
+    assert plug.verdict == PARTLY and "the 20 × 8 cell at the same ν forms the plug" in plug.reason
+    runs["c"] = _cell("c", 0.9, True)
+    assert ck.plug(runs, "c", 0.75, "big").verdict == REPRODUCED
+
+
 def test_missing_runs_give_not_run_checks(tmp_path: Path) -> None:
     ana = couette.analyse({}, tmp_path, quick=False)
     assert ana.checks and all(c.verdict == NOT_RUN for c in ana.checks)
-    assert all("not in this run" in c.reason for c in ana.checks)
+    assert all("not in this run of the study" in c.reason for c in ana.checks)
 
 
 @pytest.fixture(scope="module")

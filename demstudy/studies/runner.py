@@ -294,9 +294,6 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     out = Path(out) if out is not None else Path("results") / "studies" / (
         study.name + ("-quick" if quick else ""))
     _check_selection(study, quick, engines, only)
-    if analyse_only and records is not None and not Path(records).is_dir():
-        raise BadOption("--records", str(records), "a folder of run records is needed with "
-                        "--analyse-only (it does not exist)")
     started = time.perf_counter()
     tasks = tasks_of(study, quick, out, engines, only)
     result = StudyRun(study, out)
@@ -366,6 +363,10 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
                 result.from_records.append(t.case.name)
         elif t.path.is_file():
             runs[t.case.name] = t.path
+    if analyse_only and not runs:
+        where = f"{out}/runs/" + (f" nor in {record_dir}/" if record_dir is not None else "")
+        raise BadOption("--analyse-only", True, f"no made run of {study.name} in {where}: "
+                        "make the runs first, or point --out (or --records) at them")
     result.run_seconds = sum(_run_seconds(p) for p in runs.values())
     out.mkdir(parents=True, exist_ok=True)
     result.analysis = study.analyse(runs, out, quick)

@@ -69,7 +69,7 @@ def checks(s: dict[str, RunSummary]) -> list:
         ck.wall_slip(s, K1[1], K2[1]),
         *ck.shear_rate_independence(s, K3, SHEAR_RATES),
         ck.s_order_one(s, trend_names, trend_nu),
-        ck.s_trend(s, trend_names, trend_nu),
+        ck.s_trend(s, trend_names, trend_nu, LARGER),
         *ck.bagnold_steep(s, trend_names, trend_nu, LARGER),
         ck.chi_check(s, trend_names, trend_nu),
         ck.rotational_share(s, part_names, part_nu),
@@ -78,7 +78,7 @@ def checks(s: dict[str, RunSummary]) -> list:
         ck.angles_savage_jeffrey(s, K6, ["ν=0.45, ε=1", "ν=0.35, 0.8/0.6"]),
         ck.elastic_lower_s(s, K6[0], "couette-fixed-nu45"),
         ck.layering(s, trend_names, trend_nu),
-        ck.plug(s, FIXED[-1], FIXED_NU[-1]),
+        ck.plug(s, FIXED[-1], FIXED_NU[-1], LARGER),
         ck.lammps_cross_check(s, K1[1], LAMMPS),
     ]
     return out
