@@ -26,8 +26,13 @@ class EngineError(RuntimeError):
     """An engine failed; the message says what the engine reported and where."""
 
 
+#: how a single run's stop message ends (a sweep, which resumes by itself, drops it)
+RESUME_ADVICE = ": run the same command again with --resume to continue"
+
+
 class RunStopped(EngineError):
-    """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint."""
+    """The run stopped on request (Ctrl-C, wall-clock limit) after writing a checkpoint; its
+    message ends with ``RESUME_ADVICE``."""
 
 
 class RunAborted(EngineError):

@@ -356,3 +356,34 @@ def test_health_figures_when_present_give_the_contact_time_law():
     assert fits["error(k*) hooke, 50 steps/contact"].p == pytest.approx(0.75, abs=1e-3)
     without = _fits([{k: v for k, v in r.items() if k != "tc_flight"} for r in rows])
     assert "error(t_c/tau_flight)" not in without
+
+
+def test_a_ladder_run_stopped_with_a_checkpoint_continues_from_it(tmp_path, monkeypatch):
+    """A sweep's command takes no --resume: a run whose work folder holds a checkpoint (it
+    was stopped by Ctrl-C or a wall-clock limit) is continued from it, any other run starts
+    afresh."""
+    import types
+
+    import demstudy.api as api
+    from demstudy.accuracy.execute import Task, run_task
+    from demstudy.accuracy.plan import RunSpec
+    from demstudy.scene import load_scene, scene_to_toml
+    from demstudy.simulation.checkpoint import CHECKPOINT
+    from demstudy.simulation.options import work_folder
+
+    seen = []
+
+    def spy(scene, **kw):
+        seen.append(kw)
+        return types.SimpleNamespace(path=kw["out"], attrs={"wall_seconds": 1.0})
+
+    monkeypatch.setattr(api, "run", spy)
+    task = Task(RunSpec("edmd", tc=1e-5), scene_to_toml(load_scene("shear/lees-edwards-2d")),
+                tmp_path / "ref-edmd-tc1e-05.h5")
+    run_task(task)
+    folder = work_folder(task.path, "edmd")
+    folder.mkdir(parents=True)
+    (folder / CHECKPOINT).write_bytes(b"a checkpoint")
+    run_task(task)
+    assert "resume" not in seen[0] and seen[1]["resume"] is True
+    assert seen[1]["tc"] == 1e-5

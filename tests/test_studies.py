@@ -192,10 +192,9 @@ def test_a_stopped_run_is_listed_without_the_single_runs_resume_advice():
     """A sweep's command has no --resume (it resumes by itself): the failures list keeps what
     stopped the run and drops the per-run advice, other errors stay whole."""
     from demstudy.accuracy.execute import _failure
-    from demstudy.errors import EngineError, RunStopped
+    from demstudy.errors import RESUME_ADVICE, EngineError, RunStopped
 
-    stopped = RunStopped("stopped (Ctrl-C) at t = 12.5 after a checkpoint: run the same "
-                         "command again with --resume to continue")
+    stopped = RunStopped(f"stopped (Ctrl-C) at t = 12.5 after a checkpoint{RESUME_ADVICE}")
     assert _failure("big", stopped) == "big: stopped (Ctrl-C) at t = 12.5 after a checkpoint"
     assert _failure("bad", EngineError("x: y")) == "bad: x: y"
 

@@ -1,9 +1,10 @@
 """Running the ladder: one ``ds.run`` per task into its own results file, in a local process
 pool or on a Dask cluster, skipping every task whose file is already there and whole.
 
-Resumability rests on the results files alone: ``write_results`` writes atomically (a file is
+Resumability rests on the results files: ``write_results`` writes atomically (a file is
 whole or absent), and a file counts as done only if ``read_results`` reads it and its
-``scene_toml`` is the scene this task would run (a file from other settings is redone).
+``scene_toml`` is the scene this task would run (a file from other settings is redone). A run
+stopped with a checkpoint (Ctrl-C, a wall-clock limit) continues from it on the next call.
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 """
 
@@ -53,10 +54,15 @@ def run_task(task: Task) -> dict[str, Any]:
     """Make one run (in a pool worker or a Dask worker); the engine runs in a child process
     (``isolate``) on one rank. Returns what the ladder records of the execution."""
     from ..api import run
+    from ..simulation.checkpoint import CHECKPOINT
+    from ..simulation.options import work_folder
 
+    options = task.spec.options()
+    if (work_folder(Path(task.path), task.spec.engine) / CHECKPOINT).is_file():
+        options["resume"] = True  # a stopped run of the sweep continues from its checkpoint
     started = time.perf_counter()
     res = run(task.scene(), engine=task.spec.engine, out=task.path, isolate=True, np=1,
-              progress=False, **task.spec.options())
+              progress=False, **options)
     return {"name": task.spec.name, "path": str(res.path),
             "task_seconds": time.perf_counter() - started,
             "wall_seconds": float(res.attrs.get("wall_seconds", float("nan")))}
@@ -158,12 +164,11 @@ def _on_dask(tasks: list[Task], dask: Any, on_done) -> list[dict]:
 
 def _failure(name: str, exc: BaseException) -> str:
     """One line of the failures list. A run stopped with a checkpoint says so without the
-    single run's "--resume" advice: a sweep's command takes no --resume, it resumes itself."""
-    from ..errors import RunStopped
+    single run's "--resume" advice: a sweep's command takes no --resume, it resumes itself
+    (:func:`run_task`)."""
+    from ..errors import RESUME_ADVICE
 
-    if isinstance(exc, RunStopped):
-        return f"{name}: {str(exc).split(': run the same command')[0]}"
-    return f"{name}: {exc}"
+    return f"{name}: {str(exc).removesuffix(RESUME_ADVICE)}"
 
 
 def _raise_failures(failures: list[str]) -> None:

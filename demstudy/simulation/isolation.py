@@ -25,7 +25,14 @@ import time
 from pathlib import Path
 
 from .. import UNITS_NOTE
-from ..errors import EngineError, RunAborted, RunRefused, RunStopped, UnsupportedByEngine
+from ..errors import (
+    RESUME_ADVICE,
+    EngineError,
+    RunAborted,
+    RunRefused,
+    RunStopped,
+    UnsupportedByEngine,
+)
 from ..scene import Scene
 from .options import RunOptions, work_folder
 from .schedule import stop_notice
@@ -106,8 +113,7 @@ def launch_child(backend, scene: Scene, options: RunOptions) -> Path:
     message = error.read_text().strip() if error.exists() else ""
     error.unlink(missing_ok=True)
     if returncode == STOPPED:
-        raise RunStopped("the run stopped after writing a checkpoint: run the same command "
-                         "again with --resume to continue")
+        raise RunStopped(f"the run stopped after writing a checkpoint{RESUME_ADVICE}")
     if returncode == INTERRUPTED:  # Ctrl-C while the child set up, before its loop's handler
         raise RunAborted(f"aborted by Ctrl-C while the {backend.name} run was being set up: "
                          f"it did not start; {_last_checkpoint(work_folder(out, backend.name))}")

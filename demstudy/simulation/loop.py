@@ -38,7 +38,7 @@ from ..analysis.walls import frame_walls, with_walls
 from ..contact.health import warning_text
 from ..effects.servo import ServoController, has_servo, servo_samples, servo_settings
 from ..engines.backend import LOG_CAPACITY, BackendBase, Needs, frame_mass
-from ..errors import EngineError, RunAborted, RunStopped
+from ..errors import RESUME_ADVICE, EngineError, RunAborted, RunStopped
 from ..io.frames import Frame
 from ..io.results import write_results
 from ..scene import Scene, scene_to_toml
@@ -410,8 +410,7 @@ class Simulation:
                     self._checkpoint(state, started)
                     raise RunStopped(
                         f"stopped ({self.stop.reason}) at t = {backend.time:.6g}, inside a "
-                        "sample interval, after a checkpoint: run the same command again "
-                        "with --resume to continue") from None
+                        f"sample interval, after a checkpoint{RESUME_ADVICE}") from None
                 if state.servo is not None and backend.capabilities.time_step:
                     self._sample_servo(state)
                 self._sample(state, production=state.samples > sched.n_eq)
@@ -423,8 +422,7 @@ class Simulation:
                 if stop and state.samples < sched.n_total:
                     raise RunStopped(
                         f"stopped ({self.stop.reason or 'on another rank'}) at t = "
-                        f"{backend.time:.6g} after a checkpoint: run the same command again "
-                        "with --resume to continue")
+                        f"{backend.time:.6g} after a checkpoint{RESUME_ADVICE}")
 
     # -- results ------------------------------------------------------------------------------
     def _write(self, state: RunState, extra: dict[str, Any]) -> Path:
