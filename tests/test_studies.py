@@ -146,7 +146,7 @@ def test_a_finished_run_of_the_same_kind_turns_a_lower_bound_into_an_estimate(
 
     import demstudy.api as api
     from demstudy.scene import load_scene, scene_to_toml
-    from demstudy.studies.runner import LOWER_BOUND_NOTE, tasks_of
+    from demstudy.studies.runner import CALIBRATED_NOTE, LOWER_BOUND_NOTE, tasks_of
 
     def plan(scene, **kw):
         return {"forecast_seconds": 30.0, "forecast_kind": "lower bound"}
@@ -159,20 +159,46 @@ def test_a_finished_run_of_the_same_kind_turns_a_lower_bound_into_an_estimate(
         with h5py.File(made.path, "w") as f:
             f.attrs.update({"engine": "edmd", "forecast_kind": "lower bound",
                             "forecast_seconds": 30.0, "wall_seconds": 90.0,
-                            "scene_toml": scene_toml})
+                            "scene_toml": scene_toml, "tc": 1e-5})
         lines: list[str] = []
         run_study("toy", out=tmp_path, dry_run=True, workers=1, echo=lines.append,
                   only=["cell-b"])
         return lines
 
     lines = finished(made.scene_toml)
-    assert lines[1].startswith("forecast: 90 s on 1 worker(s)"), lines
-    assert any(s.endswith("cell-b (edmd): about 90 s (its lower bound 30 s × 3.00: what "
-                          "cell-a, N = 40, took against its own lower bound)") for s in lines)
-    assert LOWER_BOUND_NOTE not in lines
+    assert lines[1].startswith("forecast: about 90 s on 1 worker(s)"), lines
+    assert any(s.endswith("cell-b (edmd): about 90 s (its lower bound 30 s × 3.00: cell-a, "
+                          "N = 40, took 90 s against a lower bound of 30 s)") for s in lines)
+    assert LOWER_BOUND_NOTE not in lines and CALIBRATED_NOTE in lines
     lines = finished(scene_to_toml(load_scene("campbell1982/chute-20")))
     assert lines[1].startswith("forecast: probably more than 30 s"), lines
     assert LOWER_BOUND_NOTE in lines
+
+
+def test_a_calibrating_run_has_the_same_engine_options_and_is_the_closest(tmp_path):
+    """Another t_c is another kind (its runs cost differently); among runs of the kind the
+    closest in N, length, e and β calibrates; a made run counts from its record when its
+    results file is gone."""
+    from demstudy.scene import load_scene
+    from demstudy.studies.runner import Took, _made, calibration, tasks_of
+
+    scene = load_scene("campbell1982/couette-rough", ["run.production=10"])
+    near = Took("near", "edmd", scene, 90.0, 30.0, 1e-5)
+    far = Took("far", "edmd", load_scene("campbell1982/couette-rough",
+                                         ["run.production=1000"]), 900.0, 30.0, 1e-5)
+    assert calibration(scene, "edmd", [far, near]) is near
+    assert calibration(scene, "edmd", [far, near], {"tc": 1e-6}) is None
+    assert calibration(scene, "edmd", [Took("twin", "edmd", scene, 9.0, 3.0, 1e-6)],
+                       {"tc": 1e-6}).name == "twin"
+    assert calibration(scene, "lammps", [far, near]) is None
+    records = tmp_path / "records"
+    records.mkdir()
+    (records / "cell-b.h5").write_bytes(b"x")
+    task = tasks_of(TOY, False, tmp_path)[0]
+    task.path.parent.mkdir(parents=True)
+    task.path.write_bytes(b"x")
+    assert _made(TOY, False, tmp_path, records) == {"cell-a": task.path,
+                                                   "cell-b": records / "cell-b.h5"}
 
 
 def test_a_failed_case_does_not_stop_the_others_nor_the_analysis(toy, tmp_path, monkeypatch):

@@ -17,7 +17,7 @@ import math
 import platform
 import shutil
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -125,7 +125,23 @@ def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None
     return tasks
 
 
-def forecast(tasks: Sequence[StudyTask], workers: int, finished: Sequence[Took] = ()
+def _bound_now(made: Took, folder: Path) -> float:
+    """The lower bound of a made run forecast again now, as the runs to make are (the
+    pilot and its rules change between versions; a stored bound may be of another method):
+    the stored one when this forecast fails."""
+    from ..api import run
+
+    try:
+        plan = run(made.scene, engine=made.engine, out=folder / f"{made.name}.h5",
+                   dry_run=True, progress=False, **made.options)
+        s = float(plan.get("forecast_seconds", math.nan))
+    except Exception:  # noqa: BLE001 - a made run that cannot be forecast now: its own bound
+        return made.bound
+    return s if math.isfinite(s) and s > 0 else made.bound
+
+
+def forecast(tasks: Sequence[StudyTask], workers: int,
+             finished: Sequence[Took] | Callable[[], Sequence[Took]] = ()
              ) -> tuple[float | None, list[str], dict[str, str], dict[str, float]]:
     """The wall time of ``tasks`` on ``workers`` (each run's ``--dry-run`` forecast,
     scheduled longest first; None when a run has no forecast), one line per run, the runs
@@ -137,6 +153,8 @@ def forecast(tasks: Sequence[StudyTask], workers: int, finished: Sequence[Took] 
     from ..errors import UnsupportedByEngine
 
     seconds, lines, unknown, refused, lower = {}, [], False, {}, False
+    made: list[Took] | None = None  # read when a lower bound first needs it
+    again: dict[str, float] = {}  # made run → its lower bound forecast again now
     for task in tasks:
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
@@ -152,19 +170,29 @@ def forecast(tasks: Sequence[StudyTask], workers: int, finished: Sequence[Took] 
                          f"({plan.get('forecast', 'not measured')})")
             continue
         bound = plan.get("forecast_kind") == "lower bound"
-        like = calibration(task.scene(), task.case.engine, finished) if bound else None
+        like = None
+        if bound:
+            if made is None:
+                made = list(finished() if callable(finished) else finished)
+            like = calibration(task.scene(), task.case.engine, made, task.case.options)
         if like is not None:
-            seconds[task.case.name] = float(s) * like.ratio
+            if like.name not in again:  # its bound by today's method, in the same folder
+                again[like.name] = _bound_now(like, task.path.parent)
+            ratio = like.wall / again[like.name]
+            seconds[task.case.name] = float(s) * ratio
             lines.append(f"  {task.case.name} ({task.case.engine}): about "
-                         f"{_duration(s * like.ratio)} (its lower bound {_duration(s)} × "
-                         f"{like.ratio:.2f}: what {like.name}, N = {like.n}, took against "
-                         "its own lower bound)")
+                         f"{_duration(s * ratio)} (its lower bound {_duration(s)} × "
+                         f"{ratio:.2f}: {like.name}, N = {like.scene.n_particles}, took "
+                         f"{_duration(like.wall)} against a lower bound of "
+                         f"{_duration(again[like.name])})")
             continue
         seconds[task.case.name] = float(s)
         lower = lower or bound
         lines.append(f"  {task.case.name} ({task.case.engine}): "
                      f"{'probably more than ' if bound else ''}{_duration(s)}")
     total = makespan(list(seconds.values()), workers) if seconds else 0.0
+    if again:
+        lines.append(CALIBRATED_NOTE)
     if lower:  # the runs' lower bounds: the study takes longer, by how much is unknown
         lines.append(LOWER_BOUND_NOTE)
     return (None if unknown else total), lines, refused, seconds
@@ -172,20 +200,26 @@ def forecast(tasks: Sequence[StudyTask], workers: int, finished: Sequence[Took] 
 
 @dataclass(frozen=True)
 class Took:
-    """A finished run of a study whose forecast was a lower bound: how many times that
-    bound its loop took (``ratio`` = ``wall_seconds`` / ``forecast_seconds``, both in its
-    results file or record, measured on the machine that made it)."""
+    """A made run of a study whose forecast was a lower bound: its loop's ``wall`` seconds
+    and that ``bound`` (``wall_seconds`` and ``forecast_seconds`` of its results file or
+    record, measured on the machine that made it, under whatever load it met) and the
+    event-driven engine's ``tc`` (None for other engines)."""
 
     name: str
     engine: str
     scene: Any
-    n: int
-    ratio: float
+    wall: float
+    bound: float
+    tc: float | None = None
+
+    @property
+    def options(self) -> dict:
+        return {} if self.tc is None else {"tc": self.tc}
 
 
 def finished_runs(paths: Mapping[str, Path]) -> list[Took]:
     """The runs among ``paths`` (case name → results file or record) whose forecast was a
-    lower bound, with what they took against it; unreadable files are left out."""
+    lower bound; unreadable files, and files without a forecast, are left out."""
     import h5py
 
     from ..scene import parse_scene_text, validate_scene
@@ -199,40 +233,58 @@ def finished_runs(paths: Mapping[str, Path]) -> list[Took]:
                 continue
             wall, bound = float(a["wall_seconds"]), float(a["forecast_seconds"])
             scene = validate_scene(parse_scene_text(str(a["scene_toml"])), name)
+            tc = float(a["tc"]) if "tc" in a else None
         except Exception:  # noqa: BLE001 - an unreadable or older file calibrates nothing
             continue
         if wall > 0 and bound > 0 and math.isfinite(wall / bound):
-            took.append(Took(name, str(a.get("engine", "")), scene, scene.n_particles,
-                             wall / bound))
+            took.append(Took(name, str(a.get("engine", "")), scene, wall, bound, tc))
     return took
 
 
-def calibration(scene, engine: str, finished: Sequence[Took]) -> Took | None:
-    """The finished run that says how far ``scene``'s lower bound falls short: the same
-    engine, dimension, walls, gravity vector, shear, run unit and solid fraction (within
-    ``FAMILY_PHI``), the closest in N (then in e); None when there is none.
+def _tc(engine: str, options: Mapping[str, Any]) -> float | None:
+    if engine != "edmd":
+        return None
+    from ..engines.edmd import DEFAULT_TC
+
+    return float(options.get("tc", DEFAULT_TC))
+
+
+def calibration(scene, engine: str, finished: Sequence[Took],
+                options: Mapping[str, Any] | None = None) -> Took | None:
+    """The made run that says how far ``scene``'s lower bound falls short: the same engine
+    and engine options (t_c), dimension, walls (side, kind, speed), gravity vector, shear,
+    run unit and solid fraction (within ``FAMILY_PHI``); the closest in N, run length, e and
+    β (``forecast_events._distance``); None when there is none.
 
     Why: a flow that gravity accelerates outruns its pilot, and the event-driven engine's
-    cost per event grows with N beyond what the cost benchmarks (N ≤ 20000) measured
-    (Malik's N = 107811 boxes took 2.04× their lower bounds, both of them): runs of the same
-    kind fall short by similar factors, runs of other kinds by anything from ×1 to ×90."""
-    from ..simulation.forecast_events import FAMILY_PHI
+    cost per event grows with N beyond what the cost benchmarks (N ≤ 20000) measured. How
+    far the bound falls short is a property of the kind of run more than of the run: Malik's
+    two N = 107811 boxes took 2.04× their lower bounds, both; over all of that study's
+    lower-bound runs the shortfall spans ×0.85–91 (docs/forecast.md)."""
+    from ..simulation.forecast_events import FAMILY_PHI, _distance
 
     def kind(s) -> tuple:
         g = s.gravity_vector
-        return (s.dimension, tuple(w.side for w in s.walls),
+        return (s.dimension, tuple((w.side, w.kind, round(w.velocity, 6)) for w in s.walls),
                 None if g is None else tuple(round(x, 6) for x in g),
                 None if s.shear is None else round(s.shear.rate, 6), s.run.unit)
 
+    tc = _tc(engine, options or {})
+    if not scene.solid_fraction > 0:
+        return None
     like = [t for t in finished if t.engine == engine and kind(t.scene) == kind(scene)
+            and (t.tc is None) == (tc is None)
+            and (tc is None or math.isclose(t.tc, tc, rel_tol=1e-9))
             and abs(t.scene.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI]
     if not like:
         return None
-    return min(like, key=lambda t: (abs(math.log(t.n / scene.n_particles)),
-                                    abs(t.scene.contact.restitution
-                                        - scene.contact.restitution), t.name))
+    return min(like, key=lambda t: (_distance(scene, t.scene), t.name))
 
 
+#: under the list of runs when some lower bound was calibrated by a made run
+CALIBRATED_NOTE = ("  (about: a lower bound × what a made run of its kind took against its "
+                   "own; such estimates met ×0.30–4.0 of the actual time, ×2 or better in "
+                   "13 of 19 of Malik's runs: benchmarks/bench_study_forecast.py)")
 #: under the list of runs when some forecast is a lower bound (the total then is one too)
 LOWER_BOUND_NOTE = ("  (probably more: a flow that gravity accelerates outruns its pilot; "
                     "such forecasts met ×0.7–2.3 of the actual time in the forecast "
@@ -320,14 +372,15 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
     echo(f"study {study.name}{' (quick)' if quick else ''}: {len(tasks)} runs, "
          f"{len(done)} already made, {len(todo)} to make; results in {out}/")
     if todo and not analyse_only:
-        seconds, lines, refused, each = forecast(todo, 1 if dask is not None else workers,
-                                                 finished_runs(_made(study, quick, out,
-                                                                     record_dir)))
+        seconds, lines, refused, each = forecast(
+            todo, 1 if dask is not None else workers,
+            lambda: finished_runs(_made(study, quick, out, record_dir)))
         result.forecast_seconds = seconds
         result.failed = list(refused)
         todo = [t for t in todo if t.case.name not in refused]
         where = "a Dask cluster" if dask is not None else f"{workers} worker(s)"
-        bound = "probably more than " if LOWER_BOUND_NOTE in lines else ""
+        bound = ("probably more than " if LOWER_BOUND_NOTE in lines else
+                 "about " if CALIBRATED_NOTE in lines else "")
         head = (f"forecast: {bound}{_duration(seconds)} on {where}" if seconds is not None
                 else "forecast: unknown for some runs (listed)")
         echo(head + (" (measured speed of this machine; docs/forecast.md)"))
