@@ -79,7 +79,7 @@ def smooth_walls(s: Mapping[str, CouetteRun]) -> Check:
                                               "and p0 vanish")
     flat = _pick(s, bumpy=False)
     if not flat:
-        return not_run(ref, st, "0", "the flat-wall run")
+        return not_run(ref, st, "0", "a flat-wall run")
     sigma_zero = all(abs(r.v("sigma0")) <= 2 * r.e("sigma0") + 1e-12 for r in flat)
     cooled = max(r.v("ke_end_over_start") for r in flat)
     ok = sigma_zero and cooled < 0.01
@@ -106,7 +106,7 @@ def ratio_trend(s: Mapping[str, CouetteRun]) -> tuple[Check, bool]:
         rows.append(f"{dim}D, e_w = .84: {_list(runs, 'R')} (spread {100 * spread:.0f} % "
                     f"for ⟨k_τ²⟩ ≥ {SATURATED})")
     if not any_run:
-        return not_run(ref, st, "rise, saturation", "the bumpy e_w = 0.84 run"), False
+        return not_run(ref, st, "rise, saturation", "a bumpy e_w = 0.84 run"), False
     return Check(ref, st, "0 → saturation (≈ 0.2 in Gutt's solution)", "; ".join(rows)
                  + "; flat walls 0", REPRODUCED if ok else PARTLY,
                  "" if ok else "no clear saturation among the rough walls"), ok
@@ -117,7 +117,7 @@ def level(s: Mapping[str, CouetteRun], key: str, attr: str, ref: str, st: str,
     runs = _pick(s, bumpy=True)
     runs = [r for r in runs if theory(r, n=2) is not None]
     if not runs:
-        return not_run(ref, st, "Gutt's solution", "the bumpy run")
+        return not_run(ref, st, "Gutt's solution", "a bumpy run")
     ratios, rows, within = [], [], True
     for r in runs:
         sol, fit = theory(r, n=2), theory(r, fitted=True, n=2)
@@ -155,7 +155,7 @@ def slip_trend(s: Mapping[str, CouetteRun]) -> tuple[Check, bool]:
                 broken.append(f"{dim}D {b.name.split('-')[2]} (⟨k_τ²⟩ {b.v('k2'):.3f}) slips "
                               f"more than {a.name.split('-')[2]} ({a.v('k2'):.3f})")
     if not rows:
-        return not_run(ref, st, "decreasing", "the e_w = 0.84 run"), False
+        return not_run(ref, st, "decreasing", "an e_w = 0.84 run"), False
     ok = not broken
     return Check(ref, st, "decreasing", "; ".join(rows), REPRODUCED if ok else PARTLY,
                  "" if ok else "; ".join(broken) + ": ⟨k_τ²⟩ alone does not order the walls "
@@ -184,7 +184,7 @@ def v_wall_fraction(s: Mapping[str, CouetteRun]) -> Check:
         if len(rough) >= 2:
             spreads.append(float(np.ptp(rough) / np.mean(rough)))
     if not rows:
-        return not_run(ref, st, "≈ constant, a > b > c", "the e_w series run")
+        return not_run(ref, st, "≈ constant, a > b > c", "the e_w series runs")
     spread = max(spreads) if spreads else math.nan
     ok = ordered and (not spreads or spread < 0.2)
     return Check(ref, st, "≈ constant; e_w .96 > .92 > .84",
@@ -206,7 +206,7 @@ def slip_insensitive(s: Mapping[str, CouetteRun]) -> Check:
             spreads.append(float(np.ptp(x)))
             slips += x
     if not spreads:
-        return not_run(ref, st, "insensitive", "the e_w series run")
+        return not_run(ref, st, "insensitive", "the e_w series runs")
     flat = [r.v("slip") for r in _pick(s, bumpy=False)]
     span = float(np.ptp(slips + flat))
     ok = max(spreads) < INSENSITIVE * span
@@ -222,7 +222,7 @@ def regimes(s: Mapping[str, CouetteRun]) -> Check:
           "the centre (ω² < 0), above it v peaks there (ω² > 0)")
     runs = [r for r in _pick(s, e_w=0.84, bumpy=True) if "omega2" in r.values]
     if not runs:
-        return not_run(ref, st, "sign of ω² flips at .125", "the bumpy e_w = 0.84 run")
+        return not_run(ref, st, "sign of ω² flips at .125", "a bumpy e_w = 0.84 run")
     rows, wrong, later = [], [], 0
     for r in runs:
         sol = theory(r, n=2)
@@ -250,7 +250,7 @@ def tags(s: Mapping[str, CouetteRun]) -> Check:
           "γ = .16), the same everywhere in the flow")
     runs = [r for r in _pick(s, bumpy=True) if "t_fit" in r.values]
     if not runs:
-        return not_run(ref, st, "t = 1, q = .25, γ = .16", "the bumpy run")
+        return not_run(ref, st, "t = 1, q = .25, γ = .16", "a bumpy run")
     rows = []
     for key in ("t", "q", "gamma"):
         vals = [r.v(f"{key}_fit") for r in runs]
@@ -298,7 +298,7 @@ def density(s: Mapping[str, CouetteRun]) -> Check:
           "density slip is a first-order model of wall layering")
     runs = _pick(s, e_w=0.84, bumpy=True)
     if not runs:
-        return not_run(ref, st, "smooth s(y)", "the bumpy e_w = 0.84 run")
+        return not_run(ref, st, "smooth s(y)", "a bumpy e_w = 0.84 run")
     rows = [f"{r.dim}D ⟨k_τ²⟩ {r.v('k2'):.3f}: bulk φ/φ_cp {r.v('phi_bulk'):.3f} (bin spread "
             f"{r.v('phi_bulk_ptp'):.3f}), wall layers {r.v('phi_wall_layer'):.3f}"
             for r in runs]
@@ -332,7 +332,7 @@ def isotropy(s: Mapping[str, CouetteRun]) -> Check:
           "tensor relation) and one scalar thermal velocity v describes the grains")
     runs = _pick(s, e_w=0.84, bumpy=True)
     if not runs:
-        return not_run(ref, st, "isotropic", "the bumpy e_w = 0.84 run")
+        return not_run(ref, st, "isotropic", "a bumpy e_w = 0.84 run")
     rows, off = [], []
     worst = 0.0
     for r in runs:
