@@ -29,8 +29,8 @@ from pathlib import Path
 
 from ..scene import Scene
 
-__all__ = ["EventRates", "cell_widths", "crossing_rate", "estimated_rates", "mean_flow_speed",
-           "pilot_rates", "reference_rates", "same_family"]
+__all__ = ["EventRates", "cell_widths", "crossing_rate", "estimated_rates", "family_distance",
+           "mean_flow_speed", "pilot_rates", "reference_rates", "same_family"]
 
 #: a run whose pilot's event rate grew by more than this fraction over its last windows has
 #: not reached its steady rate (as ``pilot.SETTLED``)
@@ -176,7 +176,7 @@ def same_family(scene: Scene, other: Scene) -> bool:
             and abs(other.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI)
 
 
-def _distance(scene: Scene, other: Scene) -> float:
+def family_distance(scene: Scene, other: Scene) -> float:
     """How far a finished run of the family is: N and the run's length (by ratio: a short
     run's rates are more of its start-up's), then e and β (the collision rate of a channel
     grows as e → 1: ×1.8 from e = 0.8 to 0.99 at φ = 0.01)."""
@@ -194,7 +194,7 @@ def _distance(scene: Scene, other: Scene) -> float:
 def reference_rates(scene: Scene, folder: Path, engine: str = "edmd",
                     exclude: Path | None = None) -> EventRates | None:
     """The event rates of the finished ``engine`` run of ``scene``'s family in ``folder``
-    (results files' root attributes) closest in N, e and β (:func:`_distance`), the cell
+    (results files' root attributes) closest in N, e and β (:func:`family_distance`), the cell
     crossings scaled by the cells' widths (Σ 1/w, :func:`cell_widths`); None when there is
     none."""
     import h5py
@@ -218,7 +218,7 @@ def reference_rates(scene: Scene, folder: Path, engine: str = "edmd",
             continue
         if other.run.unit != "time" or not same_family(scene, other):
             continue
-        distance = _distance(scene, other)
+        distance = family_distance(scene, other)
         if best is None or distance < best[0]:
             best = (distance, path, other, a)
     if best is None:

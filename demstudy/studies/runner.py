@@ -254,14 +254,14 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     """The made run that says how far ``scene``'s lower bound falls short: the same engine
     and engine options (t_c), dimension, walls (side, kind, speed), gravity vector, shear,
     run unit and solid fraction (within ``FAMILY_PHI``); the closest in N, run length, e and
-    β (``forecast_events._distance``); None when there is none.
+    β (``forecast_events.family_distance``); None when there is none.
 
     Why: a flow that gravity accelerates outruns its pilot, and the event-driven engine's
     cost per event grows with N beyond what the cost benchmarks (N ≤ 20000) measured. How
     far the bound falls short is a property of the kind of run more than of the run: Malik's
-    two N = 107811 boxes took 2.04× their lower bounds, both; over all of that study's
-    lower-bound runs the shortfall spans ×0.85–91 (docs/forecast.md)."""
-    from ..simulation.forecast_events import FAMILY_PHI, _distance
+    two N = 107811 boxes took 2.04× their lower bounds, both, while over all of that
+    study's lower-bound runs the shortfall spans ×1.0–68 (docs/forecast.md)."""
+    from ..simulation.forecast_events import FAMILY_PHI, family_distance
 
     def kind(s) -> tuple:
         g = s.gravity_vector
@@ -278,7 +278,7 @@ def calibration(scene, engine: str, finished: Sequence[Took],
             and abs(t.scene.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI]
     if not like:
         return None
-    return min(like, key=lambda t: (_distance(scene, t.scene), t.name))
+    return min(like, key=lambda t: (family_distance(scene, t.scene), t.name))
 
 
 #: under the list of runs when some lower bound was calibrated by a made run
