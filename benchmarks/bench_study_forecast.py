@@ -39,6 +39,10 @@ def main(folder: Path) -> None:
         quotients.append(predicted / actual)
         print(f"{t.name:45s} took ×{actual:6.2f}, predicted ×{predicted:6.2f} from "
               f"{like.name}: ×{predicted / actual:.2f}")
+    raw = np.array([t.wall / now[t.name] for t in made])
+    if raw.size:
+        print(f"{raw.size} lower bounds fell short by ×{raw.min():.2f}-{raw.max():.2f} "
+              f"(median ×{np.median(raw):.2f})")
     q = np.array(quotients)
     if q.size:
         print(f"{q.size} of {len(made)} calibrated: predicted/actual median {np.median(q):.2f}, "

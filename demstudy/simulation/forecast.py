@@ -125,7 +125,7 @@ class Forecast:
         if self.lower_bound:
             return (f"forecast: probably more than {_duration(self.seconds)} (likely low: "
                     f"{self.lower_bound}; such forecasts met ×0.7–2.3 of the actual time "
-                    f"in the benchmark's 12 short runs, ×2–34 in Malik's study runs, "
+                    f"in the benchmark's 12 short runs, ×1.0–68 in Malik's study runs, "
                     f"docs/forecast.md) from {self.basis}")
         return (f"forecast: {_duration(self.seconds)} (measured accuracy: within "
                 f"×{self.factor:g} in {self.accuracy_met}) from {self.basis}")

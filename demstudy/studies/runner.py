@@ -288,7 +288,7 @@ CALIBRATED_NOTE = ("  (about: a lower bound × what a made run of its kind took 
 #: under the list of runs when some forecast is a lower bound (the total then is one too)
 LOWER_BOUND_NOTE = ("  (probably more: a flow that gravity accelerates outruns its pilot; "
                     "such forecasts met ×0.7–2.3 of the actual time in the forecast "
-                    "benchmark's short runs, ×2–34 in Malik's study runs, docs/forecast.md)")
+                    "benchmark's short runs, ×1.0–68 in Malik's study runs, docs/forecast.md)")
 
 
 def _duration(seconds: float) -> str:
