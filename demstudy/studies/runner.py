@@ -141,13 +141,14 @@ def _bound_now(made: Took, folder: Path) -> float:
 
 
 def forecast(tasks: Sequence[StudyTask], workers: int,
-             finished: Sequence[Took] | Callable[[], Sequence[Took]] = ()
+             finished: Callable[[], Sequence[Took]] = tuple
              ) -> tuple[float | None, list[str], dict[str, str], dict[str, float]]:
     """The wall time of ``tasks`` on ``workers`` (each run's ``--dry-run`` forecast,
     scheduled longest first; None when a run has no forecast), one line per run, the runs
     the engine refuses (name → why: they are not run) and each forecast run's seconds.
-    A run's lower bound becomes an estimate when a ``finished`` run of the study like it
-    says how much longer such runs took than their own lower bounds (:func:`calibration`)."""
+    A run's lower bound becomes an estimate when a made run of the study like it (from
+    ``finished()``, called only when a lower bound needs it) says how much longer such runs
+    took than their own lower bounds (:func:`calibration`)."""
     from ..accuracy.forecast import makespan
     from ..api import run
     from ..errors import UnsupportedByEngine
@@ -173,7 +174,7 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
         like = None
         if bound:
             if made is None:
-                made = list(finished() if callable(finished) else finished)
+                made = list(finished())
             like = calibration(task.scene(), task.case.engine, made, task.case.options)
         if like is not None:
             if like.name not in again:  # its bound by today's method, in the same folder
