@@ -221,3 +221,48 @@ def test_collisions_logged_before_a_stop_inside_an_interval_are_kept(tmp_path, m
         np.testing.assert_array_equal(value, parts.groups["collisions"][key], err_msg=key)
     for key, value in whole.groups["statistics/angles"].items():
         np.testing.assert_array_equal(value, parts.groups["statistics/angles"][key], key)
+
+
+def test_a_stopped_run_tells_how_far_it_got_and_what_is_left_at_its_own_pace(tmp_path):
+    """Each checkpoint leaves progress.json beside it; a resumed run's plan (``--resume
+    --dry-run``, a study or sweep continuing it) counts what is left at the run's own pace,
+    and the finished run leaves no work folder behind."""
+    from demstudy.simulation import plan_run
+    from demstudy.simulation.progress import PROGRESS, read_progress
+
+    scene = gas()  # 1 + 4 time units in samples of 0.5: 10 sample intervals
+    out, work = tmp_path / "p.h5", tmp_path / "p.ballistic"
+    with pytest.raises(EngineError, match="--resume"):
+        run_scene(scene, "ballistic", RunOptions(out=out, progress=False, wall_limit=0.0))
+    done = read_progress(work)
+    assert done.total == 10 and 1 <= done.samples < 10
+    assert done.time == pytest.approx(0.5 * done.samples)
+    assert done.marks[-1][0] == done.samples and done.wall_seconds > 0
+    plan = plan_run(scene, get_backend("ballistic"), RunOptions(out=out, resume=True),
+                    dry_run=True)
+    left = (10 - done.samples) * done.wall_seconds / done.samples
+    assert plan.as_dict()["left_seconds"] == pytest.approx(left)
+    assert f"{done.samples} of 10 samples done (t = {done.time:.6g})" in plan.describe()
+    fresh = plan_run(scene, get_backend("ballistic"), RunOptions(out=out), dry_run=True)
+    assert fresh.left is None and "left_seconds" not in fresh.as_dict()
+    run_scene(scene, "ballistic", RunOptions(out=out, progress=False, resume=True))
+    assert not (work / PROGRESS).exists() and not work.exists()
+    assert read_progress(work) is None
+
+
+def test_the_pace_left_is_the_latest_stretch_not_the_average():
+    """A run that slows as it goes (a flow gravity heats): 10 samples in 100 s, 10 more in
+    200 s, 2 in 30 s (a stop soon after a checkpoint); the stretch timed is the latest one
+    of at least a quarter of the samples done (12 samples in 230 s), so 18 samples are left
+    for 18 × 230/12 = 345 s (the average pace would say 270 s)."""
+    from demstudy.simulation.progress import Progress
+    from demstudy.simulation.state import RunState
+
+    progress = Progress(22, 40, 11.0, ((10, 100.0), (20, 300.0), (22, 330.0)))
+    assert progress.stretch() == (12, pytest.approx(230.0))
+    assert progress.seconds_left() == pytest.approx(345.0)
+    assert "5.75 min left" in progress.line() and "average: 15 s per sample" in progress.line()
+    assert Progress(3, 10, 1.0, ((3, 6.0),)).seconds_left() == pytest.approx(14.0)
+    old = RunState()  # a checkpoint pickled before RunState.marks resumes without them
+    del old.__dict__["marks"]
+    assert old.marks == ()

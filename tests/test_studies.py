@@ -8,6 +8,7 @@ Dimensionless particle units: d = 1, m = 1; the wall speed U_T = 1 sets the time
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 import types
@@ -277,18 +278,23 @@ def test_cli_refuses_an_unknown_study_and_bad_workers_with_exit_2():
 
 def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
     """A study's runs checkpoint (10 per run); a run stopped midway (here by a wall-clock
-    limit) is continued from its checkpoint by the next ``run_study``, not started again."""
+    limit) is continued from its checkpoint by the next ``run_study``, not started again,
+    and the study's forecast counts what is left of it at its own pace."""
     from demstudy.errors import RunStopped
-    from demstudy.studies.runner import tasks_of
+    from demstudy.simulation.checkpoint import stopped_run
+    from demstudy.studies.runner import forecast, tasks_of
 
     task = next(t for t in tasks_of(TOY, False, tmp_path) if t.case.name == "cell-a")
     assert task.spec.checkpoint_interval == pytest.approx(1.5)  # (5 + 10)/10 time units
-    assert "resume" not in task.spec.options()
+    assert not stopped_run(task.path, "edmd")
     with pytest.raises(RunStopped):
         ds.run(task.scene(), engine="edmd", out=task.path, wall_limit=1e-9,
                checkpoint_interval=task.spec.checkpoint_interval, progress=False)
-    assert not task.path.exists()
-    assert task.spec.options()["resume"] is True
+    assert not task.path.exists() and stopped_run(task.path, "edmd")
+    _total, lines, _refused, seconds = forecast([task], 1)
+    line = next(s for s in lines if "cell-a" in s)
+    assert "samples done (t = " in line and "left at this run's own pace" in line, line
+    assert 0 < seconds["cell-a"] < math.inf
     res = run_study("toy", out=tmp_path, echo=lambda s: None)
     assert "cell-a" in res.made
     done = ds.load(task.path)

@@ -54,11 +54,10 @@ def run_task(task: Task) -> dict[str, Any]:
     """Make one run (in a pool worker or a Dask worker); the engine runs in a child process
     (``isolate``) on one rank. Returns what the ladder records of the execution."""
     from ..api import run
-    from ..simulation.checkpoint import CHECKPOINT
-    from ..simulation.options import work_folder
+    from ..simulation.checkpoint import stopped_run
 
     options = task.spec.options()
-    if (work_folder(Path(task.path), task.spec.engine) / CHECKPOINT).is_file():
+    if stopped_run(Path(task.path), task.spec.engine):
         options["resume"] = True  # a stopped run of the sweep continues from its checkpoint
     started = time.perf_counter()
     res = run(task.scene(), engine=task.spec.engine, out=task.path, isolate=True, np=1,

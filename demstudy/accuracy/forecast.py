@@ -4,7 +4,9 @@ first; ``--dry-run`` prints it and stops).
 Each run's forecast is ``demstudy.simulation.plan_run(..., dry_run=True)`` (this machine's
 measured speed, docs/forecast.md): one per setting (replicas and the reference's t_c ladder
 share it: the forecast does not depend on the seed or t_c). Runs whose results file is
-already there are listed as reused, not forecast. The ladder's wall time on W workers is
+already there are listed as reused, not forecast; a stopped run (its checkpoint in the work
+folder: the sweep continues it) counts what is left of it at its own pace
+(``demstudy.simulation.progress``). The ladder's wall time on W workers is
 the reference phase and then the soft phase, each scheduled longest first onto the least
 busy worker (as ``execute`` starts them). The machine's speed is measured here, once, in the
 parent process (``measure_machine``), so that pool workers find it cached and never
@@ -126,7 +128,8 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
     """The forecast of ``phases`` (``PHASES`` → (to run, done)).
     ``unmeasured``: why the machine's speed is unknown (then no run is forecast)."""
     from ..engines import get_backend
-    from ..simulation import RunOptions, plan_run
+    from ..simulation import RunOptions, plan_run, work_folder
+    from ..simulation.progress import read_progress
 
     result = LadderForecast(workers=workers, unmeasured=unmeasured)
     cache: dict[RunSpec, tuple[float, str]] = {}
@@ -135,6 +138,12 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
             result.runs.append((task.spec.name, "reused", 0.0, "reused (its file is done)"))
         for task in todo:
             key = _key(task.spec)
+            left = read_progress(work_folder(Path(task.path), task.spec.engine))
+            if left is not None and math.isfinite(left.seconds_left()):
+                # a stopped run of the sweep: what is left of it, at its own pace
+                result.runs.append((task.spec.name, phase, left.seconds_left(),
+                                    left.line().removeprefix("resume: ")))
+                continue
             if unmeasured is not None:
                 cache.setdefault(key, (math.nan, "no forecast"))
             elif key not in cache:

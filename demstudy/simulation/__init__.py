@@ -61,6 +61,8 @@ def _run_scene(scene: Scene, engine: str | Any, options: RunOptions) -> Path:
                     print(f"warning: {warning}", file=sys.stderr)
         if plan.forecast is not None:
             print(plan.forecast.line(), file=sys.stderr, flush=True)
+        if plan.left is not None:
+            print(plan.left.line(), file=sys.stderr, flush=True)
     if (options.isolate or options.np > 1) and not in_worker():
         check_run(backend, scene, options)
         return launch_child(backend, scene, options)

@@ -36,6 +36,14 @@ def pickle_atomically(path: Path, obj: Any) -> None:
     write_atomically(path, data + TRAILER + hashlib.sha256(data).hexdigest().encode())
 
 
+def stopped_run(out: Path, engine: str) -> bool:
+    """Whether results file ``out`` of ``engine`` has a stopped run to resume: a checkpoint
+    in its work folder (sweeps and studies continue such a run instead of restarting it)."""
+    from .options import work_folder
+
+    return (work_folder(Path(out), engine) / CHECKPOINT).is_file()
+
+
 def read_checkpoint(path: Path) -> Any:
     """The object :func:`pickle_atomically` wrote to ``path``; :class:`DamagedCheckpoint` when
     the bytes do not match their checksum (flipped, truncated, no trailer), before anything is

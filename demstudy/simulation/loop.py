@@ -51,6 +51,7 @@ from .checkpoint import (
 )
 from .isolation import in_worker
 from .options import RunOptions, check_run, frames_on_resume, work_folder
+from .progress import PROGRESS, write_progress
 from .results import run_results
 from .schedule import Schedule, StopInInterval, StopRequest
 from .state import RunState
@@ -350,13 +351,16 @@ class Simulation:
         if self.backend.rank != 0:
             return
         self.workdir.mkdir(parents=True, exist_ok=True)
-        snapshot = dataclasses.replace(
-            state, wall_seconds=state.wall_seconds + time.perf_counter() - started)
+        wall = state.wall_seconds + time.perf_counter() - started
+        state.marks = (*state.marks, (state.samples, wall))
+        snapshot = dataclasses.replace(state, wall_seconds=wall)
         pickle_atomically(self.workdir / CHECKPOINT,
                           {"scene": scene_to_toml(self.scene), "version": self._version(),
                            "engine": self.backend.name, "out": str(self.out),
                            "units": UNITS_NOTE, "backend": saved, "run": snapshot})
         self.backend.cleanup(saved)  # committed: the engine's older files go
+        write_progress(self.workdir, state.samples, self.schedule.n_total, self.backend.time,
+                       state.marks)
 
     # -- main loop ------------------------------------------------------------------------
     def run(self) -> Path:
@@ -429,6 +433,7 @@ class Simulation:
         results = run_results(self, state, extra)
         path = write_results(self.out, results)
         (self.workdir / CHECKPOINT).unlink(missing_ok=True)
+        (self.workdir / PROGRESS).unlink(missing_ok=True)
         self.backend.cleanup(None)
         if self.workdir.exists() and not any(self.workdir.iterdir()):
             self.workdir.rmdir()

@@ -4,7 +4,8 @@ wall-time forecast; ``demstudy run --dry-run`` shows them and stops there.
 Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts (otherwise a wall speed
 or the shear rate sets the time unit τ). The pilot runs (or comes from its cache) when a
 soft-contact engine must choose k_n itself (no ``soft.stiffness``, no ``soft.hardness``), and
-for the event-driven engine's forecast; never for a resumed run's forecast alone.
+for the event-driven engine's forecast; never for a resumed run's forecast alone. A resumed
+run's plan also says how far it got and what is left at its own pace (simulation.progress).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from ..contact.pilot import PILOT_SECONDS, PilotResult, run_pilot
@@ -19,7 +21,8 @@ from ..contact.stiffness import ContactSetup, contact_setup
 from ..errors import RunAborted, RunStopped
 from ..scene import Scene
 from .forecast import Forecast, NoForecast, RatesNotMeasured, forecast_run
-from .options import RunOptions
+from .options import RunOptions, work_folder
+from .progress import Progress, read_progress
 
 __all__ = ["FORECAST_ENGINES", "RunPlan", "needs_pilot", "plan_run"]
 
@@ -42,6 +45,8 @@ class RunPlan:
     pilot: PilotResult | None
     forecast: Forecast | None
     no_forecast: str = ""  # why there is none, when the run's cost is unknowable in advance
+    #: a resumed run: how far it got and what is left at its own pace
+    left: Progress | None = None
 
     def as_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"engine": self.engine, "n_particles": self.n_particles}
@@ -60,6 +65,8 @@ class RunPlan:
             out.update(self.forecast.attrs())
         else:
             out["forecast"] = self._no_forecast()
+        if self.left is not None:
+            out.update(self.left.attrs())
         return out
 
     def _no_forecast(self) -> str:
@@ -82,6 +89,8 @@ class RunPlan:
             lines.append(f"pilot: {self.pilot.summary()}")
         lines.append(self.forecast.line() if self.forecast is not None
                      else f"forecast: {self._no_forecast()}")
+        if self.left is not None:
+            lines.append(self.left.line())
         return "\n".join(lines)
 
 
@@ -138,8 +147,10 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
             raise _interrupted(backend.name) from None
         except Exception as exc:  # noqa: BLE001 - a forecast never stops a run
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
-    n = scene.n_particles
-    return RunPlan(backend.name, n, setup, pilot, forecast, no_forecast)
+    left = None
+    if options.resume:  # the whole run's forecast, and what is left of it at its own pace
+        left = read_progress(work_folder(Path(options.out).resolve(), backend.name))
+    return RunPlan(backend.name, scene.n_particles, setup, pilot, forecast, no_forecast, left)
 
 
 def _interrupted(engine: str) -> RunAborted:

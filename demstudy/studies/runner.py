@@ -33,8 +33,8 @@ CHECKPOINTS_PER_RUN = 10
 @dataclass(frozen=True)
 class _Spec:
     """What ``demstudy.accuracy.execute`` needs of a run's settings (duck-typed RunSpec):
-    ``options()`` are the keywords of ``ds.run`` — the engine options, the checkpoint
-    interval and, when the run's work folder holds a checkpoint, ``resume``."""
+    ``options()`` are the keywords of ``ds.run``: the engine options and the checkpoint
+    interval (``run_task`` adds ``resume`` when the run's work folder holds a checkpoint)."""
 
     name: str
     engine: str
@@ -44,14 +44,9 @@ class _Spec:
     checkpoint_interval: float | None = None
 
     def options(self) -> dict:
-        from ..simulation.checkpoint import CHECKPOINT
-        from ..simulation.options import work_folder
-
         options = dict(self.engine_options)
         if self.checkpoint_interval:
             options["checkpoint_interval"] = self.checkpoint_interval
-            if self.out and (work_folder(Path(self.out), self.engine) / CHECKPOINT).is_file():
-                options["resume"] = True  # an interrupted study continues the run
         return options
 
 
@@ -146,23 +141,33 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
     """The wall time of ``tasks`` on ``workers`` (each run's ``--dry-run`` forecast,
     scheduled longest first; None when a run has no forecast), one line per run, the runs
     the engine refuses (name → why: they are not run) and each forecast run's seconds.
-    A run's lower bound becomes an estimate when a made run of the study like it (from
-    ``finished()``, called only when a lower bound needs it) says how much longer such runs
-    took than their own lower bounds (:func:`calibration`)."""
+    A stopped run (a checkpoint in its work folder) counts what is left of it at its own
+    pace (:mod:`demstudy.simulation.progress`). A run's lower bound becomes an estimate
+    when a made run of the study like it (from ``finished()``, called only when a lower
+    bound needs it) says how much longer such runs took than their own lower bounds
+    (:func:`calibration`)."""
     from ..accuracy.forecast import makespan
     from ..api import run
     from ..errors import UnsupportedByEngine
+    from ..simulation.checkpoint import stopped_run
 
     seconds, lines, unknown, refused, lower = {}, [], False, {}, False
     made: list[Took] | None = None  # read when a lower bound first needs it
     again: dict[str, float] = {}  # made run → its lower bound forecast again now
     for task in tasks:
+        resume = stopped_run(task.path, task.case.engine)
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
-                       progress=False, **task.case.options)
+                       progress=False, resume=resume, **task.case.options)
         except (UnsupportedByEngine, BadOption) as exc:
             refused[task.case.name] = str(exc)
             lines.append(f"  {task.case.name} ({task.case.engine}): refused: {exc}")
+            continue
+        left = plan.get("left_seconds", math.nan)
+        if math.isfinite(left):  # a stopped run: what is left of it, at its own pace
+            seconds[task.case.name] = float(left)
+            lines.append(f"  {task.case.name} ({task.case.engine}): "
+                         f"{plan['left'].removeprefix('resume: ')}")
             continue
         s = plan.get("forecast_seconds")
         if s is None or not math.isfinite(s):
