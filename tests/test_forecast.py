@@ -425,7 +425,7 @@ def test_gravity_given_as_an_angle_is_forecast_and_matched():
     drive (wall speed) is another family."""
     from demstudy.scene import load_scene
     from demstudy.simulation.forecast import accelerates
-    from demstudy.simulation.forecast_events import same_family
+    from demstudy.simulation.forecast_events import drive, same_family
 
     chute = load_scene("campbell1982/chute-20")
     assert chute.gravity.direction is None and accelerates(chute)
@@ -434,3 +434,10 @@ def test_gravity_given_as_an_angle_is_forecast_and_matched():
     couette = load_scene("campbell1982/couette-rough")
     faster = load_scene("campbell1982/couette-rough", ["walls.1.velocity=10.0"])
     assert not same_family(couette, faster)
+    # a bumpy base adds wall collisions: another family than the flat base at the same angle
+    flat, bumpy = load_scene("campbell1982/chute-30"), load_scene("campbell1982/chute-bumpy-30")
+    assert not same_family(flat, bumpy)
+    (f_dim, f_walls, *f_rest), (b_dim, b_walls, *b_rest) = drive(flat), drive(bumpy)
+    assert (f_dim, f_rest) == (b_dim, b_rest)  # the same angle, the same wall speeds ...
+    assert [(w[0], w[2]) for w in f_walls] == [(w[0], w[2]) for w in b_walls]
+    assert [w[1] for w in b_walls] == ["bumpy"] != [w[1] for w in f_walls]  # ... but the kind

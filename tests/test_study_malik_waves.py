@@ -92,7 +92,7 @@ def test_each_tc_twin_is_its_box_at_a_smaller_tc_only(tag: str) -> None:
     assert twin.load() == box.load() and twin.scene == box.scene
     assert not box.options
     assert not any("tc" in c.name for c in waves.cases(True))
-    assert sum("-tc" in n for n in by_name) == len(waves.TC_TWINS) == 3
+    assert sum("-tc" in n for n in by_name) == len(waves.TC_TWINS) == 4
 
 
 def test_quick_subset_is_small_and_short() -> None:

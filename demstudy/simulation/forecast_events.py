@@ -29,8 +29,9 @@ from pathlib import Path
 
 from ..scene import Scene
 
-__all__ = ["EventRates", "cell_widths", "crossing_rate", "estimated_rates", "family_distance",
-           "mean_flow_speed", "pilot_rates", "reference_rates", "same_family"]
+__all__ = ["EventRates", "cell_widths", "crossing_rate", "drive", "estimated_rates",
+           "family_distance", "mean_flow_speed", "pilot_rates", "reference_rates",
+           "same_family", "similar_fraction"]
 
 #: a run whose pilot's event rate grew by more than this fraction over its last windows has
 #: not reached its steady rate (as ``pilot.SETTLED``)
@@ -160,20 +161,29 @@ def pilot_rates(pilot, accelerating: bool = False,
 
 
 # -- finished runs of the same scene family -------------------------------------------------
+def drive(s: Scene) -> tuple:
+    """What drives a run's flow, and so sets its speed and event rates: the dimension, the
+    walls (side, kind: a bumpy wall adds collisions, and speed), gravity (vector, magnitude
+    included), the shear rate and whether y is periodic. Runs with the same drive differ in
+    N, lengths, φ, e and β only (:func:`same_family`; the study forecast's calibration)."""
+    g = s.gravity_vector
+    return (s.dimension, tuple((w.side, w.kind, round(w.velocity, 6)) for w in s.walls),
+            None if g is None else tuple(round(x, 6) for x in g),
+            None if s.shear is None else round(s.shear.rate, 6), s.y_periodic)
+
+
+def similar_fraction(scene: Scene, other: Scene) -> bool:
+    """Solid fractions within ``FAMILY_PHI`` of each other."""
+    return abs(other.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI
+
+
 def same_family(scene: Scene, other: Scene) -> bool:
     """Whether a finished run of ``other`` tells the event rates of ``scene``: the same
-    dimension, walls and their speeds, gravity (vector, magnitude included) and shear rate
-    (the drive sets the flow's speed and so its event rates), the same wall gap (box size
-    along y) and a solid fraction within ``FAMILY_PHI``; N, the periodic lengths, e and β
-    may differ."""
-    def shape(s: Scene) -> tuple:
-        g = s.gravity_vector
-        gravity = None if g is None else tuple(round(x, 6) for x in g)
-        return (s.dimension, tuple((w.side, round(w.velocity, 6)) for w in s.walls), gravity,
-                None if s.shear is None else round(s.shear.rate, 6), s.y_periodic,
-                round(s.box.size[1], 6))
-    return (shape(scene) == shape(other)
-            and abs(other.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI)
+    :func:`drive`, the same wall gap (box size along y) and a solid fraction within
+    ``FAMILY_PHI``; N, the periodic lengths, e and β may differ."""
+    return (drive(scene) == drive(other)
+            and round(scene.box.size[1], 6) == round(other.box.size[1], 6)
+            and similar_fraction(scene, other))
 
 
 def family_distance(scene: Scene, other: Scene) -> float:

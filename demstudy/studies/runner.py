@@ -258,8 +258,9 @@ def _tc(engine: str, options: Mapping[str, Any]) -> float | None:
 def calibration(scene, engine: str, finished: Sequence[Took],
                 options: Mapping[str, Any] | None = None) -> Took | None:
     """The made run that says how far ``scene``'s lower bound falls short: the same engine
-    and engine options (t_c), dimension, walls (side, kind, speed), gravity vector, shear,
-    run unit and solid fraction (within ``FAMILY_PHI``); the closest in N, run length, e and
+    and engine options (t_c), the same drive (``forecast_events.drive``: walls with their
+    kind and speed, gravity, shear), run unit and solid fraction (within ``FAMILY_PHI``;
+    the wall gap may differ); the closest in N, run length, e and
     β (``forecast_events.family_distance``); None when there is none.
 
     Why: a flow that gravity accelerates outruns its pilot, and the event-driven engine's
@@ -267,21 +268,16 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     far the bound falls short is a property of the kind of run more than of the run: Malik's
     two N = 107811 boxes took 2.04× their lower bounds, both, while over all of that
     study's lower-bound runs the shortfall spans ×1.0–68 (docs/forecast.md)."""
-    from ..simulation.forecast_events import FAMILY_PHI, family_distance
-
-    def kind(s) -> tuple:
-        g = s.gravity_vector
-        return (s.dimension, tuple((w.side, w.kind, round(w.velocity, 6)) for w in s.walls),
-                None if g is None else tuple(round(x, 6) for x in g),
-                None if s.shear is None else round(s.shear.rate, 6), s.run.unit)
+    from ..simulation.forecast_events import drive, family_distance, similar_fraction
 
     tc = _tc(engine, options or {})
     if not scene.solid_fraction > 0:
         return None
-    like = [t for t in finished if t.engine == engine and kind(t.scene) == kind(scene)
+    like = [t for t in finished if t.engine == engine and drive(t.scene) == drive(scene)
+            and t.scene.run.unit == scene.run.unit
             and (t.tc is None) == (tc is None)
             and (tc is None or math.isclose(t.tc, tc, rel_tol=1e-9))
-            and abs(t.scene.solid_fraction / scene.solid_fraction - 1) <= FAMILY_PHI]
+            and similar_fraction(scene, t.scene)]
     if not like:
         return None
     return min(like, key=lambda t: (family_distance(scene, t.scene), t.name))
@@ -290,7 +286,7 @@ def calibration(scene, engine: str, finished: Sequence[Took],
 #: under the list of runs when some lower bound was calibrated by a made run
 CALIBRATED_NOTE = ("  (about: a lower bound × what a made run of its kind took against its "
                    "own; such estimates met ×0.30–4.0 of the actual time, ×2 or better in "
-                   "13 of 19 of Malik's runs: benchmarks/bench_study_forecast.py)")
+                   "14 of 20 of Malik's runs: benchmarks/bench_study_forecast.py)")
 #: under the list of runs when some forecast is a lower bound (the total then is one too)
 LOWER_BOUND_NOTE = ("  (probably more: a flow that gravity accelerates outruns its pilot; "
                     "such forecasts met ×0.7–2.3 of the actual time in the forecast "
