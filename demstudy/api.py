@@ -49,7 +49,9 @@ def run(scene: Scene | str | os.PathLike, engine: str | type | None = None,
     ``stiffness_basis``), the pilot's impact speeds and collision rate, and the wall-time
     forecast (``forecast_seconds``, ``forecast_basis``, ``forecast_factor``; without this
     machine's measured speed, which a dry run never measures, ``forecast`` says why there is
-    none), as ``demstudy run --dry-run``."""
+    none), as ``demstudy run --dry-run``; with ``resume``, what is left of the stopped run at
+    its own pace (``left_seconds``, ``left``, ``intervals_done``, ``intervals_total``:
+    ``demstudy.simulation.progress``)."""
     from .engines import DEFAULT_ENGINE, get_backend
     from .simulation import RunOptions, check_run, plan_run, run_scene
 

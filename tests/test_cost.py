@@ -389,10 +389,13 @@ def test_a_ladder_run_stopped_with_a_checkpoint_continues_from_it(tmp_path, monk
     assert seen[1]["tc"] == 1e-5
     # the ladder's forecast counts what is left of the stopped run at its own pace
     from demstudy.accuracy.forecast import ladder_forecast
-    from demstudy.simulation.progress import write_progress
+    from demstudy.simulation.checkpoint import pickle_atomically
+    from demstudy.simulation.progress import Progress, scene_digest, write_progress
 
-    write_progress(folder, 2, 10, 0.4, ((2, 10.0),))  # 2 of 10 samples in 10 s
+    digest = pickle_atomically(folder / CHECKPOINT, {"a": "checkpoint"})
+    write_progress(folder, Progress(2, 10, 0.4, ((2, 10.0),)),  # 2 of 10 intervals in 10 s
+                   digest, scene_digest(task.scene_toml))
     plan = ladder_forecast({"reference": ([task], [])}, workers=1, unmeasured="not measured")
     (name, phase, seconds, line), = plan.runs
     assert phase == "reference" and seconds == pytest.approx(40.0)
-    assert "2 of 10 samples done" in line and plan.total == pytest.approx(40.0)
+    assert "2 of 10 sample intervals done" in line and plan.total == pytest.approx(40.0)

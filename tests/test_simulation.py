@@ -15,7 +15,7 @@ from demstudy.analysis.registry import STATISTICS
 from demstudy.engines import backend_names, get_backend, register_backend
 from demstudy.errors import EngineError, UnsupportedByEngine
 from demstudy.io.results import read_results
-from demstudy.scene import SceneError, validate_scene
+from demstudy.scene import SceneError, scene_to_toml, validate_scene
 from demstudy.simulation import RunOptions, Simulation, run_scene
 
 GAS = {"dimension": 2, "box": {"size": [12.0, 12.0]}, "particles": {"count": 40},
@@ -235,34 +235,86 @@ def test_a_stopped_run_tells_how_far_it_got_and_what_is_left_at_its_own_pace(tmp
     with pytest.raises(EngineError, match="--resume"):
         run_scene(scene, "ballistic", RunOptions(out=out, progress=False, wall_limit=0.0))
     done = read_progress(work)
-    assert done.total == 10 and 1 <= done.samples < 10
-    assert done.time == pytest.approx(0.5 * done.samples)
-    assert done.marks[-1][0] == done.samples and done.wall_seconds > 0
+    assert done.total == 10 and 1 <= done.done < 10 and done.done == int(done.done)
+    assert done.time == pytest.approx(0.5 * done.done)
+    assert done.marks[-1][0] == done.done and done.wall_seconds > 0
     plan = plan_run(scene, get_backend("ballistic"), RunOptions(out=out, resume=True),
                     dry_run=True)
-    left = (10 - done.samples) * done.wall_seconds / done.samples
+    left = (10 - done.done) * done.wall_seconds / done.done
     assert plan.as_dict()["left_seconds"] == pytest.approx(left)
-    assert f"{done.samples} of 10 samples done (t = {done.time:.6g})" in plan.describe()
+    assert f"{done.done:.4g} of 10 sample intervals done (t = {done.time:.6g})" in (
+        plan.describe())
     fresh = plan_run(scene, get_backend("ballistic"), RunOptions(out=out), dry_run=True)
     assert fresh.left is None and "left_seconds" not in fresh.as_dict()
+    other = gas(particles={"count": 41})  # another scene: its progress is not this one
+    assert read_progress(work, scene_to_toml(other)) is None
+    assert read_progress(work, scene_to_toml(scene)) == done
     run_scene(scene, "ballistic", RunOptions(out=out, progress=False, resume=True))
     assert not (work / PROGRESS).exists() and not work.exists()
     assert read_progress(work) is None
 
 
+def test_a_stop_inside_an_interval_counts_the_part_done(tmp_path, monkeypatch):
+    """A stop between two event chunks lands inside a sample interval: the progress counts
+    the part done (t / interval), not a whole interval less or more."""
+    from demstudy.engines.edmd import core
+    from demstudy.simulation.progress import read_progress
+
+    monkeypatch.setattr(core, "STALL_CHUNK", 50)
+    scene = validate_scene({**small_scene("profiles"), "run": {
+        "equilibration": 0.0, "production": 4.0, "sample_interval": 2.0}})
+    out = tmp_path / "p.h5"
+    with pytest.raises(EngineError, match="inside a sample interval"):
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, wall_limit=0.0))
+    done = read_progress(tmp_path / "p.edmd", scene_to_toml(scene))
+    assert 0 < done.time < 2.0 and done.total == 2
+    assert done.done == pytest.approx(done.time / 2.0)  # a fraction of the first interval
+    assert done.seconds_left() == pytest.approx(
+        (2 - done.done) * done.wall_seconds / done.done)
+
+
+def test_a_progress_file_of_another_checkpoint_is_ignored(tmp_path):
+    """progress.json names the checkpoint it belongs to (SHA-256): one left by a crash
+    between the two writes, or a checkpoint rewritten by a version that writes none, is not
+    read as this checkpoint's progress; a checkpoint pickled before RunState.marks resumes
+    (no pace until its next checkpoint, which has one mark)."""
+    from demstudy.simulation.checkpoint import CHECKPOINT, pickle_atomically, read_checkpoint
+    from demstudy.simulation.progress import PROGRESS, read_progress
+
+    scene = gas()
+    out, work = tmp_path / "p.h5", tmp_path / "p.ballistic"
+    with pytest.raises(EngineError, match="--resume"):
+        run_scene(scene, "ballistic", RunOptions(out=out, progress=False, wall_limit=0.0))
+    assert read_progress(work) is not None
+    saved = read_checkpoint(work / CHECKPOINT)
+    del saved["run"].__dict__["marks"]  # as pickled before RunState.marks
+    assert saved["run"].marks == ()
+    pickle_atomically(work / CHECKPOINT, saved)  # the old progress file is now another's
+    assert (work / PROGRESS).exists() and read_progress(work) is None
+    (work / PROGRESS).unlink()
+    with pytest.raises(EngineError, match="--resume"):
+        run_scene(scene, "ballistic", RunOptions(out=out, progress=False, resume=True,
+                                                 wall_limit=0.0))
+    again = read_progress(work)
+    assert len(again.marks) == 1 and again.done > saved["run"].samples
+    parts = read_results(run_scene(scene, "ballistic", RunOptions(
+        out=out, progress=False, resume=True)))
+    np.testing.assert_allclose(parts.timeseries["time"], np.arange(11) * 0.5)
+
+
 def test_the_pace_left_is_the_latest_stretch_not_the_average():
-    """A run that slows as it goes (a flow gravity heats): 10 samples in 100 s, 10 more in
+    """A run that slows as it goes (a flow gravity heats): 10 intervals in 100 s, 10 more in
     200 s, 2 in 30 s (a stop soon after a checkpoint); the stretch timed is the latest one
-    of at least a quarter of the samples done (12 samples in 230 s), so 18 samples are left
-    for 18 × 230/12 = 345 s (the average pace would say 270 s)."""
+    of at least a quarter of the intervals done (12 in 230 s), so 18 intervals are left for
+    18 × 230/12 = 345 s (the average pace would say 270 s)."""
     from demstudy.simulation.progress import Progress
-    from demstudy.simulation.state import RunState
 
     progress = Progress(22, 40, 11.0, ((10, 100.0), (20, 300.0), (22, 330.0)))
     assert progress.stretch() == (12, pytest.approx(230.0))
     assert progress.seconds_left() == pytest.approx(345.0)
-    assert "5.75 min left" in progress.line() and "average: 15 s per sample" in progress.line()
+    line = progress.line()
+    assert "5.75 min left" in line and "average: 15 s per interval" in line
     assert Progress(3, 10, 1.0, ((3, 6.0),)).seconds_left() == pytest.approx(14.0)
-    old = RunState()  # a checkpoint pickled before RunState.marks resumes without them
-    del old.__dict__["marks"]
-    assert old.marks == ()
+    assert Progress(2.5, 4, 1.0, ((2.5, 5.0),)).seconds_left() == pytest.approx(3.0)
+    for nothing in (Progress(0, 10, 0.0, ()), Progress(0, 10, 0.0, ((0, 0.0),))):
+        assert math.isnan(nothing.seconds_left()) and "no pace" in nothing.line()

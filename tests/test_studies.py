@@ -8,7 +8,6 @@ Dimensionless particle units: d = 1, m = 1; the wall speed U_T = 1 sets the time
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 import types
@@ -282,7 +281,9 @@ def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
     and the study's forecast counts what is left of it at its own pace."""
     from demstudy.errors import RunStopped
     from demstudy.simulation.checkpoint import stopped_run
-    from demstudy.studies.runner import forecast, tasks_of
+    from demstudy.simulation.options import work_folder
+    from demstudy.simulation.progress import read_progress
+    from demstudy.studies.runner import OWN_PACE_NOTE, forecast, tasks_of
 
     task = next(t for t in tasks_of(TOY, False, tmp_path) if t.case.name == "cell-a")
     assert task.spec.checkpoint_interval == pytest.approx(1.5)  # (5 + 10)/10 time units
@@ -291,10 +292,11 @@ def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
         ds.run(task.scene(), engine="edmd", out=task.path, wall_limit=1e-9,
                checkpoint_interval=task.spec.checkpoint_interval, progress=False)
     assert not task.path.exists() and stopped_run(task.path, "edmd")
+    left = read_progress(work_folder(task.path, "edmd"), task.scene_toml)
     _total, lines, _refused, seconds = forecast([task], 1)
     line = next(s for s in lines if "cell-a" in s)
-    assert "samples done (t = " in line and "left at this run's own pace" in line, line
-    assert 0 < seconds["cell-a"] < math.inf
+    assert "sample intervals done (t = " in line and "left at this run's own pace" in line
+    assert seconds["cell-a"] == pytest.approx(left.seconds_left()) and OWN_PACE_NOTE in lines
     res = run_study("toy", out=tmp_path, echo=lambda s: None)
     assert "cell-a" in res.made
     done = ds.load(task.path)

@@ -138,7 +138,8 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
             result.runs.append((task.spec.name, "reused", 0.0, "reused (its file is done)"))
         for task in todo:
             key = _key(task.spec)
-            left = read_progress(work_folder(Path(task.path), task.spec.engine))
+            left = read_progress(work_folder(Path(task.path), task.spec.engine),
+                                 task.scene_toml)
             if left is not None and math.isfinite(left.seconds_left()):
                 # a stopped run of the sweep: what is left of it, at its own pace
                 result.runs.append((task.spec.name, phase, left.seconds_left(),

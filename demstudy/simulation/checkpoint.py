@@ -28,12 +28,28 @@ TRAILER = b"\n#sha256="  # then the 64 hex digits of the pickle's SHA-256
 _TRAILER_SIZE = len(TRAILER) + 64
 
 
-def pickle_atomically(path: Path, obj: Any) -> None:
+def pickle_atomically(path: Path, obj: Any) -> str:
     """Pickle ``obj`` to ``path`` atomically (temporary file, fsync, rename), followed by the
     SHA-256 trailer: a checkpoint is whole or absent, also when the disk is full, and damage
-    done afterwards is detected by :func:`read_checkpoint`."""
+    done afterwards is detected by :func:`read_checkpoint`. Returns the SHA-256 (hex)."""
     data = pickle.dumps(obj)
-    write_atomically(path, data + TRAILER + hashlib.sha256(data).hexdigest().encode())
+    digest = hashlib.sha256(data).hexdigest()
+    write_atomically(path, data + TRAILER + digest.encode())
+    return digest
+
+
+def checkpoint_digest(path: Path) -> str | None:
+    """The SHA-256 a checkpoint's trailer holds (its last bytes, the pickle unread); None
+    when there is no readable trailer."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(-_TRAILER_SIZE, 2)
+            trailer = fh.read()
+    except OSError:
+        return None
+    if not trailer.startswith(TRAILER):
+        return None
+    return trailer[len(TRAILER):].decode("ascii", "replace")
 
 
 def stopped_run(out: Path, engine: str) -> bool:

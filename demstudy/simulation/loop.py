@@ -51,7 +51,7 @@ from .checkpoint import (
 )
 from .isolation import in_worker
 from .options import RunOptions, check_run, frames_on_resume, work_folder
-from .progress import PROGRESS, write_progress
+from .progress import PROGRESS, Progress, scene_digest, write_progress
 from .results import run_results
 from .schedule import Schedule, StopInInterval, StopRequest
 from .state import RunState
@@ -59,9 +59,11 @@ from .tracks import MarkedTracks
 
 __all__ = ["Simulation"]
 
-# 2: RunState.health. RunState.tracks (marked grains' paths) came later without a new
-# version: a checkpoint pickled before it unpickles with the class default (None), and only
-# lattice scenes with marked grains have tracks (none were checkpointed before them)
+# 2: RunState.health. RunState.tracks (marked grains' paths) and RunState.marks (the run's
+# pace at each checkpoint) came later without a new version: a checkpoint pickled before
+# them unpickles with the class defaults (None, ()); only lattice scenes with marked grains
+# have tracks (none were checkpointed before them), and a run resumed without marks has no
+# pace until its next checkpoint
 LOOP_VERSION = f"demstudy {__version__} (simulation loop 2)"
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 
@@ -352,15 +354,19 @@ class Simulation:
             return
         self.workdir.mkdir(parents=True, exist_ok=True)
         wall = state.wall_seconds + time.perf_counter() - started
-        state.marks = (*state.marks, (state.samples, wall))
+        done = self.schedule.done(self.backend, state.samples)  # a stop may land mid-interval
+        state.marks = (*state.marks, (done, wall))
         snapshot = dataclasses.replace(state, wall_seconds=wall)
-        pickle_atomically(self.workdir / CHECKPOINT,
-                          {"scene": scene_to_toml(self.scene), "version": self._version(),
-                           "engine": self.backend.name, "out": str(self.out),
-                           "units": UNITS_NOTE, "backend": saved, "run": snapshot})
+        scene_toml = scene_to_toml(self.scene)
+        # the progress file describes the checkpoint written next; without it, none
+        (self.workdir / PROGRESS).unlink(missing_ok=True)
+        digest = pickle_atomically(
+            self.workdir / CHECKPOINT,
+            {"scene": scene_toml, "version": self._version(), "engine": self.backend.name,
+             "out": str(self.out), "units": UNITS_NOTE, "backend": saved, "run": snapshot})
         self.backend.cleanup(saved)  # committed: the engine's older files go
-        write_progress(self.workdir, state.samples, self.schedule.n_total, self.backend.time,
-                       state.marks)
+        write_progress(self.workdir, Progress(done, self.schedule.n_total, self.backend.time,
+                                              state.marks), digest, scene_digest(scene_toml))
 
     # -- main loop ------------------------------------------------------------------------
     def run(self) -> Path:

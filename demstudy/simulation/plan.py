@@ -19,7 +19,7 @@ from typing import Any
 from ..contact.pilot import PILOT_SECONDS, PilotResult, run_pilot
 from ..contact.stiffness import ContactSetup, contact_setup
 from ..errors import RunAborted, RunStopped
-from ..scene import Scene
+from ..scene import Scene, scene_to_toml
 from .forecast import Forecast, NoForecast, RatesNotMeasured, forecast_run
 from .options import RunOptions, work_folder
 from .progress import Progress, read_progress
@@ -149,7 +149,8 @@ def plan_run(scene: Scene, backend: Any, options: RunOptions, *,
             warnings.warn(f"no forecast: {type(exc).__name__}: {exc}", stacklevel=2)
     left = None
     if options.resume:  # the whole run's forecast, and what is left of it at its own pace
-        left = read_progress(work_folder(Path(options.out).resolve(), backend.name))
+        left = read_progress(work_folder(Path(options.out).resolve(), backend.name),
+                             scene_to_toml(scene))
     return RunPlan(backend.name, scene.n_particles, setup, pilot, forecast, no_forecast, left)
 
 

@@ -16,6 +16,7 @@ import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any
 
 from ..scene import Scene
 from .options import RunOptions
@@ -163,6 +164,18 @@ class Schedule:
     n_ckpt: int
     by_collisions: bool
     by_steps: bool = False
+
+    def done(self, backend: Any, samples: int) -> float:
+        """Sample intervals done, with the part of the current one (a stop between two
+        event chunks lands inside an interval): the backend's time, pair collisions per
+        particle or lattice steps over the interval, kept within [samples, samples + 1]."""
+        if self.by_steps:
+            reached = backend.steps / self.interval
+        elif self.by_collisions:
+            reached = backend.collisions / (self.interval * backend.n_particles)
+        else:
+            reached = backend.time / self.interval
+        return min(max(float(reached), samples), samples + 1.0)
 
     @classmethod
     def of(cls, scene: Scene, options: RunOptions, time_step: float | None) -> Schedule:

@@ -47,10 +47,10 @@ class RunState:
     health: dict[str, list] = field(default_factory=dict)
     # marked grains' paths, every sample from t = 0 (engines with ``marked``), else None
     tracks: MarkedTracks | None = None
-    # (samples done, wall seconds taken) at each checkpoint: the run's own pace, for the
+    # (sample intervals done, wall seconds taken) at each checkpoint: the run's own pace, for the
     # forecast of what is left when it resumes (simulation.progress); a checkpoint pickled
     # before it unpickles with this class default
-    marks: tuple[tuple[int, float], ...] = ()
+    marks: tuple[tuple[float, float], ...] = ()
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)

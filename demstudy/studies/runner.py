@@ -40,7 +40,6 @@ class _Spec:
     engine: str
     engine_options: tuple[tuple[str, Any], ...] = ()
     relative_cost: float = 1.0
-    out: str = ""
     checkpoint_interval: float | None = None
 
     def options(self) -> dict:
@@ -114,7 +113,7 @@ def tasks_of(study: Study, quick: bool, out: Path, engines: Sequence[str] | None
         path = out / "runs" / f"{case.name}.h5"
         tasks.append(StudyTask(case, quick, path,
                                _Spec(case.name, case.engine,
-                                     tuple(sorted(case.options.items())), out=str(path),
+                                     tuple(sorted(case.options.items())),
                                      checkpoint_interval=checkpoint_interval(scene)),
                                scene_to_toml(scene)))
     return tasks
@@ -149,25 +148,27 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
     from ..accuracy.forecast import makespan
     from ..api import run
     from ..errors import UnsupportedByEngine
-    from ..simulation.checkpoint import stopped_run
+    from ..simulation.options import work_folder
+    from ..simulation.progress import read_progress
 
-    seconds, lines, unknown, refused, lower = {}, [], False, {}, False
+    seconds, lines, unknown, refused, lower, own = {}, [], False, {}, False, False
     made: list[Took] | None = None  # read when a lower bound first needs it
     again: dict[str, float] = {}  # made run → its lower bound forecast again now
     for task in tasks:
-        resume = stopped_run(task.path, task.case.engine)
+        left = read_progress(work_folder(task.path, task.case.engine), task.scene_toml)
+        if left is not None and math.isfinite(left.seconds_left()):
+            # a stopped run of this scene: what is left of it, at its own pace (no pilot)
+            seconds[task.case.name] = left.seconds_left()
+            lines.append(f"  {task.case.name} ({task.case.engine}): "
+                         f"{left.line().removeprefix('resume: ')}")
+            own = True
+            continue
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
-                       progress=False, resume=resume, **task.case.options)
+                       progress=False, **task.case.options)
         except (UnsupportedByEngine, BadOption) as exc:
             refused[task.case.name] = str(exc)
             lines.append(f"  {task.case.name} ({task.case.engine}): refused: {exc}")
-            continue
-        left = plan.get("left_seconds", math.nan)
-        if math.isfinite(left):  # a stopped run: what is left of it, at its own pace
-            seconds[task.case.name] = float(left)
-            lines.append(f"  {task.case.name} ({task.case.engine}): "
-                         f"{plan['left'].removeprefix('resume: ')}")
             continue
         s = plan.get("forecast_seconds")
         if s is None or not math.isfinite(s):
@@ -197,6 +198,8 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
         lines.append(f"  {task.case.name} ({task.case.engine}): "
                      f"{'probably more than ' if bound else ''}{_duration(s)}")
     total = makespan(list(seconds.values()), workers) if seconds else 0.0
+    if own:
+        lines.append(OWN_PACE_NOTE)
     if again:
         lines.append(CALIBRATED_NOTE)
     if lower:  # the runs' lower bounds: the study takes longer, by how much is unknown
@@ -283,6 +286,10 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     return min(like, key=lambda t: (family_distance(scene, t.scene), t.name))
 
 
+#: under the list of runs when a stopped run is counted by what is left of it
+OWN_PACE_NOTE = ("  (a stopped run: what is left of it at its own pace over its latest "
+                 "stretch, the loop's time; its set-up and final analyses come on top: "
+                 "docs/forecast.md)")
 #: under the list of runs when some lower bound was calibrated by a made run
 CALIBRATED_NOTE = ("  (about: a lower bound × what a made run of its kind took against its "
                    "own; such estimates met ×0.30–4.0 of the actual time, ×2 or better in "
@@ -382,7 +389,7 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         todo = [t for t in todo if t.case.name not in refused]
         where = "a Dask cluster" if dask is not None else f"{workers} worker(s)"
         bound = ("probably more than " if LOWER_BOUND_NOTE in lines else
-                 "about " if CALIBRATED_NOTE in lines else "")
+                 "about " if CALIBRATED_NOTE in lines or OWN_PACE_NOTE in lines else "")
         head = (f"forecast: {bound}{_duration(seconds)} on {where}" if seconds is not None
                 else "forecast: unknown for some runs (listed)")
         echo(head + (" (measured speed of this machine; docs/forecast.md)"))
