@@ -712,3 +712,31 @@ def test_the_vdf_bins_are_the_theses_per_volume_fraction() -> None:
     assert vdf_bins(0.01) == (4, 13, 21)
     assert vdf_bins(0.1) == (1, 4, 13)
     assert vdf_bins(0.5) == (1, 3, 13)
+
+
+def test_a_two_temperature_velocity_histogram_is_recognised_and_one_gaussian_is_not():
+    """The VDF rows' 'two temperatures' cause: 10⁶ velocities drawn from 40 % at T/3 and 60 %
+    at 1.44 T (the mixture's variance T = 1), σ-scaled and histogrammed as the vdf analysis
+    does (bins of 0.1 on [-5, 5], Poisson errors), give back q, T₁ and T₂ with χ²/dof ≈ 1,
+    where one Gaussian has χ²/dof in the hundreds; 10⁶ Gaussian velocities do not need a
+    mixture (the fit's cold share or its temperatures collapse onto one Gaussian's)."""
+    from demstudy.studies.malik2008.poiseuille_checks import MIXTURE_FIT, two_temperatures
+
+    rng = np.random.default_rng(7)
+    edges = 0.1 * np.arange(-50, 51)
+
+    def histogram(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = (v - v.mean()) / v.std()
+        count = np.histogram(x, edges)[0].astype(float)
+        return count / (len(v) * 0.1), np.sqrt(np.maximum(count, 1)) / (len(v) * 0.1)
+
+    n = 1_000_000
+    cold = rng.random(n) < 0.4
+    v = np.where(cold, rng.normal(0, math.sqrt(1 / 3), n), rng.normal(0, math.sqrt(1.44), n))
+    q, t1, t2, chi, one = two_temperatures(edges, *histogram(v))
+    assert q == pytest.approx(0.4, abs=0.02)
+    assert t1 == pytest.approx(1 / 3 / 1.0, rel=0.05) and t2 == pytest.approx(1.44, rel=0.03)
+    assert chi < MIXTURE_FIT and one > 100 * chi
+    q, t1, t2, chi, one = two_temperatures(edges, *histogram(rng.normal(0, 1, n)))
+    assert chi < MIXTURE_FIT and one < 1.5  # one Gaussian fits already
+    assert min(q, 1 - q) < 0.05 or t2 / t1 < 1.2  # the "mixture" is one Gaussian

@@ -392,6 +392,49 @@ def tails_core_deviation(kurtosis: float) -> float:
 #: the share of a core deviation heavy tails must predict to be named its cause
 TAILS_SHARE = 0.7
 
+#: a two-temperature mixture describes a peaked core when its χ² per degree of freedom on
+#: the histogram (|x| < MIXTURE_RANGE) stays below this (one Gaussian: hundreds to thousands)
+MIXTURE_FIT = 2.0
+MIXTURE_RANGE = 4.0
+
+
+def two_temperatures(edges: np.ndarray, pdf: np.ndarray, err: np.ndarray
+                     ) -> tuple[float, float, float, float, float] | None:
+    """Fit q N(0, T₁) + (1 − q) N(0, T₂), with q T₁ + (1 − q) T₂ = 1 (the bin's own σ² = 1),
+    to a σ-scaled velocity histogram (density per bin of ``edges``, its errors ``err``; bins
+    with |x| < ``MIXTURE_RANGE`` and an error): (q, T₁, T₂, χ²/dof, χ²/dof of one Gaussian)
+    with T₁ ≤ T₂, None when too few bins. The model is the histogram bins' average of the
+    mixture (erf differences), as ``gaussian_binned`` is of one Gaussian."""
+    from scipy import optimize, special
+
+    width = np.diff(edges)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    use = np.isfinite(pdf) & np.isfinite(err) & (err > 0) & (np.abs(centres) < MIXTURE_RANGE)
+    if use.sum() < 6:
+        return None
+
+    def binned(variance: float) -> np.ndarray:
+        cdf = 0.5 * (1 + special.erf(edges / math.sqrt(2 * variance)))
+        return np.diff(cdf) / width
+
+    def chi2(params: np.ndarray) -> float:
+        q, t1 = params
+        if not (0 < q < 1 and 0 < t1 < 1 / q):
+            return 1e30
+        model = q * binned(t1) + (1 - q) * binned((1 - q * t1) / (1 - q))
+        return float(np.sum(((model - pdf)[use] / err[use]) ** 2))
+
+    best = min((optimize.minimize(chi2, [q, t1], method="Nelder-Mead")
+                for q in (0.1, 0.3, 0.5, 0.7, 0.9) for t1 in (0.2, 0.5, 0.8)),
+               key=lambda fit: fit.fun)
+    q, t1 = (float(v) for v in best.x)
+    t2 = (1 - q * t1) / (1 - q)
+    if t1 > t2:  # name the colder population first
+        q, t1, t2 = 1 - q, t2, t1
+    one = float(np.sum(((binned(1.0) - pdf)[use] / err[use]) ** 2))
+    dof = int(use.sum())
+    return q, t1, t2, float(best.fun) / (dof - 2), one / dof
+
 
 def _vdf_cause(d: FlowData, k: int, c: int, dev: float, kur: float, ker: float,
                skew: float) -> tuple[str, str]:
@@ -402,8 +445,18 @@ def _vdf_cause(d: FlowData, k: int, c: int, dev: float, kur: float, ker: float,
     if kur - 3 > 2 * ker and tails_core_deviation(kur) >= TAILS_SHARE * dev:
         return "tails", f"{entry} (κ {kur:.2f}: {100 * tails_core_deviation(kur):.0f} % of " \
                         f"{100 * dev:.0f} %)"
-    shape = "flat-topped" if _core_above(d, k - 1, c) else "peaked"
-    return "other", f"{entry} {shape}"
+    if _core_above(d, k - 1, c):  # no mixture of centred Gaussians is flat-topped
+        return "other", f"{entry} flat-topped"
+    v = d.stat("vdf")
+    fit = (two_temperatures(v["malik_edges"], v["malik_pdf"][k - 1, c],
+                            v["malik_pdf_err"][k - 1, c])
+           if "malik_pdf_err" in v and "malik_edges" in v else None)
+    if fit is not None and fit[3] < MIXTURE_FIT:
+        q, t1, t2, chi, one = fit
+        return "mixture", (f"{entry} ({100 * q:.0f} % at {t1:.2f} T, the rest at {t2:.2f} T; "
+                           f"χ²/dof {chi:.1f} against {one:.0f} for one Gaussian)")
+    return "other", f"{entry} peaked" + (f" (two temperatures: χ²/dof {fit[3]:.1f})"
+                                         if fit is not None else "")
 
 
 #: the words for each cause of a core deviation, in the reason's order
@@ -416,8 +469,15 @@ VDF_CAUSES = {
     "tails": "Symmetric with heavy tails: σ-scaled, heavy tails narrow the core (a Student t of "
              "the same kurtosis lies this far below exp(-x²/2) at |x| = 1), so a Gaussian "
              "core and non-Gaussian tails cannot both hold to 10 %; the thesis judged by eye",
-    "other": "Neither skewed nor heavy-tailed enough (flat-topped: above exp(-x²/2) towards "
-             "|x| = 1; peaked: below), not explained here",
+    "mixture": "Peaked, and described by two temperatures (a fit of q N(0, T₁) + (1 − q) "
+               "N(0, T₂) with the bin's own variance to the histogram, χ²/dof < {m:g}): "
+               "particles of two temperatures share the bin, not one local Maxwellian (a "
+               "σ-scaled mixture of Gaussians has a peaked core and only mildly heavy tails); "
+               "which particles are the colder ones (fresh from the dissipative walls, or "
+               "from a denser layer) is not measured here",
+    "other": "Neither skewed, heavy-tailed enough nor two temperatures (flat-topped: above "
+             "exp(-x²/2) towards |x| = 1, which no mixture of centred Gaussians is; peaked: "
+             "below), not explained here",
 }
 
 
@@ -427,7 +487,8 @@ def vdf_checks(data: Runs) -> list[Check]:
     1) the two pull against each other: heavy tails narrow the σ-scaled core (a Student t of
     kurtosis 4 lies 14 % below exp(-x²/2) at |x| = 1). Each deviating core (run, bin,
     component) is given one cause: its skewness, tails heavy enough to predict most of the
-    deviation (TAILS_SHARE), or none found."""
+    deviation (TAILS_SHARE), a peaked core that two temperatures describe
+    (:func:`two_temperatures`, MIXTURE_FIT), or none found."""
     out = []
     for phi in (0.01, 0.1, 0.5):
         bins = vdf_bins(phi)
@@ -470,7 +531,7 @@ def vdf_checks(data: Runs) -> list[Check]:
                             + ", skewness " + "/".join(f"{x:.2f}" for x in skew))
         verdict = REPRODUCED if cores and tails else PARTLY if (cores or tails) \
             else NOT_REPRODUCED
-        named = [f"{VDF_CAUSES[key].format(s=SKEWED)}: {', '.join(entries)}"
+        named = [f"{VDF_CAUSES[key].format(s=SKEWED, m=MIXTURE_FIT)}: {', '.join(entries)}"
                  for key, entries in causes.items() if entries]
         reason = "" if verdict == REPRODUCED else (
             ("The core departs from the Gaussian by > 10 % beyond 2σ in some bins. "
