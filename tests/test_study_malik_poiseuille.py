@@ -740,3 +740,26 @@ def test_a_two_temperature_velocity_histogram_is_recognised_and_one_gaussian_is_
     q, t1, t2, chi, one = two_temperatures(edges, *histogram(rng.normal(0, 1, n)))
     assert chi < MIXTURE_FIT and one < 1.5  # one Gaussian fits already
     assert min(q, 1 - q) < 0.05 or t2 / t1 < 1.2  # the "mixture" is one Gaussian
+
+
+def test_a_flat_top_names_the_shortage_of_slow_particles_only_when_it_is_real():
+    """Two streams at ±0.8 σ (a flat top) have fewer slow particles than a Gaussian: the
+    density at C = 0 is named, with its error, against the unit Gaussian's 0.398; a
+    Gaussian's is not."""
+    from demstudy.studies.malik2008.poiseuille_checks import _slow_deficit
+
+    rng = np.random.default_rng(3)
+    edges = 0.1 * np.arange(-50, 51)
+    n = 400_000
+
+    def stat(v: np.ndarray) -> dict:
+        x = (v - v.mean()) / v.std()
+        count = np.histogram(x, edges)[0].astype(float)
+        pdf, err = count / (n * 0.1), np.sqrt(np.maximum(count, 1)) / (n * 0.1)
+        return {"malik_pdf": pdf[None, None], "malik_pdf_err": err[None, None],
+                "malik_edges": edges}
+
+    streams = rng.choice([-0.8, 0.8], n) + rng.normal(0, 0.6, n)
+    text = _slow_deficit(stat(streams), 0, 0)
+    assert "fewer slow particles" in text and "against 0.398" in text
+    assert _slow_deficit(stat(rng.normal(0, 1, n)), 0, 0) == ""

@@ -436,6 +436,23 @@ def two_temperatures(edges: np.ndarray, pdf: np.ndarray, err: np.ndarray
     return q, t1, t2, float(best.fun) / (dof - 2), one / dof
 
 
+def _slow_deficit(v: dict, b: int, c: int) -> str:
+    """The σ-scaled density at C = 0 (the two histogram bins beside it, as Malik's P(0))
+    against a unit Gaussian's, when it lies below by more than 2σ: a flat top that is a real
+    shortage of slow particles, not the P(0) = 1 scaling of a noisy centre."""
+    if "malik_pdf_err" not in v or "malik_edges" not in v:
+        return ""
+    pdf, err, edges = v["malik_pdf"][b, c], v["malik_pdf_err"][b, c], v["malik_edges"]
+    nx = len(pdf) // 2
+    p0, p0_err = 0.5 * (pdf[nx - 1] + pdf[nx]), 0.5 * math.hypot(err[nx - 1], err[nx])
+    width = float(edges[nx + 1] - edges[nx])  # a unit Gaussian over the bin (0, width)
+    gauss = 0.5 * math.erf(width / math.sqrt(2)) / width
+    if not p0 + 2 * p0_err < gauss:
+        return ""
+    return (f" (fewer slow particles than a Gaussian: density at C = 0 {pm(p0, p0_err)} per σ "
+            f"against {gauss:.3f})")
+
+
 def _vdf_cause(d: FlowData, k: int, c: int, dev: float, kur: float, ker: float,
                skew: float) -> tuple[str, str]:
     """(cause, entry) of a core deviating by ``dev`` (> 10 %): component ``c`` of bin ``k``."""
@@ -445,9 +462,9 @@ def _vdf_cause(d: FlowData, k: int, c: int, dev: float, kur: float, ker: float,
     if kur - 3 > 2 * ker and tails_core_deviation(kur) >= TAILS_SHARE * dev:
         return "tails", f"{entry} (κ {kur:.2f}: {100 * tails_core_deviation(kur):.0f} % of " \
                         f"{100 * dev:.0f} %)"
-    if _core_above(d, k - 1, c):  # no mixture of centred Gaussians is flat-topped
-        return "other", f"{entry} flat-topped"
     v = d.stat("vdf")
+    if _core_above(d, k - 1, c):  # no mixture of centred Gaussians is flat-topped
+        return "other", f"{entry} flat-topped{_slow_deficit(v, k - 1, c)}"
     fit = (two_temperatures(v["malik_edges"], v["malik_pdf"][k - 1, c],
                             v["malik_pdf_err"][k - 1, c])
            if "malik_pdf_err" in v and "malik_edges" in v else None)
