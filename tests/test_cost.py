@@ -399,3 +399,24 @@ def test_a_ladder_run_stopped_with_a_checkpoint_continues_from_it(tmp_path, monk
     (name, phase, seconds, line), = plan.runs
     assert phase == "reference" and seconds == pytest.approx(40.0)
     assert "2 of 10 sample intervals done" in line and plan.total == pytest.approx(40.0)
+    # a checkpoint whose progress file names another scene (the case changed since): the
+    # run starts afresh instead of failing on --resume; of this scene: it resumes
+    write_progress(folder, Progress(2, 10, 0.4, ((2, 10.0),)), digest, scene_digest("other"))
+    run_task(task)
+    assert "resume" not in seen[-1]
+    write_progress(folder, Progress(2, 10, 0.4, ((2, 10.0),)), digest,
+                   scene_digest(task.scene_toml))
+    run_task(task)
+    assert seen[-1]["resume"] is True
+    # a soft run's scene is the base with its soft section (scene_for): its progress file
+    # names that scene, which the ladder's forecast matches (not the base's)
+    soft = Task(RunSpec("lammps", "hooke", 1e4, 50), task.scene_toml,
+                tmp_path / "soft-lammps.h5")
+    assert scene_to_toml(soft.scene()) != task.scene_toml
+    sfolder = work_folder(soft.path, "lammps")
+    sfolder.mkdir(parents=True)
+    sdigest = pickle_atomically(sfolder / CHECKPOINT, {"a": "checkpoint"})
+    write_progress(sfolder, Progress(3, 10, 0.6, ((3, 6.0),)), sdigest,
+                   scene_digest(scene_to_toml(soft.scene())))
+    plan = ladder_forecast({"soft": ([soft], [])}, workers=1, unmeasured="not measured")
+    assert plan.runs[0][2] == pytest.approx(14.0)

@@ -54,13 +54,15 @@ def run_task(task: Task) -> dict[str, Any]:
     """Make one run (in a pool worker or a Dask worker); the engine runs in a child process
     (``isolate``) on one rank. Returns what the ladder records of the execution."""
     from ..api import run
+    from ..scene import scene_to_toml
     from ..simulation.checkpoint import stopped_run
 
     options = task.spec.options()
-    if stopped_run(Path(task.path), task.spec.engine):
+    scene = task.scene()
+    if stopped_run(Path(task.path), task.spec.engine, scene_to_toml(scene)):
         options["resume"] = True  # a stopped run of the sweep continues from its checkpoint
     started = time.perf_counter()
-    res = run(task.scene(), engine=task.spec.engine, out=task.path, isolate=True, np=1,
+    res = run(scene, engine=task.spec.engine, out=task.path, isolate=True, np=1,
               progress=False, **options)
     return {"name": task.spec.name, "path": str(res.path),
             "task_seconds": time.perf_counter() - started,

@@ -128,6 +128,7 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
     """The forecast of ``phases`` (``PHASES`` → (to run, done)).
     ``unmeasured``: why the machine's speed is unknown (then no run is forecast)."""
     from ..engines import get_backend
+    from ..scene import scene_to_toml
     from ..simulation import RunOptions, plan_run, work_folder
     from ..simulation.progress import read_progress
 
@@ -139,7 +140,7 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
         for task in todo:
             key = _key(task.spec)
             left = read_progress(work_folder(Path(task.path), task.spec.engine),
-                                 task.scene_toml)
+                                 scene_to_toml(task.scene()))  # the run's, not the base's
             if left is not None and math.isfinite(left.seconds_left()):
                 # a stopped run of the sweep: what is left of it, at its own pace
                 result.runs.append((task.spec.name, phase, left.seconds_left(),
