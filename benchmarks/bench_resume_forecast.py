@@ -6,10 +6,11 @@ it part way (after a checkpoint); ``ds.run(..., resume=True, dry_run=True)`` giv
 left (``left_seconds``, from ``progress.json``); the run is then resumed to its end, and the
 time the rest took is the results file's ``wall_seconds`` (every part summed) less the wall
 seconds at the stop. Printed per scene: the forecast, the actual, their ratio. Scenes: a
-steady Lees–Edwards gas (event-driven), Malik's smallest density-wave box from rest (N = 573,
+steady Lees–Edwards gas (event-driven), Malik's smallest density-wave box from rest (N = 600,
 event-driven; gravity accelerates the flow, so each interval of time holds more collisions
-than the last) and the Lees–Edwards gas with soft contacts in LAMMPS. Dimensionless particle units (d = 1, m = 1, g = 1 when gravity acts); wall
-times in seconds of this machine.
+than the last) and the Lees–Edwards gas with soft contacts in LAMMPS. Dimensionless
+particle units (d = 1, m = 1, g = 1 when gravity acts); wall times in seconds of this
+machine.
 
     .venv/bin/python benchmarks/bench_resume_forecast.py [--stop-share 0.3]
 """
