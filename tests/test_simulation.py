@@ -249,7 +249,9 @@ def test_a_stopped_run_tells_how_far_it_got_and_what_is_left_at_its_own_pace(tmp
     other = gas(particles={"count": 41})  # another scene: its progress is not this one
     assert read_progress(work, scene_to_toml(other)) is None
     assert read_progress(work, scene_to_toml(scene)) == done
-    run_scene(scene, "ballistic", RunOptions(out=out, progress=False, resume=True))
+    whole = read_results(run_scene(scene, "ballistic", RunOptions(out=out, progress=False,
+                                                                   resume=True)))
+    assert whole.attrs["resumes"] == 1
     assert not (work / PROGRESS).exists() and not work.exists()
     assert read_progress(work) is None
 
@@ -300,6 +302,7 @@ def test_a_progress_file_of_another_checkpoint_is_ignored(tmp_path):
     parts = read_results(run_scene(scene, "ballistic", RunOptions(
         out=out, progress=False, resume=True)))
     np.testing.assert_allclose(parts.timeseries["time"], np.arange(11) * 0.5)
+    assert parts.attrs["resumes"] == 2  # the old checkpoint (no count) resumed twice
 
 
 def test_the_pace_left_is_the_latest_stretch_not_the_average():

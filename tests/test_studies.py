@@ -300,6 +300,7 @@ def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
     res = run_study("toy", out=tmp_path, echo=lambda s: None)
     assert "cell-a" in res.made
     done = ds.load(task.path)
+    assert done.attrs["resumes"] == 1  # continued from the checkpoint, not started again
     times = done.timeseries["time"]
     assert times[-1] == pytest.approx(15.0, abs=1.0)  # the whole run, equilibration + production
 

@@ -59,11 +59,11 @@ from .tracks import MarkedTracks
 
 __all__ = ["Simulation"]
 
-# 2: RunState.health. RunState.tracks (marked grains' paths) and RunState.marks (the run's
-# pace at each checkpoint) came later without a new version: a checkpoint pickled before
-# them unpickles with the class defaults (None, ()); only lattice scenes with marked grains
-# have tracks (none were checkpointed before them), and a run resumed without marks has no
-# pace until its next checkpoint
+# 2: RunState.health. RunState.tracks (marked grains' paths), RunState.marks (the run's
+# pace at each checkpoint) and RunState.resumes came later without a new version: a
+# checkpoint pickled before them unpickles with the class defaults (None, (), 0); only
+# lattice scenes with marked grains have tracks (none were checkpointed before them), and a
+# run resumed without marks has no pace until its next checkpoint
 LOOP_VERSION = f"demstudy {__version__} (simulation loop 2)"
 FRAME_ARRAYS = ("position", "velocity", "angular_velocity", "radius", "box_lo", "box_hi")
 
@@ -114,6 +114,7 @@ class Simulation:
             saved = load_checkpoint(path, self.scene, {"run", "backend"}, self._version(),
                                     backend.name)
             state = saved["run"]
+            state.resumes += 1
             self.keep_frames = frames_on_resume(self.options.keep_frames, state.keep_frames)
             backend.setup(self._needs(), saved["backend"], state.servo)
             return state

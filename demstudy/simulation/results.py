@@ -58,6 +58,7 @@ def run_results(sim: Any, state: RunState, extra: dict[str, Any]) -> Results:
     equilibration_end = float(timeseries["time"][sim.schedule.n_eq])
     attrs = run_attrs(scene, backend.name, backend.version, state.wall_seconds,
                       equilibration_end, timeseries)
+    attrs["resumes"] = state.resumes
     attrs.update(extra)
     results = Results(attrs, timeseries, profiles.results, profiles.attrs, frames)
     if sim.measure_stress:

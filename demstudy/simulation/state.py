@@ -51,6 +51,9 @@ class RunState:
     # forecast of what is left when it resumes (simulation.progress); a checkpoint pickled
     # before it unpickles with this class default
     marks: tuple[tuple[float, float], ...] = ()
+    # how many times the run was resumed (the results file's ``resumes``; class default 0
+    # for checkpoints pickled before it)
+    resumes: int = 0
 
     def record(self, key: str, value) -> None:
         self.timeseries.setdefault(key, []).append(value)
