@@ -130,6 +130,7 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
     from ..engines import get_backend
     from ..scene import scene_to_toml
     from ..simulation import RunOptions, plan_run, work_folder
+    from ..simulation.checkpoint import stopped_run
     from ..simulation.progress import read_progress
 
     result = LadderForecast(workers=workers, unmeasured=unmeasured)
@@ -139,8 +140,9 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
             result.runs.append((task.spec.name, "reused", 0.0, "reused (its file is done)"))
         for task in todo:
             key = _key(task.spec)
-            left = read_progress(work_folder(Path(task.path), task.spec.engine),
-                                 scene_to_toml(task.scene()))  # the run's, not the base's
+            left = (read_progress(work_folder(Path(task.path), task.spec.engine),
+                                  scene_to_toml(task.scene()))  # the run's, not the base's
+                    if stopped_run(Path(task.path), task.spec.engine) else None)
             if left is not None and math.isfinite(left.seconds_left()):
                 # a stopped run of the sweep: what is left of it, at its own pace
                 result.runs.append((task.spec.name, phase, left.seconds_left(),

@@ -57,25 +57,16 @@ def stopped_run(out: Path, engine: str, scene_toml: str | None = None) -> bool:
     in its work folder (sweeps and studies continue such a run instead of restarting it),
     and (``scene_toml`` given) not one its progress file says is of another scene: a case
     whose scene changed since starts afresh, replacing that checkpoint, instead of failing
-    on ``--resume``. A checkpoint without a progress file of its own is resumed (the resume
-    then checks its scene)."""
-    import json
-
+    on ``--resume``. A checkpoint without a progress file of its own (older, or damaged: the
+    resume refuses it by name) is resumed, and the resume checks its scene."""
     from .options import work_folder
-    from .progress import PROGRESS, scene_digest
+    from .progress import progress_record, scene_digest
 
     folder = work_folder(Path(out), engine)
     if not (folder / CHECKPOINT).is_file():
         return False
-    if scene_toml is None:
-        return True
-    try:  # a damaged checkpoint is resumed too: the resume refuses it by name
-        data = json.loads((folder / PROGRESS).read_text())
-        if data["checkpoint_sha256"] != checkpoint_digest(folder / CHECKPOINT):
-            return True  # not this checkpoint's progress: the resume decides
-        return bool(data["scene_sha256"] == scene_digest(scene_toml))
-    except (OSError, ValueError, KeyError, TypeError):
-        return True
+    record = progress_record(folder) if scene_toml is not None else None
+    return record is None or record.get("scene_sha256") == scene_digest(scene_toml)
 
 
 def read_checkpoint(path: Path) -> Any:

@@ -28,7 +28,8 @@ from typing import Any
 from .. import UNITS_NOTE
 from ..io.results import write_atomically
 
-__all__ = ["PROGRESS", "Progress", "read_progress", "scene_digest", "write_progress"]
+__all__ = ["PROGRESS", "Progress", "progress_record", "read_progress", "scene_digest",
+           "write_progress"]
 
 PROGRESS = "progress.json"
 
@@ -114,10 +115,9 @@ def write_progress(workdir: Path, progress: Progress, checkpoint_sha256: str,
         (workdir / PROGRESS).unlink(missing_ok=True)
 
 
-def read_progress(workdir: Path, scene_toml: str | None = None) -> Progress | None:
-    """The progress of the run stopped in ``workdir``; None when there is no checkpoint, no
-    readable progress file, or one written for another checkpoint or (``scene_toml`` given)
-    another scene."""
+def progress_record(workdir: Path) -> dict | None:
+    """The progress file in ``workdir`` as written, when it belongs to the checkpoint there
+    (its SHA-256); None otherwise (no checkpoint, no readable file, another checkpoint's)."""
     from .checkpoint import CHECKPOINT, checkpoint_digest
 
     digest = checkpoint_digest(workdir / CHECKPOINT)
@@ -125,12 +125,26 @@ def read_progress(workdir: Path, scene_toml: str | None = None) -> Progress | No
         return None
     try:
         data = json.loads((workdir / PROGRESS).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("checkpoint_sha256") != digest:
+        return None
+    return data
+
+
+def read_progress(workdir: Path, scene_toml: str | None = None) -> Progress | None:
+    """The progress of the run stopped in ``workdir``; None when there is no checkpoint, no
+    readable progress file, or one written for another checkpoint or (``scene_toml`` given)
+    another scene."""
+    data = progress_record(workdir)
+    if data is None:
+        return None
+    try:
         marks = tuple((float(k), float(w)) for k, w in data["marks"])
         progress = Progress(float(data["intervals_done"]), int(data["intervals_total"]),
                             float(data["time"]), marks)
-        mine = data["checkpoint_sha256"] == digest and (
-            scene_toml is None or data["scene_sha256"] == scene_digest(scene_toml))
-    except (OSError, ValueError, KeyError, TypeError):
+        mine = scene_toml is None or data["scene_sha256"] == scene_digest(scene_toml)
+    except (ValueError, KeyError, TypeError):
         return None
     if not mine or not marks or progress.total <= 0:
         return None
