@@ -131,7 +131,7 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
     from ..scene import scene_to_toml
     from ..simulation import RunOptions, plan_run, work_folder
     from ..simulation.checkpoint import stopped_run
-    from ..simulation.progress import read_progress
+    from ..simulation.progress import time_left
 
     result = LadderForecast(workers=workers, unmeasured=unmeasured)
     cache: dict[RunSpec, tuple[float, str]] = {}
@@ -140,13 +140,11 @@ def ladder_forecast(phases: dict[str, tuple[list[Task], list[Task]]], workers: i
             result.runs.append((task.spec.name, "reused", 0.0, "reused (its file is done)"))
         for task in todo:
             key = _key(task.spec)
-            left = (read_progress(work_folder(Path(task.path), task.spec.engine),
-                                  scene_to_toml(task.scene()))  # the run's, not the base's
+            left = (time_left(work_folder(Path(task.path), task.spec.engine),
+                              scene_to_toml(task.scene()))  # the run's, not the base's
                     if stopped_run(Path(task.path), task.spec.engine) else None)
-            if left is not None and math.isfinite(left.seconds_left()):
-                # a stopped run of the sweep: what is left of it, at its own pace
-                result.runs.append((task.spec.name, phase, left.seconds_left(),
-                                    left.line().removeprefix("resume: ")))
+            if left is not None:  # a stopped run of the sweep: what is left, at its own pace
+                result.runs.append((task.spec.name, phase, *left))
                 continue
             if unmeasured is not None:
                 cache.setdefault(key, (math.nan, "no forecast"))

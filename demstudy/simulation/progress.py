@@ -29,7 +29,7 @@ from .. import UNITS_NOTE
 from ..io.results import write_atomically
 
 __all__ = ["PROGRESS", "Progress", "progress_record", "read_progress", "scene_digest",
-           "write_progress"]
+           "time_left", "write_progress"]
 
 PROGRESS = "progress.json"
 
@@ -149,3 +149,13 @@ def read_progress(workdir: Path, scene_toml: str | None = None) -> Progress | No
     if not mine or not marks or progress.total <= 0:
         return None
     return progress
+
+
+def time_left(workdir: Path, scene_toml: str) -> tuple[float, str] | None:
+    """(seconds, line) of what is left of the run of ``scene_toml`` stopped in ``workdir``
+    at its own pace, for a forecast's list of runs; None when there is no such pace (no
+    checkpoint or progress file of its own, another scene, nothing timed yet)."""
+    progress = read_progress(workdir, scene_toml)
+    if progress is None or not math.isfinite(progress.seconds_left()):
+        return None
+    return progress.seconds_left(), progress.line().removeprefix("resume: ")

@@ -149,18 +149,16 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
     from ..api import run
     from ..errors import UnsupportedByEngine
     from ..simulation.options import work_folder
-    from ..simulation.progress import read_progress
+    from ..simulation.progress import time_left
 
     seconds, lines, unknown, refused, lower, own = {}, [], False, {}, False, False
     made: list[Took] | None = None  # read when a lower bound first needs it
     again: dict[str, float] = {}  # made run → its lower bound forecast again now
     for task in tasks:
-        left = read_progress(work_folder(task.path, task.case.engine), task.scene_toml)
-        if left is not None and math.isfinite(left.seconds_left()):
-            # a stopped run of this scene: what is left of it, at its own pace (no pilot)
-            seconds[task.case.name] = left.seconds_left()
-            lines.append(f"  {task.case.name} ({task.case.engine}): "
-                         f"{left.line().removeprefix('resume: ')}")
+        left = time_left(work_folder(task.path, task.case.engine), task.scene_toml)
+        if left is not None:  # a stopped run of this scene: what is left of it (no pilot)
+            seconds[task.case.name], line = left
+            lines.append(f"  {task.case.name} ({task.case.engine}): {line}")
             own = True
             continue
         try:
