@@ -282,8 +282,8 @@ def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
     from demstudy.errors import RunStopped
     from demstudy.simulation.checkpoint import stopped_run
     from demstudy.simulation.options import work_folder
-    from demstudy.simulation.progress import read_progress
-    from demstudy.studies.runner import OWN_PACE_NOTE, forecast, tasks_of
+    from demstudy.simulation.progress import PROGRESS, read_progress
+    from demstudy.studies.runner import OLD_CHECKPOINT_NOTE, OWN_PACE_NOTE, forecast, tasks_of
 
     task = next(t for t in tasks_of(TOY, False, tmp_path) if t.case.name == "cell-a")
     assert task.spec.checkpoint_interval == pytest.approx(1.5)  # (5 + 10)/10 time units
@@ -297,6 +297,11 @@ def test_an_interrupted_run_resumes_from_its_checkpoint(toy, tmp_path):
     line = next(s for s in lines if "cell-a" in s)
     assert "sample intervals done (t = " in line and "left at this run's own pace" in line
     assert seconds["cell-a"] == pytest.approx(left.seconds_left()) and OWN_PACE_NOTE in lines
+    # an older checkpoint, without a progress file: the whole run's forecast, said to resume
+    (work_folder(task.path, "edmd") / PROGRESS).unlink()
+    _total, lines, _refused, _seconds = forecast([task], 1)
+    line = next(s for s in lines if "cell-a" in s)
+    assert "resumes;" in line and OLD_CHECKPOINT_NOTE in lines and OWN_PACE_NOTE not in lines
     res = run_study("toy", out=tmp_path, echo=lambda s: None)
     assert "cell-a" in res.made
     done = ds.load(task.path)

@@ -146,63 +146,88 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
     bound needs it) says how much longer such runs took than their own lower bounds
     (:func:`calibration`)."""
     from ..accuracy.forecast import makespan
-    from ..api import run
-    from ..errors import UnsupportedByEngine
-    from ..simulation.options import work_folder
-    from ..simulation.progress import time_left
 
-    seconds, lines, unknown, refused, lower, own = {}, [], False, {}, False, False
-    made: list[Took] | None = None  # read when a lower bound first needs it
-    again: dict[str, float] = {}  # made run → its lower bound forecast again now
+    each = _Forecasts(finished)
     for task in tasks:
+        each.add(task)
+    total = makespan(list(each.seconds.values()), workers) if each.seconds else 0.0
+    notes = [note for note, used in ((OWN_PACE_NOTE, each.own), (OLD_CHECKPOINT_NOTE, each.old),
+                                     (CALIBRATED_NOTE, bool(each.again)),
+                                     # the runs' lower bounds: the study takes longer,
+                                     # by how much is unknown
+                                     (LOWER_BOUND_NOTE, each.lower)) if used]
+    return (None if each.unknown else total), each.lines + notes, each.refused, each.seconds
+
+
+@dataclass
+class _Forecasts:
+    """The study forecast's runs one by one: a stopped run by what is left of it, else its
+    ``--dry-run`` forecast, a lower bound calibrated by a made run like it when there is
+    one. Collects the seconds, lines and which notes the list needs."""
+
+    finished: Callable[[], Sequence[Took]]
+    seconds: dict[str, float] = field(default_factory=dict)
+    lines: list[str] = field(default_factory=list)
+    refused: dict[str, str] = field(default_factory=dict)
+    unknown: bool = False  # a run without a forecast: no total
+    lower: bool = False  # an uncalibrated lower bound among the runs
+    own: bool = False  # a stopped run counted at its own pace
+    old: bool = False  # a checkpoint without a progress file: the whole run's forecast
+    #: made run → its lower bound forecast again now
+    again: dict[str, float] = field(default_factory=dict)
+    made: list[Took] | None = None  # read when a lower bound first needs it
+
+    def add(self, task: StudyTask) -> None:
+        from ..api import run
+        from ..errors import UnsupportedByEngine
+        from ..simulation.checkpoint import stopped_run
+        from ..simulation.options import work_folder
+        from ..simulation.progress import time_left
+
+        name = f"  {task.case.name} ({task.case.engine}):"
         left = time_left(work_folder(task.path, task.case.engine), task.scene_toml)
         if left is not None:  # a stopped run of this scene: what is left of it (no pilot)
-            seconds[task.case.name], line = left
-            lines.append(f"  {task.case.name} ({task.case.engine}): {line}")
-            own = True
-            continue
+            self.seconds[task.case.name], line = left
+            self.lines.append(f"{name} {line}")
+            self.own = True
+            return
+        resumes = stopped_run(task.path, task.case.engine, task.scene_toml)
+        self.old = self.old or resumes
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
                        progress=False, **task.case.options)
         except (UnsupportedByEngine, BadOption) as exc:
-            refused[task.case.name] = str(exc)
-            lines.append(f"  {task.case.name} ({task.case.engine}): refused: {exc}")
-            continue
+            self.refused[task.case.name] = str(exc)
+            self.lines.append(f"{name} refused: {exc}")
+            return
         s = plan.get("forecast_seconds")
         if s is None or not math.isfinite(s):
-            unknown = True
-            lines.append(f"  {task.case.name} ({task.case.engine}): no forecast "
-                         f"({plan.get('forecast', 'not measured')})")
-            continue
-        bound = plan.get("forecast_kind") == "lower bound"
-        like = None
-        if bound:
-            if made is None:
-                made = list(finished())
-            like = calibration(task.scene(), task.case.engine, made, task.case.options)
-        if like is not None:
-            if like.name not in again:  # its bound by today's method, in the same folder
-                again[like.name] = _bound_now(like, task.path.parent)
-            ratio = like.wall / again[like.name]
-            seconds[task.case.name] = float(s) * ratio
-            lines.append(f"  {task.case.name} ({task.case.engine}): about "
-                         f"{_duration(s * ratio)} (its lower bound {_duration(s)} × "
-                         f"{ratio:.2f}: {like.name}, N = {like.scene.n_particles}, took "
-                         f"{_duration(like.wall)} against a lower bound of "
-                         f"{_duration(again[like.name])})")
-            continue
-        seconds[task.case.name] = float(s)
-        lower = lower or bound
-        lines.append(f"  {task.case.name} ({task.case.engine}): "
-                     f"{'probably more than ' if bound else ''}{_duration(s)}")
-    total = makespan(list(seconds.values()), workers) if seconds else 0.0
-    if own:
-        lines.append(OWN_PACE_NOTE)
-    if again:
-        lines.append(CALIBRATED_NOTE)
-    if lower:  # the runs' lower bounds: the study takes longer, by how much is unknown
-        lines.append(LOWER_BOUND_NOTE)
-    return (None if unknown else total), lines, refused, seconds
+            self.unknown = True
+            self.lines.append(f"{name} no forecast ({plan.get('forecast', 'not measured')})")
+            return
+        name += " resumes;" if resumes else ""
+        like = self._like(task) if plan.get("forecast_kind") == "lower bound" else None
+        if like is None:
+            bound = plan.get("forecast_kind") == "lower bound"
+            self.seconds[task.case.name] = float(s)
+            self.lower = self.lower or bound
+            self.lines.append(f"{name} {'probably more than ' if bound else ''}{_duration(s)}")
+            return
+        if like.name not in self.again:  # its bound by today's method, in the same folder
+            self.again[like.name] = _bound_now(like, task.path.parent)
+        ratio = like.wall / self.again[like.name]
+        self.seconds[task.case.name] = float(s) * ratio
+        self.lines.append(
+            f"{name} about {_duration(s * ratio)} (its lower bound {_duration(s)} × "
+            f"{ratio:.2f}: {like.name}, N = {like.scene.n_particles}, took "
+            f"{_duration(like.wall)} against a lower bound of "
+            f"{_duration(self.again[like.name])})")
+
+    def _like(self, task: StudyTask) -> Took | None:
+        """The made run that calibrates ``task``'s lower bound (:func:`calibration`)."""
+        if self.made is None:
+            self.made = list(self.finished())
+        return calibration(task.scene(), task.case.engine, self.made, task.case.options)
 
 
 @dataclass(frozen=True)
@@ -284,6 +309,9 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     return min(like, key=lambda t: (family_distance(scene, t.scene), t.name))
 
 
+#: under a forecast that resumes a checkpoint without a progress file of its own
+OLD_CHECKPOINT_NOTE = ("  (resumes: a checkpoint without a progress file (written by an older "
+                       "demstudy) does not say how far it got: the whole run's forecast)")
 #: under the list of runs when a stopped run is counted by what is left of it
 OWN_PACE_NOTE = ("  (a stopped run: what is left of it at its own pace over its latest "
                  "stretch, the loop's time; its set-up and final analyses come on top: "
