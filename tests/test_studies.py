@@ -498,3 +498,32 @@ def test_the_report_tallies_the_thesis_statements_apart_from_demstudys_own_check
         "1 partly)" in alone
     with pytest.raises(ValueError, match="allowed are reproduced, partly"):
         Check("x", "s", "1", "1", "inconclusive")
+
+
+def test_the_tc_rule_weakens_agreements_resting_on_a_run_the_tc_model_changed():
+    """VERDICT_LEGEND's rule, study-wide: a row resting on a run whose TC-elastic share
+    exceeds the engine's warning level names the share and an agreement becomes "partly"; a
+    disagreement stays; a run shown not to depend on t_c keeps its rows' verdicts; rows
+    below the level, without runs (the t_c row itself) and not run are left alone."""
+    from demstudy.engines.edmd.tc_share import WARN_SHARE
+    from demstudy.studies.base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, tc_caveats
+
+    def row(verdict, runs):
+        return Check("ref", "statement", "thesis", "value", verdict, "why", runs=runs)
+
+    shares = {"hot": (0.16, 1e-5), "cold": (0.5 * WARN_SHARE, 1e-5), "tested": (0.2, 1e-5),
+              "soft": (float("nan"), float("nan"))}
+    agree, differ, below, none, missing, tested, soft = (
+        row(REPRODUCED, ("cold", "hot")), row(NOT_REPRODUCED, ("hot",)),
+        row(REPRODUCED, ("cold",)), row(REPRODUCED, ()), row(NOT_RUN, ("hot",)),
+        row(REPRODUCED, ("tested",)), row(REPRODUCED, ("soft",)))
+    tc_caveats([agree, differ, below, none, missing, tested, soft], shares,
+               {"tested": "its twin at t_c = 1e-6 agrees"})
+    assert agree.verdict == PARTLY and "hot: 16.0 % (t_c = 1e-05)" in agree.reason
+    assert "cold" not in agree.reason.split("elastic (")[1]
+    assert agree.reason.startswith("why. The engine's TC model") and agree.reason.endswith(".")
+    assert differ.verdict == NOT_REPRODUCED and "hot: 16.0 %" in differ.reason
+    assert tested.verdict == REPRODUCED and "its twin at t_c = 1e-6 agrees" in tested.reason
+    for untouched in (below, none, missing, soft):
+        assert "TC model" not in untouched.reason
+    assert (below.verdict, none.verdict, missing.verdict) == (REPRODUCED, REPRODUCED, NOT_RUN)

@@ -524,11 +524,11 @@ def test_an_s_wave_must_beat_the_slug_mode():
                                run_info=lambda: {"steady": True, "trend": 0.0,
                                                  "tc_fraction": 0.0, "tc": 1e-5})
 
-    (s,) = wave_checks({(0.1, 0.99, 0.7): run(391.0, 70.0)})
+    s = wave_checks({(0.1, 0.99, 0.7): run(391.0, 70.0)})[0]
     assert s.verdict == REPRODUCED and "R(1,±1) S-wave = 391 ± 10" in s.measured
-    (slug,) = wave_checks({(0.1, 0.99, 0.7): run(80.0, 75.0)})
+    slug = wave_checks({(0.1, 0.99, 0.7): run(80.0, 75.0)})[0]
     assert slug.verdict == NOT_REPRODUCED and "rather than an S-wave" in slug.reason
-    (noise,) = wave_checks({(0.1, 0.99, 0.7): run(1.0, 0.5)})
+    noise = wave_checks({(0.1, 0.99, 0.7): run(1.0, 0.5)})[0]
     assert noise.verdict == NOT_REPRODUCED and "noise of independent" in noise.reason
 
 
@@ -769,3 +769,123 @@ def test_a_flat_top_names_the_shortage_of_slow_particles_only_when_it_is_real():
     text = _slow_deficit(stat(streams), 0, 0)
     assert "fewer slow particles" in text and "against 0.398" in text
     assert _slow_deficit(stat(rng.normal(0, 1, n)), 0, 0) == ""
+
+
+def test_the_structure_of_each_beta_is_classed_from_the_three_modes():
+    """Figs 4.1/4.3/4.5: a plug is (0, 1) alone (the x-modulated modes below 1 % of it or at
+    the shot noise); x-modulation is an S-wave when (1, ±1) wins, a slug when (1, 0) wins,
+    mixed when neither does beyond 2σ. The β = 0 row expects a plug, β = -0.99 has no class
+    in the thesis."""
+    from demstudy.studies.malik2008.poiseuille_checks import NO_THESIS_VALUE, wave_checks
+    from demstudy.studies.malik2008.poiseuille_waves import structure_class
+    from demstudy.studies.records import DERIVED
+
+    def modes(r11, r10, r01=7000.0):
+        return {"11": (r11, 10.0), "10": (r10, 10.0), "01": (r01, 100.0)}
+
+    assert structure_class(modes(30.0, 20.0))[0] == "plug"  # < 1 % of (0, 1)
+    assert structure_class(modes(1.2, 0.9, 50.0))[0] == "plug"  # shot noise
+    assert structure_class(modes(391.0, 70.0))[0] == "s-wave"
+    assert structure_class(modes(70.0, 391.0))[0] == "slug"
+    assert structure_class(modes(614.0, 597.0))[0] == "mixed"
+
+    def run(beta, m):
+        groups = {f"{DERIVED}/mode_ratios": {k: np.array(v) for k, v in m.items()}}
+        return SimpleNamespace(flow=Flow(0.1, 0.7, beta), res=SimpleNamespace(groups=groups),
+                               path=None,
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    data = {(0.1, 0.99, 0.7): run(0.99, modes(391.0, 70.0)),
+            (0.1, 0.0, 0.7): run(0.0, modes(614.0, 597.0, 12000.0)),
+            (0.1, -0.99, 0.7): run(-0.99, modes(30.0, 20.0))}
+    s_wave, plug, smooth = wave_checks(data)
+    assert s_wave.verdict == REPRODUCED and "mean density profile" in s_wave.reason
+    assert plug.verdict == NOT_REPRODUCED and plug.measured.startswith("mixed")
+    assert "5.1 % of (0, 1) here against 5.6 % in the β = 0.99 run" in plug.reason
+    assert smooth.verdict == NO_THESIS_VALUE and smooth.measured.startswith("plug")
+    data[(0.1, 0.0, 0.7)] = run(0.0, modes(30.0, 20.0))
+    assert wave_checks(data)[1].verdict == REPRODUCED
+    assert [c.verdict for c in wave_checks({})] == [NOT_RUN] * 3
+
+
+def test_velocity_correlation_rows_name_common_motion_and_uncorrelated_runs():
+    """Figs 4.12-4.14, 4.19 have no values in the thesis's text: the rows give C_aa near
+    contact and at 4-5 d, and name the runs whose centre bin moves as a block (far C_xx
+    ≥ 0.5) and those uncorrelated as a molecular gas."""
+    from demstudy.studies.malik2008.poiseuille_checks import (
+        NO_THESIS_VALUE,
+        correlation_at,
+        vcorr_checks,
+    )
+
+    edges = np.linspace(0.0, 5.0, 51)
+
+    def run(beta, e, level):
+        c = np.zeros((25, 3, 50))
+        c[12, 0, 10:] = level  # C_xx of the centre bin from r = 1 d on
+        vc = {"r_edges": edges, "C": c, "C_err": np.full_like(c, 0.01)}
+        return SimpleNamespace(flow=Flow(0.1, e, beta), stat=lambda name: vc,
+                               run_info=lambda: {"steady": True, "trend": 0.0,
+                                                 "tc_fraction": 0.0, "tc": 1e-5})
+
+    vc = run(0.0, 0.7, 0.9).stat("vcorr")
+    assert correlation_at(vc, 12, 0, 1.0) == (0.9, 0.01)
+    assert correlation_at(vc, 12, 0, 4.0, 5.0)[0] == pytest.approx(0.9)
+    data = {(0.1, -0.99, 0.7): run(-0.99, 0.7, 0.95), (0.1, 0.99, 0.7): run(0.99, 0.7, 0.0),
+            (0.1, 0.0, 0.99): run(0.0, 0.99, 0.3)}
+    figs_12_13, fig_14, fig_19 = vcorr_checks(data)
+    assert figs_12_13.verdict == fig_14.verdict == NO_THESIS_VALUE
+    assert "bin 13: C_xx/C_yy/C_zz at r = 1 d 0.95 ± 0.01/" in figs_12_13.measured
+    assert "mostly common motion): β = -0.99, e = 0.7 (0.95)" in fig_14.reason
+    assert "in bin 13: β = 0.99, e = 0.7" in fig_14.reason  # uncorrelated
+    assert "β = 0, e = 0.99" not in fig_14.reason  # neither: 0.3
+    assert fig_19.verdict == NOT_RUN
+
+
+def test_wall_gradients_keep_an_antisymmetric_profile_and_rows_span_e():
+    """Fig 3.11: a symmetric profile's two wall gradients have opposite signs, ω_z's (odd
+    about the centre) the same sign: neither may cancel in the mean. Figs 3.10-3.11 rows give
+    each β's values at its smallest and largest e."""
+    from demstudy.studies.malik2008.poiseuille_checks import (
+        NO_THESIS_VALUE,
+        wall_slope,
+        wall_value_checks,
+    )
+
+    y = np.arange(25) * 2.0 + 1.0
+    c = 25.0
+    profiles = {"ux": 1.0 - ((y - c) / c) ** 2, "omz": (y - c) / c, "T": 1.0 + 0 * y,
+                "theta": 0.5 + 0 * y}
+
+    def run(beta, e):
+        return SimpleNamespace(
+            flow=Flow(0.01, e, beta), y=y,
+            series=lambda k: (profiles[k], np.full(25, 1e-3)),
+            wall_value=lambda k: (1.0, 0.01),
+            run_info=lambda: {"steady": True, "trend": 0.0, "tc_fraction": 0.0, "tc": 1e-5})
+
+    d = run(0.0, 0.8)
+    assert wall_slope(d, "ux")[0] == pytest.approx((profiles["ux"][1] - profiles["ux"][0]) / 2)
+    assert wall_slope(d, "omz")[0] == pytest.approx(1.0 / c)  # not cancelled
+    assert wall_slope(d, "T")[0] == pytest.approx(0.0)
+    data = {(0.01, 0.0, e): run(0.0, e) for e in (0.8, 0.9, 0.99)}
+    fig_310, fig_311 = wall_value_checks(data)
+    assert fig_310.verdict == fig_311.verdict == NO_THESIS_VALUE
+    assert "β = 0, e = 0.8 → 0.99:" in fig_310.measured and "0.9 →" not in fig_310.measured
+    assert [c.verdict for c in wall_value_checks({})] == [NOT_RUN, NOT_RUN]
+
+
+def test_the_free_path_tail_length_of_an_exponential_is_its_mean():
+    """Fig 3.9: P(l) = exp(-l/λ)/λ gives a tail length ℓ = λ; a longer tail gives ℓ > λ."""
+    from demstudy.studies.malik2008.poiseuille_checks import tail_length
+
+    x = np.linspace(0.5, 67.5, 50)
+    lam = 8.5
+    p = np.exp(-x / lam) / lam
+    fp = {"lambda": x, "p_lambda": p[None, :], "p_lambda_err": 0.02 * p[None, :],
+          "mean_free_path": np.array([lam])}
+    ell, got = tail_length(fp, 0)
+    assert got == lam and ell == pytest.approx(lam, rel=1e-6)
+    fp["p_lambda"] = (np.exp(-x / (1.2 * lam)) / (1.2 * lam))[None, :]
+    assert tail_length(fp, 0)[0] == pytest.approx(1.2 * lam, rel=1e-6)

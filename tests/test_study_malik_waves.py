@@ -7,6 +7,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -92,7 +93,7 @@ def test_each_tc_twin_is_its_box_at_a_smaller_tc_only(tag: str) -> None:
     assert twin.load() == box.load() and twin.scene == box.scene
     assert not box.options
     assert not any("tc" in c.name for c in waves.cases(True))
-    assert sum("-tc" in n for n in by_name) == len(waves.TC_TWINS) == 4
+    assert sum("-tc" in n for n in by_name) == len(waves.TC_TWINS) == 5
 
 
 def test_quick_subset_is_small_and_short() -> None:
@@ -258,9 +259,16 @@ def test_plug_turning_into_slug_is_not_steady_though_energy_is(tmp_path: Path) -
     steady = measure(_synthetic_run(tmp_path / "steady.h5", plug))
     assert steady.stationary and steady.modes.pattern == "plug"
     assert steady_check(box, steady).verdict == REPRODUCED
+    # a plateau is the halves' KE within 2σ + 2 %: 1.2 % apart (2.3σ) is one, 6.7 % is not,
+    # and the row says by how much the KE still rises
+    level = dataclasses.replace(steady, ke_halves=((1440.1, 5.2), (1422.3, 5.7)))
+    assert level.plateau and steady_check(box, level).verdict == REPRODUCED
+    rising = dataclasses.replace(steady, ke_halves=((6219.0, 50.0), (6637.0, 25.0)))
+    row = steady_check(box, rising)
+    assert not rising.plateau and row.verdict == PARTLY
+    assert "the KE/N rises by 6.7 % from the first half" in row.reason
     # a slug at one snapshot window of the production (too short to move a half): the
     # structure has not settled, and the row names the window
-    import dataclasses
 
     early = dataclasses.replace(steady, windows={11000.0: changing.halves[1]})
     assert early.window_changes == [11000.0] and not early.stationary
@@ -340,7 +348,6 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     """A box run whose pair collisions the TC model made elastic in a large share (20 %): an
     agreement becomes "partly", a mismatch stays "not reproduced", the share in the reason
     either way; 1 % changes nothing."""
-    import dataclasses
 
     from demstudy.studies.base import NOT_REPRODUCED, PARTLY, REPRODUCED
     from demstudy.studies.malik2008.waves_boxes import BOXES
@@ -412,7 +419,6 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     """The TC row: the same slug at both t_c with a small share at the smaller one is
     "reproduced"; a plug at the smaller t_c "not reproduced"; a KE apart or a large share at
     the smaller t_c "partly"; a missing twin "not run"."""
-    import dataclasses
 
     from demstudy.studies.base import NOT_REPRODUCED, PARTLY, REPRODUCED
     from demstudy.studies.malik2008.waves_measure import measure
@@ -475,7 +481,6 @@ def test_unbalanced_run_names_the_clock_that_dense_clumps_speed_up(tmp_path: Pat
     production (a slug forming): the KE against c/p rises ten times more slowly than in time,
     and the reason must say so with the measured rates; with a steady collision rate it must
     not blame the clock."""
-    import dataclasses
 
     from demstudy.studies.base import NOT_REPRODUCED
     from demstudy.studies.malik2008.waves_boxes import BOXES
@@ -514,7 +519,6 @@ def test_peak_density_is_judged_box_by_box(tmp_path: Path) -> None:
     """The colour bars' ≈ 0.58: a box whose 2 d / 5 d peaks bracket 0.58 (± 2σ + 0.03)
     counts; one box in range makes the row "partly" (the thesis's cells are unknown), none
     "not reproduced", and a close-packed densest box is named only when it is out of range."""
-    import dataclasses
 
     from demstudy.studies.base import NOT_REPRODUCED, PARTLY
     from demstudy.studies.malik2008.waves_measure import measure
@@ -542,7 +546,6 @@ def test_the_sequence_of_classes_is_compared_with_the_thesis_order(tmp_path: Pat
     """N = 50094's plug → S-wave → slug: our windows' classes in time order (repeats merged,
     classes the thesis does not name skipped) must follow the thesis's order from some class
     on; a slug turning back into a plug is another order."""
-    import dataclasses
 
     from demstudy.studies.malik2008.waves_measure import measure
     from demstudy.studies.malik2008.waves_report import sequence_text

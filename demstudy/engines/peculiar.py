@@ -11,6 +11,14 @@ profile (slope γ̇, zero without shear) plus a uniform velocity, the mass-weigh
 v − γ̇ y x̂ (the offset of the profile, a centre-of-mass drift). This is the same fluctuation
 ``/stress``'s kinetic part and the ``/profiles`` temperatures measure (about each bin's
 mean), up to the profile's variation inside a bin, γ̇² h²/12 in ⟨u'²⟩ for bins of width h.
+
+Why the imposed profile and not each bin's own mean: a bin's instantaneous mean of a few
+particles takes 1/N_bin of their thermal energy with it (a dilute gas's pressure would come
+out low by that), while the imposed profile is exact for the homogeneous shear these boxes
+make. A flow whose mean profile departs from it (shear bands, a plug in a dense box) keeps
+the departure's kinetic energy, ⟨ρ (u − γ̇ y)²⟩/2 per volume, in these observables; the
+``/stress`` and ``/profiles`` routes, which subtract each bin's time-averaged mean, do not:
+compare them when a band is suspected.
 """
 
 from __future__ import annotations

@@ -10,8 +10,9 @@ in its footer.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -47,8 +48,19 @@ def _finish(fig, path: Path, note: str = "") -> Path:
     return path
 
 
-def _colour(i: int):
-    return _plt().get_cmap("tab10")(i % 10)
+#: the study's reference run, black in every figure it is in
+REFERENCE = "chute-30-bumpy"
+
+
+def run_colours(runs: Sequence[ChuteRun]) -> dict[str, Any]:
+    """One colour per run of a figure, the same in each of its panels: the reference run
+    black, the others tab10's colours in the order they first appear (tab20's beyond ten
+    runs, so that no two runs of a figure share one)."""
+    names = list(dict.fromkeys(r.name for r in runs))
+    others = [n for n in names if n != REFERENCE]
+    size = 10 if len(others) <= 10 else 20
+    cmap = _plt().get_cmap(f"tab{size}")
+    return {n: ("k" if n == REFERENCE else cmap(others.index(n) % size)) for n in names}
 
 
 def _bed(run: ChuteRun) -> np.ndarray:
@@ -57,20 +69,22 @@ def _bed(run: ChuteRun) -> np.ndarray:
 
 
 def profile_panels(axes: Sequence, runs: Sequence[ChuteRun], labels: Sequence[str],
-                   what: Sequence[str] = ("u", "nu", "T", "T_rot"), fit: bool = False) -> None:
+                   what: Sequence[str] = ("u", "nu", "T", "T_rot"), fit: bool = False,
+                   colours: Mapping[str, Any] | None = None) -> None:
     """Campbell's profile forms against y/H (vertical): u/u_max, ν, T, T_rot; ``fit``: overlay
     the thesis's velocity-profile fit F(y/H) (COL007, digest §1.2) on u/u_max."""
     titles = {"u": ("u / u_max", "mean velocity"), "nu": ("ν", "solid fraction"),
               "T": ("T [g d]", "translational temperature (⟨u'²⟩+⟨v'²⟩)/2"),
               "T_rot": ("T_rot [g d]", "rotational temperature β⟨w'²⟩")}
+    colours = colours or run_colours(runs)
     for ax, key in zip(axes, what, strict=True):
-        for i, (run, label) in enumerate(zip(runs, labels, strict=True)):
+        for run, label in zip(runs, labels, strict=True):
             p, sel = run.profiles, _bed(run)
             value, err = p[key][sel], p[f"{key}_err"][sel]
             if key == "u":
                 value, err = value / run.u_max, err / abs(run.u_max)
             ax.errorbar(value, p["y"][sel] / run.depth, xerr=err, fmt="o-", ms=3, lw=1,
-                        capsize=2, color=_colour(i), label=label)
+                        capsize=2, color=colours[run.name], label=label)
         if key == "u" and fit:
             from ...scene.initial import CAMPBELL_CHUTE_FIT
 
@@ -103,9 +117,10 @@ def energy_history(runs: dict[str, ChuteRun], main: str, path: Path) -> Path | N
         return None
     plt = _plt()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5.2))
+    colours = run_colours(list(runs.values()))
     if main in runs:
         r = runs[main]
-        ax1.plot(r.t, r.energy, color=_colour(0), lw=0.7, label=r.label)
+        ax1.plot(r.t, r.energy, color=colours[r.name], lw=0.7, label=r.label)
         prod = r.t > r.start
         m = float(r.energy[prod].mean())
         ax1.axhline(m, color="k", lw=1, label=f"production mean {m:.1f}")
@@ -117,8 +132,8 @@ def energy_history(runs: dict[str, ChuteRun], main: str, path: Path) -> Path | N
                       "(converged: |trend| < 0.2 within 2σ)",
                 ylim=(0, 2.2 * m))
         ax1.legend(fontsize=8, loc="upper right")
-    for i, r in enumerate(runs.values()):
-        ax2.plot(r.t, r.energy, color=_colour(i), lw=0.8,
+    for r in runs.values():
+        ax2.plot(r.t, r.energy, color=colours[r.name], lw=0.8,
                  label=f"{r.name}: trend {r.trend:+.2f}")
     ax2.set(yscale="log", xlabel="t [√(d/g)]", ylabel="kinetic energy per disc [m g d]",
             title="the angle series (log scale)")
@@ -203,8 +218,9 @@ def plug_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
     labels = [f"{r.name} ({r.base} base)" for r in runs]
     profile_panels(axes[:2], runs, labels, what=("nu", "u"))
     axes[0].axvline(NU_SHEARABLE, color="k", ls="--", lw=1, label="ν_m = 0.821 (max. shearable)")
+    colours = run_colours(runs)
     for i, r in enumerate(runs):
-        axes[2].plot(r.t, r.energy, color=_colour(i), lw=0.8, label=labels[i])
+        axes[2].plot(r.t, r.energy, color=colours[r.name], lw=0.8, label=labels[i])
     axes[2].set(yscale="log", xlabel="t [√(d/g)]", ylabel="kinetic energy per disc [m g d]",
                 title="energy history")
     axes[2].title.set_fontsize(9)
@@ -219,8 +235,9 @@ def flat_scan_figure(flat: Sequence[ChuteRun], bumpy: ChuteRun | None, path: Pat
     plt = _plt()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5.2))
     flat = sorted(flat, key=lambda r: r.angle)
-    for i, r in enumerate(flat):
-        ax1.plot(r.t, r.energy, color=_colour(i), lw=0.8, label=f"flat base, {r.angle:g}°")
+    colours = run_colours(flat)
+    for r in flat:
+        ax1.plot(r.t, r.energy, color=colours[r.name], lw=0.8, label=f"flat base, {r.angle:g}°")
     if bumpy is not None:
         ax1.plot(bumpy.t, bumpy.energy, color="k", lw=0.8, label="bumpy base, 30°")
     ax1.set(yscale="log", xlabel="t [√(d/g)]", ylabel="kinetic energy per disc [m g d]",
@@ -251,8 +268,9 @@ def tc_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
     fig, axes = plt.subplots(1, 4, figsize=(15, 5.4))
     labels = [f"t_c = {r.tc:g}" for r in runs]
     profile_panels(axes[:2], runs, labels, what=("u", "nu"))
+    colours = run_colours(runs)
     for i, r in enumerate(runs):
-        axes[2].plot(r.t, r.energy, color=_colour(i), lw=0.7, label=labels[i])
+        axes[2].plot(r.t, r.energy, color=colours[r.name], lw=0.7, label=labels[i])
     axes[2].axvline(runs[0].start, color="k", ls=":", lw=1)
     axes[2].set(xlabel="t [√(d/g)]  (dotted: end of equilibration)",
                 ylabel="kinetic energy per disc [m g d]", title="energy history")
@@ -274,8 +292,10 @@ def series_figure(series: Sequence[tuple[str, Sequence[ChuteRun], Sequence[str]]
         return None
     plt = _plt()
     fig, axes = plt.subplots(2, len(series), figsize=(4.2 * len(series), 9), squeeze=False)
+    colours = run_colours([r for _title, runs, _labels in series for r in runs])
     for j, (title, runs, labels) in enumerate(series):
-        profile_panels([axes[0, j], axes[1, j]], runs, labels, what=("u", "nu"))
+        profile_panels([axes[0, j], axes[1, j]], runs, labels, what=("u", "nu"),
+                       colours=colours)
         axes[0, j].set_title(f"{title}: u/u_max", fontsize=9)
         axes[1, j].set_title(f"{title}: ν", fontsize=9)
         axes[0, j].legend(fontsize=7, loc="upper left")

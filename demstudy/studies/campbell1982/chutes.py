@@ -12,15 +12,16 @@ Cases: :mod:`.chute_cases` (which base for which statement, and why); the measur
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
-from ..base import Analysis, Case, Figure, pm
+from ..base import Analysis, Case, Figure, pm, tc_caveats
 from . import chute_figures as figs
 from .chute_cases import cases as _cases
-from .chute_checks import all_checks
+from .chute_checks import all_checks, tc_unchanged
 from .chute_measure import ChuteRun, summarise_all
 
 __all__ = ["analyse", "cases"]
@@ -187,6 +188,8 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     found = summarise_all(dict(runs))
     out.mkdir(parents=True, exist_ok=True)
     checks = all_checks(found, quick)
+    shares = {n: (r.tc_share, math.nan if r.tc is None else r.tc) for n, r in found.items()}
+    tc_caveats(checks, shares, tc_unchanged(found))
     sections = [("Chutes: how they were measured, and which base", HOW)]
     if found:
         sections.append(("Chutes: every run", _table(found)))

@@ -15,10 +15,11 @@ Measurements: :mod:`.couette_measure`; checks: :mod:`.couette_checks`; figures:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from ..base import Analysis, Case, pm
+from ..base import Analysis, Case, pm, tc_caveats
 from . import couette_checks as ck
 from . import couette_figures as figs
 from .couette_cases import FIXED_NU, SERVO_FACTORS, SHEAR_RATES, all_cases, nu_tag
@@ -49,6 +50,8 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     summaries = {name: summarise(name, Path(path)) for name, path in sorted(runs.items())}
     ana = Analysis()
     ana.checks = checks(summaries)
+    tc_caveats(ana.checks, {n: (r.attrs.get("tc_elastic_fraction", math.nan),
+                                r.attrs.get("tc", math.nan)) for n, r in summaries.items()})
     ana.figures = figures(summaries, out)
     ana.sections = sections(summaries, quick)
     return ana
@@ -134,6 +137,12 @@ def figures(s: dict[str, RunSummary], out: Path) -> list:
     return made
 
 
+def _share(r: RunSummary) -> str:
+    """The run's TC-elastic share, "—" for an engine without the TC model (soft contacts)."""
+    share = r.attrs.get("tc_elastic_fraction", math.nan)
+    return "—" if not math.isfinite(share) else f"{100 * share:.2f} %"
+
+
 def _row(name: str, r: RunSummary) -> str:
     return (f"| {name} | {r.attrs['engine']} | {pm(*r.values['nu_cell'])} | "
             f"{pm(*r.values['nu'])} | {pm(*r.values.get('S_text', (float('nan'), 0)))} | "
@@ -142,7 +151,7 @@ def _row(name: str, r: RunSummary) -> str:
             f"{pm(*r.values.get('chi', (float('nan'), 0)))} | {pm(*r.values['T_mean'])} | "
             f"{pm(*r.values['rot_share'])} | "
             f"{pm(*r.values.get('layering', (float('nan'), 0)))} | "
-            f"{100 * r.attrs['tc_elastic_fraction']:.2f} % |")
+            f"{_share(r)} |")
 
 
 HEADER = ("| run | engine | ν cell | ν centre | S (text) | f_s | f_N | χ | T(H/U_T)² | "
@@ -209,7 +218,7 @@ def causes(s: dict[str, RunSummary]) -> str:
                 rows.append(f"| ν = {nu:g} | {what} | {pm(*r.values['nu'])} | "
                             f"{pm(*r.values['S_text'])} | {pm(*r.values['f_s'])} | "
                             f"{pm(*r.values['T_mean'])} | {pm(*r.values['layering'])} | "
-                            f"{100 * r.attrs['tc_elastic_fraction']:.2f} % |")
+                            f"{_share(r)} |")
     for name, what in ((K1[1], "baseline: rough walls, servo σ_n×1, t_c = 1e-5"),
                        ("couette-cause-tc0.0001-rough-servo-s1", "rough servo, t_c = 1e-4"),
                        ("couette-cause-tc1e-06-rough-servo-s1", "rough servo, t_c = 1e-6")):
@@ -219,7 +228,7 @@ def causes(s: dict[str, RunSummary]) -> str:
                         f"{pm(*r.values['nu_cell'])}) | {pm(*r.values['S_text'])} | "
                         f"{pm(*r.values['f_s'])} | {pm(*r.values['T_mean'])} | "
                         f"{pm(*r.values['layering'])} | "
-                        f"{100 * r.attrs['tc_elastic_fraction']:.2f} % |")
+                        f"{_share(r)} |")
     servo = [(n, s[n]) for n in K2 if n in s]
     if not rows and not servo:
         return "The cause runs are not in this run of the study (full study only)."

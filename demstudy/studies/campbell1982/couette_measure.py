@@ -147,6 +147,7 @@ def summarise(name: str, path: Path) -> RunSummary:
     _distributions(out, res, (float(edges[0]), float(edges[-1])) if not servo else
                    (float(res.profiles["edges"][0]), float(res.profiles["edges"][-1])))
     out.attrs["tc_elastic_fraction"] = float(res.attrs.get("tc_elastic_fraction", math.nan))
+    out.attrs["tc"] = float(res.attrs.get("tc", math.nan))  # the event-driven engine's t_c
     out.attrs["engine"] = res.attrs.get("engine", "?")
     out.attrs["rows_columns"] = (scene.initial.rows, scene.initial.columns)
     out.attrs["eps"] = (scene.walls[0].restitution, scene.contact.restitution)

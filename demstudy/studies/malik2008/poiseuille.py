@@ -32,6 +32,8 @@ from .poiseuille_data import (
     vdf_bins,
 )
 from .poiseuille_figures import (
+    GRADIENT_PANELS,
+    freepath_figure,
     gr_figure,
     lambda_figure,
     profiles_figure,
@@ -50,9 +52,10 @@ Runs = dict[tuple[float, float, float], FlowData]  # (φ, β, e) -> run
 #: the checks, in the report's order: each takes the runs and returns its Check(s)
 CHECKS: tuple[Callable[[Runs], list[Check]], ...] = (
     pc.steady_checks, pc.validation_checks, pc.dissipation_checks, pc.knudsen_checks,
-    pc.vdf_checks, pc.vdf_elastic_limit_checks, pc.wall_dissipation_checks,
+    pc.freepath_checks,
+    pc.vdf_checks, pc.vdf_elastic_limit_checks, pc.wall_value_checks, pc.wall_dissipation_checks,
     pc.contact_checks, pc.gr_shell_checks, pc.sparse_wall_checks, pc.lambda_checks,
-    pc.dense_checks, pc.wave_checks)
+    pc.vcorr_checks, pc.dense_checks, pc.wave_checks)
 
 
 #: a steady run (|trend| < STEADY_LIMIT) whose kinetic energy still changes by this fraction
@@ -214,11 +217,26 @@ def _phi_figures(data: Runs, phi: float, out: Path, tag: str) -> list[Figure]:
                            f"Λ(y) (horizontal) against y, φ = {phi:g}, one panel per β, "
                            "the molecular 1/3 line; inset: Λ(centre) and mean Λ against e."))
     if phi == 0.01 and any(len(ds) > 1 for _b, ds in groups):
-        figs.append(Figure(wall_figure([(f"β = {b:g}", ds) for b, ds in groups],
+        by_beta = [(f"β = {b:g}", ds) for b, ds in groups]
+        figs.append(Figure(wall_figure(by_beta,
                                        f"Malik Fig 3.10: wall values vs e, φ = {phi:g}{tag}",
                                        out / f"poiseuille-walls-phi{phi:g}.png"),
                            "Translational and rotational slip, T and θ at the walls (mean "
                            "of bins 1 and 25) against e, one curve per β (Fig 3.10)."))
+        figs.append(Figure(wall_figure(by_beta, f"Malik Fig 3.11: wall gradients vs e, "
+                                                f"φ = {phi:g}{tag}",
+                                       out / f"poiseuille-wall-gradients-phi{phi:g}.png",
+                                       value=pc.wall_slope, panels=GRADIENT_PANELS),
+                           "Wall gradients of U_x, ω_z, T and θ (bins 1-2 and 24-25, per d) "
+                           "against e, one curve per β (Fig 3.11)."))
+        figs.append(Figure(freepath_figure(by_beta[::-1], f"Malik Fig 3.9: free-path "
+                                                          f"distribution in bin 13, "
+                                                          f"φ = {phi:g}{tag}",
+                                           out / f"poiseuille-freepath-phi{phi:g}.png",
+                                           CENTRE_BIN - 1),
+                           "P(l) of the free paths (relative to the local mean flow) in bin "
+                           "13, several e, one panel per β (β = 0.99, 0, -0.99 as in Fig "
+                           "3.9); dashed: exp(-l/λ)/λ with each run's λ."))
     return figs
 
 

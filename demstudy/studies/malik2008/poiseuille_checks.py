@@ -19,7 +19,17 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...engines.edmd.tc_share import WARN_SHARE
-from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, not_run, pm, within
+from ..base import (
+    NO_THESIS_VALUE,
+    NOT_REPRODUCED,
+    NOT_RUN,
+    PARTLY,
+    REPRODUCED,
+    Check,
+    not_run,
+    pm,
+    within,
+)
 from .poiseuille_cases import BETAS, RESTITUTIONS
 from .poiseuille_data import (
     CENTRE_BIN,
@@ -1033,10 +1043,23 @@ def _second_shell(d: FlowData) -> tuple[str, bool]:
 
 
 def wave_checks(data: Runs) -> list[Check]:
+    """Figs 4.1, 4.3, 4.5 (φ = 0.1, e = 0.7): the density structure for each β, from the
+    modes of the xy density (``poiseuille_waves``): the thesis names the β = 0 plug [L875]
+    and the β = 0.99 S-wave (Fig 4.5); of β = -0.99 it shows snapshots only."""
+    return [_s_wave(data), _beta_structure(data, 0.0), _beta_structure(data, -0.99)]
+
+
+#: the (0, 1) mode is also the mean density profile across the walls: strong in every
+#: wall-bounded flow, so the structures are told apart by the x-modulated modes
+PROFILE_MODE = ("the (0, 1) mode is also the mean density profile across the walls, strong in "
+                "every wall-bounded flow: the structures differ in the x-modulated modes")
+
+
+def _s_wave(data: Runs) -> Check:
     d = data.get((0.1, 0.99, 0.7))
     ref, statement = "Fig 4.5 [L925]", "φ = 0.1, β = 0.99, e = 0.7: an S-shaped density wave"
     if d is None:
-        return [not_run(ref, statement, "S-wave seen", "the φ = 0.1, β = 0.99, e = 0.7 run")]
+        return not_run(ref, statement, "S-wave seen", "the φ = 0.1, β = 0.99, e = 0.7 run")
     from .poiseuille_waves import mode_ratios, s_wave_text
 
     r = mode_ratios(d)
@@ -1050,8 +1073,250 @@ def wave_checks(data: Runs) -> list[Check]:
               if not above_noise else
               "the (1,1) mode does not exceed the slug's (1,0) beyond 2σ: a slug or a mixed "
               "wave rather than an S-wave")
-    return [Check(ref, statement, "S-wave (mode (1,1) of the xy density)", text,
-                  _cap(REPRODUCED if seen else NOT_REPRODUCED, d), reason + _steady_note(d))]
+    reason = f"{reason}; {PROFILE_MODE}" if reason else PROFILE_MODE[0].upper() + PROFILE_MODE[1:]
+    return Check(ref, statement, "S-wave (mode (1,1) of the xy density)", text,
+                 _cap(REPRODUCED if seen else NOT_REPRODUCED, d), reason + "." + _steady_note(d),
+                 runs=(d.flow.name,))
+
+
+def _beta_structure(data: Runs, beta: float) -> Check:
+    """The β = 0 plug [L875] (Fig 4.3), or the β = -0.99 structure (Fig 4.1: no class in
+    the thesis's text)."""
+    from .poiseuille_waves import s_wave_text, structure_class
+
+    plug = beta == 0.0
+    ref = "[L875], Fig 4.3" if plug else "Fig 4.1 [L861]"
+    statement = (f"φ = 0.1, β = {beta:g}, e = 0.7: " + ("a plug (dense centre, no modulation "
+                 "along the flow)" if plug else "the density structure (snapshots)"))
+    thesis = "plug" if plug else "snapshots only (no class stated)"
+    d = data.get((0.1, beta, 0.7))
+    if d is None:
+        return not_run(ref, statement, thesis, f"the φ = 0.1, β = {beta:g}, e = 0.7 run")
+    from .poiseuille_waves import mode_ratios
+
+    r = mode_ratios(d)
+    kind, why = structure_class(r)
+    measured = f"{kind}: {why}; {s_wave_text(r)}"
+    if not plug:
+        return Check(ref, statement, thesis, measured, NO_THESIS_VALUE,
+                     "the thesis shows this run's snapshots without naming its structure; "
+                     + PROFILE_MODE + "." + _steady_note(d), runs=(d.flow.name,))
+    if kind == "plug":
+        return Check(ref, statement, thesis, measured, _cap(REPRODUCED, d),
+                     _steady_note(d).strip(), runs=(d.flow.name,))
+    other = data.get((0.1, 0.99, 0.7))
+    than = ""
+    if other is not None:
+        o = mode_ratios(other)
+        share = lambda m: 100 * max(m["11"][0], m["10"][0]) / m["01"][0]  # noqa: E731
+        than = (f" ({share(r):.2g} % of (0, 1) here against {share(o):.2g} % in the β = 0.99 "
+                "run the thesis calls an S-wave)")
+    return Check(ref, statement, thesis, measured, NOT_REPRODUCED,
+                 f"not a plug: the density is modulated along the flow ({kind}){than}; the "
+                 "thesis's plug is read off snapshots (one time), ours is the mean over the "
+                 "production's frames; " + PROFILE_MODE + "." + _steady_note(d),
+                 runs=(d.flow.name,))
+
+
+# ------------------------------------------------------------------ free paths (Fig 3.9)
+def tail_length(fp: dict[str, np.ndarray], b: int, below: float = math.inf
+                ) -> tuple[float, float]:
+    """(ℓ, λ) in bin ``b`` (0-based): the decay length of P(l)'s tail, a weighted
+    straight-line fit to log P over λ < l < min(4λ, ``below``) (resolved histogram bins
+    only; ``below``: where the walls start to cut the flights off), and the mean free path
+    λ."""
+    x, p, e = fp["lambda"], fp["p_lambda"][b], fp["p_lambda_err"][b]
+    lam = float(fp["mean_free_path"][b])
+    ok = (p > 0) & np.isfinite(e) & (e < 0.5 * p) & (x > lam) & (x < min(4 * lam, below))
+    if ok.sum() < 3:
+        return math.nan, lam
+    slope = np.polyfit(x[ok], np.log(p[ok]), 1, w=p[ok] / e[ok])[0]
+    return (-1.0 / slope if slope < 0 else math.nan), lam
+
+
+#: the tail fit stops at this fraction of the distance from the bin to the nearer wall
+WALL_REACH = 0.8
+
+
+def freepath_checks(data: Runs) -> list[Check]:
+    """Fig 3.9: the free-path distribution P(l), whose tails the thesis shows on a log scale
+    without stating values: the tail's decay length against the mean free path in bin 13,
+    fitted below the distance to the walls (which cut the longest flights off)."""
+    ref, statement = "Fig 3.9 [L718]", ("φ = 0.01: the free-path distribution P(l) for "
+                                        "several e (tails on a log scale)")
+    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.01
+          and "p_lambda" in d.stat("freepath")]
+    if not ds:
+        return [not_run(ref, statement, "figure only", "the φ = 0.01 runs")]
+    parts, ratios = [], []
+    y = ds[0].y
+    reach = float(min(y[CENTRE_BIN - 1], y[-1] + y[0] - y[CENTRE_BIN - 1]))  # to a wall
+    for d in ds:
+        ell, lam = tail_length(d.stat("freepath"), CENTRE_BIN - 1, WALL_REACH * reach)
+        ratios.append(ell / lam)
+        parts.append(f"{_tag(d)}: ℓ = {ell:.3g} d, λ = {lam:.3g} d (ℓ/λ {ell / lam:.2f})")
+    lo, hi = np.nanmin(ratios), np.nanmax(ratios)
+    return [Check(ref, statement, "figure only (no values in the text)",
+                  f"bin 13, tail exp(-l/ℓ) fitted over λ < l < {WALL_REACH * reach:.0f} d: "
+                  + "; ".join(parts), NO_THESIS_VALUE,
+                  f"the tails decay as exp(-l/ℓ) with ℓ = {lo:.2f}-{hi:.2f} λ: a free flight "
+                  "ends at a rate set by the collision frequency, as in a dilute gas"
+                  + ("; ℓ above λ: fast particles fly further (a hard sphere's free path "
+                     "grows with its speed)" if lo > 1 else "")
+                  + f". Beyond the walls' distance ({reach:.0f} d from bin 13) P(l) has a "
+                  "shoulder and then drops: the walls end the longest flights (the figure); "
+                  "the thesis states no value to compare with." + _steady_note(ds),
+                  runs=tuple(d.flow.name for d in ds))]
+
+
+# ------------------------------------------------------------------ wall values (Figs 3.10-3.11)
+WALL_KEYS = (("ux", "U_x*"), ("omz", "ω_z*"), ("T", "T*"), ("theta", "θ*"))
+
+
+def wall_slope(d: FlowData, key: str) -> tuple[float, float]:
+    """The wall gradient of profile ``key`` (bins 1-2 and 24-25, per d): the mean magnitude
+    of the two walls' gradients, signed as at the lower wall (ω_z is antisymmetric: its two
+    walls' gradients have the same sign; the other profiles are symmetric: opposite)."""
+    v, e = d.series(key)
+    if key != "omz":
+        return wall_gradient(v, e, d.y)
+    dy = float(d.y[1] - d.y[0])
+    value = 0.5 * ((v[1] - v[0]) + (v[-1] - v[-2])) / dy
+    return float(value), 0.5 * math.sqrt(e[0] ** 2 + e[1] ** 2 + e[-1] ** 2 + e[-2] ** 2) / dy
+
+
+def wall_value_checks(data: Runs) -> list[Check]:
+    """Figs 3.10 and 3.11 (φ = 0.01): the wall values (Malik's mean of bins 1 and 25) and the
+    wall gradients against e, one curve per β: figures only in the thesis (digest §4.5);
+    the rows give the values at the smallest and largest e of each β."""
+    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.01]
+    rows = [("Fig 3.10 [L722]", "φ = 0.01: translational and rotational slip, T and θ at the "
+             "walls against e, one curve per β", lambda d, k: d.wall_value(k)),
+            ("Fig 3.11 [L732] (digest item 8)", "φ = 0.01: wall gradients of U_x, ω_z, T, θ "
+             "against e, one curve per β", wall_slope)]
+    out = []
+    for ref, statement, value in rows:
+        if not ds:
+            out.append(not_run(ref, statement, "figures only", "the φ = 0.01 runs"))
+            continue
+        parts = []
+        for beta in sorted({d.flow.beta for d in ds}):
+            by_e = sorted((d for d in ds if d.flow.beta == beta), key=lambda d: d.flow.e)
+            ends = [by_e[0], by_e[-1]] if len(by_e) > 1 else by_e
+            cells = [f"{name} " + " → ".join(pm(*value(d, key)) for d in ends)
+                     for key, name in WALL_KEYS]
+            span = " → ".join(f"{d.flow.e:g}" for d in ends)
+            parts.append(f"β = {beta:g}, e = {span}: " + ", ".join(cells))
+        out.append(Check(ref, statement, "figures only (no values in the text)",
+                         "; ".join(parts) + " (ω_z at the walls: positive when the spheres "
+                         "roll along them; gradients per d, signed as at the lower wall)",
+                         NO_THESIS_VALUE,
+                         "the thesis plots these against e without stating values; its text's "
+                         "one claim about the walls (much wall dissipation for β = 0) has its "
+                         "own row." + _steady_note(ds), runs=tuple(d.flow.name for d in ds)))
+    return out
+
+
+# ------------------------------------------------------------------ velocity correlations
+#: the far range of C_aa(r): its mean over 4 d ≤ r < 5 d (the largest shells measured) is the
+#: share of the bin's fluctuation about its run mean that moves together across the bin
+FAR = (4.0, 5.0)
+
+
+def correlation_at(vc: dict[str, np.ndarray], b: int, a: int, lo: float,
+                   hi: float | None = None) -> tuple[float, float]:
+    """C_aa of bin ``b`` (0-based), component ``a``, at the shell starting at ``lo`` (or the
+    mean over lo ≤ r < hi, errors combined as independent: a yardstick)."""
+    edges = vc["r_edges"]
+    if hi is None:
+        k = int(np.searchsorted(edges, lo - 1e-9))
+        return float(vc["C"][b, a, k]), float(vc["C_err"][b, a, k])
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    sel = (centres >= lo) & (centres < hi)
+    v, e = vc["C"][b, a, sel], vc["C_err"][b, a, sel]
+    return _mean(v, e)
+
+
+def _correlation_text(d: FlowData, bins: Sequence[int]) -> str:
+    vc, parts = d.stat("vcorr"), []
+    for k in bins:
+        near = "/".join(pm(*correlation_at(vc, k - 1, a, 1.0), 1) for a in range(3))
+        far = "/".join(pm(*correlation_at(vc, k - 1, a, *FAR), 1) for a in range(3))
+        parts.append(f"bin {k}: C_xx/C_yy/C_zz at r = 1 d {near}, at {FAR[0]:g}-{FAR[1]:g} d "
+                     f"{far}")
+    return f"{_tag(d)}: " + "; ".join(parts)
+
+
+COMMON_MOTION = (
+    "No value in the thesis's text (figures only). C_aa(r) about the bin's run mean (the "
+    "formula's ⟨c⟩, digest §4.1, §4.9) does not decay where it stays near its r = 1 d value "
+    "out to 5 d: that share of the bin's ⟨C_a²⟩ is motion common to the whole bin, the "
+    "dense centre moving as a block whose speed varies over the run (a plug or wave, or a "
+    "drift), not thermal motion; the bin's T, VDF and Λ, taken about the same run mean, "
+    "include it (about the instantaneous bin mean T_aa would be about (1 − far value) of "
+    "it)")
+
+
+def _common_motion(ds: Sequence[FlowData]) -> str:
+    """COMMON_MOTION and, in the centre bin, which runs are dominated by common motion (far
+    C_xx ≥ 0.5) and which are uncorrelated as a molecular gas (|C_aa| < 0.05 at every r)."""
+    block, free = [], []
+    for d in ds:
+        vc = d.stat("vcorr")
+        if "C" not in vc:
+            continue
+        far = correlation_at(vc, CENTRE_BIN - 1, 0, *FAR)[0]
+        if far >= 0.5:
+            block.append(f"{_tag(d)} ({far:.2f})")
+        elif np.nanmax(np.abs(vc["C"][CENTRE_BIN - 1])) < 0.05:
+            free.append(_tag(d))
+    text = COMMON_MOTION
+    if block:
+        text += f". Bin 13's far C_xx ≥ 0.5 (mostly common motion): {', '.join(block)}"
+    if free:
+        text += f". Uncorrelated (|C_aa| < 0.05 at every r) in bin 13: {', '.join(free)}"
+    return text
+
+
+def vcorr_checks(data: Runs) -> list[Check]:
+    """Figs 4.12-4.14 and 4.19: the spatial velocity correlations C_aa(r) (digest §4.9) that
+    the thesis plots without stating values: measured near contact and at the far range,
+    with what a far value that does not decay means."""
+    out = []
+    rows = [("Figs 4.12-4.13 [L978], [L988]", (0.1, -0.99), (0.1, 0.99), (1, 4, 13),
+             "φ = 0.1, β = ∓0.99, e = 0.7, bins 1, 4, 13: velocity correlations C_xx, C_yy, "
+             "C_zz against r")]
+    for ref, *keys, bins, statement in rows:
+        ds = [data[(p, b, 0.7)] for p, b in keys if (p, b, 0.7) in data]
+        if not ds:
+            out.append(not_run(ref, statement, "figures only", "the φ = 0.1, e = 0.7 runs"))
+            continue
+        out.append(Check(ref, statement, "figures only (no values in the text)",
+                         "; ".join(_correlation_text(d, bins) for d in ds), NO_THESIS_VALUE,
+                         _common_motion(ds) + "." + _steady_note(ds),
+                         runs=tuple(d.flow.name for d in ds)))
+    ref = "Fig 4.14 [L992]"
+    statement = "φ = 0.1, bin 13, several e: C_xx, C_yy, C_zz for each β"
+    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.1]
+    if not ds:
+        out.append(not_run(ref, statement, "figures only", "the φ = 0.1 runs"))
+    else:
+        out.append(Check(ref, statement, "figures only (no values in the text)",
+                         "; ".join(_correlation_text(d, (CENTRE_BIN,)) for d in ds),
+                         NO_THESIS_VALUE, _common_motion(ds) + "." + _steady_note(ds),
+                         runs=tuple(d.flow.name for d in ds)))
+    ref = "Fig 4.19 [L1036], [L1048]"
+    statement = "φ = 0.5, bins 1, 3, 13: C_xx, C_yy, C_zz against r (compared with Orpe & "
+    statement += "Kudrolli's experiments in the thesis)"
+    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.5]
+    if not ds:
+        out.append(not_run(ref, statement, "figures only", "the φ = 0.5 run"))
+    else:
+        out.append(Check(ref, statement, "figures only; Orpe & Kudrolli's values not in the "
+                         "digest", "; ".join(_correlation_text(d, (1, 3, 13)) for d in ds),
+                         NO_THESIS_VALUE, _common_motion(ds) + "." + _steady_note(ds),
+                         runs=tuple(d.flow.name for d in ds)))
+    return out
 
 
 # ------------------------------------------------------------------ numbers for the report

@@ -91,32 +91,50 @@ def trace_figure(datas: Sequence[FlowData], title: str, out: Path) -> Path:
     return save(fig, out)
 
 
+#: the VDF panels' line styles: no dashes, which mark the Gaussian (Malik's black dashed line)
+VDF_STYLES = ("-", "-.", ":", (0, (4, 1, 1, 1, 1, 1)))
+#: the panels' upper limit of P/P(0): a curve beyond it is a core the P(0) = 1 scaling fails on
+VDF_TOP = 3.0
+
+
 def vdf_figure(series: Sequence[Series], title: str, out: Path) -> Path:
     """Six panels P(x) against x = C/σ (P(0) = 1, log scale) with the Gaussian exp(-x²/2);
-    shaded: ± the block-jackknife error; histogram bins with errors > 50 % are left out."""
+    shaded: ± the block-jackknife error; histogram bins with errors > 50 % are left out. A
+    curve that leaves the panel (P/P(0) > VDF_TOP: a spike the P(0) = 1 scaling cannot
+    normalise, e.g. a plug's bin whose σ is its drift) or has no resolved bin is named in
+    the panel, not left to look like missing data."""
     fig, axes = new_figure(2, 3, width=3.4, height=2.9)
     colours = _series_colours(series)
     for c, ax in enumerate(axes.flat):
-        for i, (_label, d, b) in enumerate(series):
+        notes = []
+        for i, (label, d, b) in enumerate(series):
             vdf = d.stat("vdf")
             if "malik_P" not in vdf:
                 continue
             x, p, e = vdf["malik_centres"], vdf["malik_P"][b, c], vdf["malik_P_err"][b, c]
             # histogram bins resolved within their error only (the far tails are noise)
             ok = (p > 0) & np.isfinite(e) & (e < 0.5 * p)
-            ax.plot(x[ok], p[ok], color=colours[i], ls=LINESTYLES[i % 4], lw=1.3)
+            if not ok.any():
+                notes.append(f"{label.split(' (')[0]}: no resolved bin")
+                continue
+            ax.plot(x[ok], p[ok], color=colours[i], ls=VDF_STYLES[i % 4], lw=1.3)
             ax.fill_between(x[ok], np.maximum(p[ok] - e[ok], 1e-5), p[ok] + e[ok],
                             color=colours[i], alpha=0.25, lw=0)
+            if p[ok].max() > VDF_TOP:
+                notes.append(f"{label.split(' (')[0]}: off scale (peak {p[ok].max():.0f})")
         x = np.linspace(-5, 5, 201)
         ax.plot(x, np.exp(-0.5 * x**2), "k--", lw=1)
         ax.set_yscale("log")
-        ax.set_ylim(1e-4, 3)
+        ax.set_ylim(1e-4, VDF_TOP)
         ax.set_xlim(-5, 5)
         ax.set_xlabel(f"{VDF_COMPONENTS[c]}/σ")
         ax.set_ylabel(f"P({VDF_COMPONENTS[c]}/σ), P(0) = 1")
+        if notes:  # the empty floor between the Gaussian's flanks
+            ax.text(0.5, 0.04, "\n".join(notes), transform=ax.transAxes, ha="center",
+                    va="bottom", fontsize=7, color="0.25")
     labels = [s[0] for s in series] + ["Gaussian exp(-x²/2)"]
     handles, labels = _legend(labels, colours + ["k"],
-                              [LINESTYLES[i % 4] for i in range(len(series))] + ["--"])
+                              [VDF_STYLES[i % 4] for i in range(len(series))] + ["--"])
     finish(fig, _runs([s[1] for s in series]), title, legend=(handles, labels))
     return save(fig, out)
 
@@ -196,7 +214,7 @@ def lambda_figure(panels: Sequence[tuple[str, Sequence[FlowData]]], title: str,
                 continue
             ax.errorbar(lam["lambda"], lam["y"], xerr=lam["lambda_err"], color=colours[id(d)],
                         marker="o", ms=3, lw=1, elinewidth=0.6)
-        ax.axvline(1 / 3, color="saddlebrown", lw=1.2)
+        ax.axvline(1 / 3, color="saddlebrown", lw=0.9, alpha=0.7, zorder=0)  # under the data
         ax.xaxis.set_major_locator(MaxNLocator(4))
         ax.set_xlabel("Λ = <cos²Ψ> (brown: molecular 1/3)")
         ax.set_ylabel("y/d")
@@ -229,18 +247,26 @@ def _lambda_inset(ax, datas: Sequence[FlowData]) -> None:
     ax.set_ylabel("Λ")
 
 
+#: Fig 3.10's panels: the wall values (FlowData.wall_value)
+WALL_PANELS = (("ux", "U_x,w* (slip)"), ("omz", "ω_z,w* (rotational slip)"), ("T", "T_w*"),
+               ("theta", "θ_w*"))
+#: Fig 3.11's panels: the wall gradients (poiseuille_checks.wall_slope), per d
+GRADIENT_PANELS = (("ux", "dU_x*/dy at the wall [1/d]"), ("omz", "dω_z*/dy at the wall [1/d]"),
+                   ("T", "dT*/dy at the wall [1/d]"), ("theta", "dθ*/dy at the wall [1/d]"))
+
+
 def wall_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: str,
-                out: Path) -> Path:
+                out: Path, value=None, panels=WALL_PANELS) -> Path:
     """Fig 3.10: against e, one curve per β: translational slip U_x,w, rotational slip
-    |ω_z,w|, T_w and θ_w (the mean of bins 1 and 25)."""
+    ω_z,w (> 0: rolling along the walls), T_w and θ_w (the mean of bins 1 and 25); with
+    ``value`` = ``wall_slope`` and ``GRADIENT_PANELS``, Fig 3.11's wall gradients."""
+    value = value or (lambda d, key: d.wall_value(key))
     fig, axes = new_figure(1, 4, width=3.0, height=3.0)
-    keys = (("ux", "U_x,w* (slip)"), ("omz", "|ω_z,w*| (rotational slip)"),
-            ("T", "T_w*"), ("theta", "θ_w*"))
     colours = [run_colour(i) for i in range(len(by_beta))]
-    for ax, (key, name) in zip(axes.flat, keys, strict=True):
+    for ax, (key, name) in zip(axes.flat, panels, strict=True):
         for i, (_label, datas) in enumerate(by_beta):
             e = [d.flow.e for d in datas]
-            vals = np.array([d.wall_value(key) for d in datas])
+            vals = np.array([value(d, key) for d in datas])
             if vals.size:
                 ax.errorbar(e, vals[:, 0], yerr=vals[:, 1], color=colours[i],
                             marker=MARKERS[i], ms=4, lw=1, capsize=2)
@@ -249,4 +275,34 @@ def wall_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: str,
     every = [d for _l, ds in by_beta for d in ds]
     finish(fig, _runs(every), title,
            legend=_legend([b[0] for b in by_beta], colours, markers=list(MARKERS[:3])))
+    return save(fig, out)
+
+
+def freepath_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: str,
+                    out: Path, b: int) -> Path:
+    """Fig 3.9: the free-path distribution P(l) in bin ``b`` (0-based; free paths relative
+    to the local mean flow, the collision log's) for several e, one panel per β, log scale;
+    dashed: the exponential exp(-l/λ)/λ with the run's own mean free path λ."""
+    fig, axes = new_figure(1, len(by_beta), width=3.6, height=3.2)
+    es = sorted({d.flow.e for _l, ds in by_beta for d in ds})
+    colours = {e: run_colour(i) for i, e in enumerate(es)}
+    for ax, (label, datas) in zip(axes.flat, by_beta, strict=True):
+        for d in datas:
+            fp = d.stat("freepath")
+            if "p_lambda" not in fp:
+                continue
+            x, p, e = fp["lambda"], fp["p_lambda"][b], fp["p_lambda_err"][b]
+            ok = (p > 0) & np.isfinite(e) & (e < 0.5 * p)
+            ax.errorbar(x[ok], p[ok], yerr=e[ok], color=colours[d.flow.e], lw=1, ms=2,
+                        marker="o", elinewidth=0.5)
+            lam = float(fp["mean_free_path"][b])
+            ax.plot(x, np.exp(-x / lam) / lam, color=colours[d.flow.e], ls="--", lw=0.8)
+        ax.set_yscale("log")
+        ax.set_xlabel("free path l [d]")
+        ax.set_ylabel("P(l) [1/d]")
+        ax.set_title(label, fontsize=9)
+    labels = [f"e = {e:g}" for e in es] + ["exp(-l/λ)/λ, the run's λ"]
+    handles, labels = _legend(labels, [colours[e] for e in es] + ["0.3"],
+                              ["-"] * len(es) + ["--"])
+    finish(fig, _runs([d for _l, ds in by_beta for d in ds]), title, legend=(handles, labels))
     return save(fig, out)

@@ -59,3 +59,28 @@ def s_wave_text(r: dict[str, tuple[float, float]]) -> str:
     return text + (" (R(k_x, k_y) = |FFT of the xy cell counts at that mode|² / N, the "
                    "(1, 1) and (1, -1) modes averaged; shot noise of independent particles "
                    "= 1)")
+
+
+#: a plug: the x-modulated modes (1, 0) and (1, ±1) hold less than this share of the (0, 1)
+#: mode (the density profile across the walls, strong in every wall-bounded flow)
+PLUG_SHARE = 0.01
+
+
+def structure_class(r: dict[str, tuple[float, float]]) -> tuple[str, str]:
+    """(class, why) of a channel flow from its three modes (``mode_ratios``), Malik's
+    taxonomy (digest §4.11) cut down to what they tell: "plug" when (1, 0) and (1, ±1) lie
+    below ``PLUG_SHARE`` of (0, 1) or within 2σ of the shot noise (1) (the density varies
+    across y only); else "s-wave" when (1, ±1) beats (1, 0) beyond 2σ (the antisymmetric
+    mode whose birth marks plug → S-wave), "slug" when (1, 0) beats (1, ±1), "mixed"
+    (slug + S-wave, Malik's "sandwich") when neither does."""
+    (s, es), (g, eg), (p, _ep) = r["11"], r["10"], r["01"]
+    top = max(s, g)
+    if top < PLUG_SHARE * p or max(s - 2 * es, g - 2 * eg) <= 1.0:
+        return "plug", (f"(1, 0) and (1, ±1) at {100 * top / p:.2g} % of (0, 1): the density "
+                        "varies across y only")
+    modulated = f"x-modulated ((1, 0) and (1, ±1) up to {100 * top / p:.2g} % of (0, 1))"
+    if s - g > 2 * float(np.hypot(es, eg)):
+        return "s-wave", f"{modulated}, (1, ±1) above (1, 0) beyond 2σ"
+    if g - s > 2 * float(np.hypot(es, eg)):
+        return "slug", f"{modulated}, (1, 0) above (1, ±1) beyond 2σ"
+    return "mixed", f"{modulated}, (1, 0) and (1, ±1) equal within 2σ (slug + S-wave)"

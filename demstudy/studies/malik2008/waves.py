@@ -37,10 +37,12 @@ THESIS_SPAN = {"run": {"unit": "collisions", "equilibration": 1000.0, "productio
 #: the TC-model twins (not in the thesis): boxes run again at t_c = 10⁻⁶ √(d/g) instead of the
 #: engine's default 10⁻⁵, over the same span, so the same snapshot windows compare. At the
 #: default L42W30H30's slug made 6 % of the pair collisions elastic, L90W30H30's 17.7 % and
-#: L150W50H10's 15-18 % and L150W30H30's 17.7 % (the thesis's collisions all dissipate): does
-#: the structure depend on the engine's TC model? The cheapest W = 30 box, the W = 30 slugs
-#: with the largest shares and the flat W = 50 plane; ≈ 10-35 min each on one core here.
-TC_TWINS = ("L42W30H30", "L90W30H30", "L150W50H10", "L150W30H30")
+#: L150W50H10's 15-18 %, L150W30H30's 17.7 % and L70W50H50's 12.7 % (the thesis's collisions
+#: all dissipate): does the structure depend on the engine's TC model? The cheapest W = 30
+#: box, the W = 30 slugs with the largest shares, the flat W = 50 plane and the thesis's
+#: featured N = 50094 box (Figs 5.6-5.10); ≈ 10-35 min each on one core here, ≈ 75 min the
+#: last.
+TC_TWINS = ("L42W30H30", "L90W30H30", "L150W50H10", "L150W30H30", "L70W50H50")
 TC_TWIN_TC = 1e-6
 
 

@@ -157,14 +157,20 @@ def run_figure(run: RunWaves, box: Box, out: Path) -> Path:
 
 
 def phase_figure(found: Sequence[tuple[Box, str]], missing: Sequence[Box],
-                 thesis: Sequence[tuple[Box, str, str]], out: Path) -> Path:
+                 thesis: Sequence[tuple[Box, str, str]], out: Path,
+                 transient: Sequence[str] = ()) -> Path:
     """Fig 5.25's form: classes over (L/W, W/d) at e = 0.7, H = W; filled: demstudy, open
-    rings: the thesis where known (``thesis``: box, class, source), ×: not run."""
+    rings: the thesis where known (``thesis``: box, class, source), ×: not run; a box in
+    ``transient`` (names: its modes not stationary over the production) is drawn pale with
+    a dashed edge: the class of a flow still changing, not a steady structure."""
     fig = Figure(figsize=(7.5, 5.4))
     ax = fig.add_subplot(1, 1, 1)
     for box, cls in found:
         marker, colour = STYLE.get(cls.split(" ")[0], ("*", "k"))
-        ax.scatter(box.aspect, box.width, marker=marker, color=colour, s=90, zorder=3)
+        changing = box.name in transient
+        ax.scatter(box.aspect, box.width, marker=marker, color=colour, s=90, zorder=3,
+                   alpha=0.45 if changing else 1.0, edgecolors="k" if changing else "none",
+                   linestyles="--", linewidths=0.8 if changing else 0)
         if "+ z" in cls:
             ax.annotate("+z", (box.aspect, box.width), textcoords="offset points",
                         xytext=(7, -10), fontsize=7)
@@ -179,6 +185,9 @@ def phase_figure(found: Sequence[tuple[Box, str]], missing: Sequence[Box],
                for k, (m, c) in STYLE.items()]
     handles += [Line2D([], [], marker="o", markerfacecolor="none", markeredgecolor="k",
                        ls="", markersize=13, label="thesis, digest §1.8 (solid ring)"),
+                Line2D([], [], marker="o", color="0.5", alpha=0.45, markeredgecolor="k",
+                       ls="", markersize=8, label="pale: modes not stationary\n(a transient's "
+                                                  "class)"),
                 Line2D([], [], marker="x", color="0.6", ls="", label="not run")]
     ax.legend(handles=handles, fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
     ax.set_xlabel("aspect ratio L/W")
@@ -188,8 +197,8 @@ def phase_figure(found: Sequence[tuple[Box, str]], missing: Sequence[Box],
     ax.set_xticks([0.6, 1.4, 3, 5])
     ax.set_yticks([15, 30, 50])
     ax.grid(alpha=0.3)
-    ax.set_title("Fig 5.25's form: steady structures, φ ≈ 0.15, e = 0.7, β = 0.1, "
-                 "H = W", fontsize=9)
+    ax.set_title("Fig 5.25's form: structures over the thesis's span\n"
+                 "φ ≈ 0.15, e = 0.7, β = 0.1, H = W", fontsize=9)
     _footer(fig)
     fig.subplots_adjust(left=0.1, right=0.62, top=0.92, bottom=0.2)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -32,7 +32,15 @@ from ..base import (
 from .waves import TC_TWIN_TC, on_thesis_span, twin_boxes, twin_name
 from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
-from .waves_measure import COARSE, DRIFT_SIGMAS, SNAPSHOTS, WINDOW, RunWaves, measure
+from .waves_measure import (
+    COARSE,
+    DRIFT_SIGMAS,
+    PLATEAU_TOL,
+    SNAPSHOTS,
+    WINDOW,
+    RunWaves,
+    measure,
+)
 
 #: CPU seconds per particle per √(d/g), measured on this machine (N = 600 box, steady
 #: state, one core): the forecast of a run missing when no run of this analysis gives one
@@ -373,7 +381,13 @@ def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
 
 
 def _share(run: RunWaves) -> str:
-    return f"{100 * run.tc_fraction:.1f} %" if math.isfinite(run.tc_fraction) else "unknown"
+    """The TC-elastic share in per cent: one decimal, two where one would round onto the
+    warning level (4.96 % is below 5 %, "5.0 %" would not say so)."""
+    if not math.isfinite(run.tc_fraction):
+        return "unknown"
+    share = 100 * run.tc_fraction
+    near = round(share, 1) == round(100 * WARN_SHARE, 1)
+    return f"{share:.2f} %" if near else f"{share:.1f} %"
 
 
 def steady_check(box: Box, run: RunWaves) -> Check:
@@ -390,8 +404,14 @@ def steady_check(box: Box, run: RunWaves) -> Check:
         return Check(STEADY_REF, statement, thesis, measured, NOT_REPRODUCED,
                      _unbalanced_reason(run, on_thesis_span(box)))
     if not run.plateau:
+        change = 100 * (m2 - m1) / m1
         return Check(STEADY_REF, statement, thesis, measured, PARTLY,
-                     "energy balance holds but the KE of the two halves differs by > 2σ")
+                     f"energy balance holds, but the KE/N {'rises' if change > 0 else 'falls'} "
+                     f"by {abs(change):.1f} % from the first half of the production to the "
+                     f"second (beyond 2σ + {100 * PLATEAU_TOL:g} %): gravity's input and the "
+                     "dissipation balance on average while the flow's energy still "
+                     f"{'grows' if change > 0 else 'decays'} slowly, so a longer production "
+                     "is needed to call it a plateau")
     if not run.stationary:
         return Check(STEADY_REF, statement, thesis, measured, PARTLY,
                      f"energy balanced and KE on a plateau, but a mode drifts by > "
@@ -645,10 +665,13 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     path = phase_figure([(b, measured[b.name].modes.pattern) for b in diagram
                          if b.name in measured],
                         [b for b in diagram if b.name not in measured], thesis,
-                        out / "waves-phase-diagram.png")
+                        out / "waves-phase-diagram.png",
+                        [b.name for b in diagram
+                         if b.name in measured and not measured[b.name].stationary])
     ana.figures.append(Figure(path, "Fig 5.25's form: the structure class of each box over "
                                     "(L/W, W/d), demstudy (filled) and the thesis where the "
-                                    "digest gives it (rings); × not run"))
+                                    "digest gives it (rings); pale: modes not stationary over the "
+                                    "production (a transient's class); × not run"))
     ana.sections.append(("Density waves (Malik Ch. 5): method", method_text(measured)))
     if table:
         ana.sections.append(("Density waves: the runs", _run_table(table)))
