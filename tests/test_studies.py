@@ -519,7 +519,7 @@ def test_the_tc_rule_weakens_agreements_resting_on_a_run_the_tc_model_changed():
         row(REPRODUCED, ("tested",)), row(REPRODUCED, ("soft",)))
     tc_caveats([agree, differ, below, none, missing, tested, soft], shares,
                {"tested": "its twin at t_c = 1e-6 agrees"})
-    assert agree.verdict == PARTLY and "hot: 16.0 % (t_c = 1e-05)" in agree.reason
+    assert agree.verdict == PARTLY and "hot: 16.0 % (t_c = 1e-05 time units)" in agree.reason
     assert "cold" not in agree.reason.split("elastic (")[1]
     assert agree.reason.startswith("why. The engine's TC model") and agree.reason.endswith(".")
     assert differ.verdict == NOT_REPRODUCED and "hot: 16.0 %" in differ.reason
@@ -527,3 +527,8 @@ def test_the_tc_rule_weakens_agreements_resting_on_a_run_the_tc_model_changed():
     for untouched in (below, none, missing, soft):
         assert "TC model" not in untouched.reason
     assert (below.verdict, none.verdict, missing.verdict) == (REPRODUCED, REPRODUCED, NOT_RUN)
+    # a reason that discusses the TC model already gets no second note, but the same verdict
+    named = Check("ref", "statement", "thesis", "value", REPRODUCED,
+                  "the TC model's share is the cause here", runs=("hot",))
+    tc_caveats([named], shares)
+    assert named.verdict == PARTLY and named.reason == "the TC model's share is the cause here"

@@ -120,7 +120,7 @@ def test_trend_verdicts() -> None:
     assert ck.trend_verdict([(1.0, 0.5), (1.2, 0.5), (1.4, 0.5)])[0] == PARTLY
     # the weakest step by name, in σ, and the longer runs that would resolve a step that size
     why = ck.trend_verdict([(1.0, 0.1), (2.0, 0.1), (2.1, 0.1)])[1]
-    assert "step 2 → 3 rises by 0.7σ only" in why and "runs ×8.0 longer" in why
+    assert "point 2 → 3 by 0.7σ (2σ in runs ×8.0 longer)" in why and "1 → 2" not in why
     assert ck.trend_verdict([(1.0, 0.1), (0.5, 0.1)])[0] == NOT_REPRODUCED
 
 

@@ -802,7 +802,7 @@ def test_the_structure_of_each_beta_is_classed_from_the_three_modes():
     s_wave, plug, smooth = wave_checks(data)
     assert s_wave.verdict == REPRODUCED and "mean density profile" in s_wave.reason
     assert plug.verdict == NOT_REPRODUCED and plug.measured.startswith("mixed")
-    assert "5.1 % of (0, 1) here against 5.6 % in the β = 0.99 run" in plug.reason
+    assert "5.1 % of (0, 1)'s power here against 5.6 % in the β = 0.99 run" in plug.reason
     assert smooth.verdict == NO_THESIS_VALUE and smooth.measured.startswith("plug")
     data[(0.1, 0.0, 0.7)] = run(0.0, modes(30.0, 20.0))
     assert wave_checks(data)[1].verdict == REPRODUCED
@@ -867,13 +867,38 @@ def test_wall_gradients_keep_an_antisymmetric_profile_and_rows_span_e():
 
     d = run(0.0, 0.8)
     assert wall_slope(d, "ux")[0] == pytest.approx((profiles["ux"][1] - profiles["ux"][0]) / 2)
-    assert wall_slope(d, "omz")[0] == pytest.approx(1.0 / c)  # not cancelled
+    # ω_z = (y − c)/c: rolling along both walls (the wall value > 0), fading into the flow:
+    # the inward gradient of that wall value is −1/c, from both walls (not cancelled)
+    assert wall_slope(d, "omz")[0] == pytest.approx(-1.0 / c)
     assert wall_slope(d, "T")[0] == pytest.approx(0.0)
     data = {(0.01, 0.0, e): run(0.0, e) for e in (0.8, 0.9, 0.99)}
     fig_310, fig_311 = wall_value_checks(data)
     assert fig_310.verdict == fig_311.verdict == NO_THESIS_VALUE
     assert "β = 0, e = 0.8 → 0.99:" in fig_310.measured and "0.9 →" not in fig_310.measured
     assert [c.verdict for c in wall_value_checks({})] == [NOT_RUN, NOT_RUN]
+
+
+def test_the_free_path_row_fits_below_the_walls_reach():
+    """Fig 3.9's row fits the tail between λ and 0.8 × the distance from bin 13 to a wall
+    (the walls end longer flights): a distribution exponential there and cut beyond gives
+    ℓ = λ; the row states the window and the walls' distance."""
+    from demstudy.studies.malik2008.poiseuille_checks import NO_THESIS_VALUE, freepath_checks
+
+    x = np.linspace(0.5, 67.5, 68)
+    lam = 8.5
+    p = np.exp(-x / lam) / lam
+    p[x > 25.0] *= np.exp(-(x[x > 25.0] - 25.0) / 2.0)  # the walls' cut
+    fp = {"lambda": x, "p_lambda": np.tile(p, (25, 1)),
+          "p_lambda_err": np.tile(0.02 * p, (25, 1)), "mean_free_path": np.full(25, lam)}
+    run = SimpleNamespace(flow=Flow(0.01, 0.8, 0.0), y=np.arange(25) * 2.0 + 1.0,
+                          stat=lambda name: fp,
+                          run_info=lambda: {"steady": True, "trend": 0.0,
+                                            "tc_fraction": 0.0, "tc": 1e-5})
+    (row,) = freepath_checks({(0.01, 0.0, 0.8): run})
+    assert row.verdict == NO_THESIS_VALUE
+    assert "fitted over λ < l < 20 d" in row.measured and "(ℓ/λ 1.00)" in row.measured
+    assert "The walls, 25 d from bin 13" in row.reason
+    assert freepath_checks({})[0].verdict == NOT_RUN
 
 
 def test_the_free_path_tail_length_of_an_exponential_is_its_mean():
@@ -889,3 +914,29 @@ def test_the_free_path_tail_length_of_an_exponential_is_its_mean():
     assert got == lam and ell == pytest.approx(lam, rel=1e-6)
     fp["p_lambda"] = (np.exp(-x / (1.2 * lam)) / (1.2 * lam))[None, :]
     assert tail_length(fp, 0)[0] == pytest.approx(1.2 * lam, rel=1e-6)
+
+
+def test_vdf_and_lambda_rows_name_the_runs_whose_centre_moves_as_a_block():
+    """The VDF, Λ and Gaussian-limit rows of a φ name the runs whose centre bin's far C_xx is
+    ≥ 0.5 (their 'fluctuations' include the bin's common motion); other rows, and a φ
+    without such runs, are left alone."""
+    from demstudy.studies.base import Check
+    from demstudy.studies.malik2008.poiseuille_checks import common_motion_caveats
+
+    edges = np.linspace(0.0, 5.0, 51)
+
+    def run(beta, level):
+        c = np.zeros((25, 3, 50))
+        c[12, 0, 10:] = level
+        vc = {"r_edges": edges, "C": c, "C_err": np.full_like(c, 0.01)}
+        return SimpleNamespace(flow=Flow(0.1, 0.7, beta), stat=lambda name: vc)
+
+    data = {(0.1, 0.0, 0.7): run(0.0, 0.9), (0.1, 0.99, 0.7): run(0.99, 0.1)}
+    rows = [Check("r", f"φ = 0.1{s}", "t", "m", REPRODUCED, "why.") for s in
+            (", bins 1, 4, 13: VDFs with a Gaussian core", ": orientational correlation Λ(y)",
+             ", β = 0.99, e = 0.7: an S-shaped density wave")]
+    rows.append(Check("r", "φ = 0.5: orientational correlation Λ(y)", "t", "m", REPRODUCED, ""))
+    common_motion_caveats(rows, data)
+    assert all("In bin 13 of β = 0, e = 0.7 the fluctuations" in r.reason for r in rows[:2])
+    assert "β = 0.99" not in rows[0].reason.split("In bin 13 of")[1].split("the")[0]
+    assert rows[2].reason == "why." and rows[3].reason == ""

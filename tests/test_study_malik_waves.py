@@ -259,11 +259,11 @@ def test_plug_turning_into_slug_is_not_steady_though_energy_is(tmp_path: Path) -
     steady = measure(_synthetic_run(tmp_path / "steady.h5", plug))
     assert steady.stationary and steady.modes.pattern == "plug"
     assert steady_check(box, steady).verdict == REPRODUCED
-    # a plateau is the halves' KE within 2σ + 2 %: 1.2 % apart (2.3σ) is one, 6.7 % is not,
-    # and the row says by how much the KE still rises
+    # a plateau is the halves' KE within 2σ or within 2 %: 1.2 % apart (2.3σ) is one; 6.7 %
+    # (2.1σ, L18W30H30's halves) is not, and the row says by how much the KE still rises
     level = dataclasses.replace(steady, ke_halves=((1440.1, 5.2), (1422.3, 5.7)))
     assert level.plateau and steady_check(box, level).verdict == REPRODUCED
-    rising = dataclasses.replace(steady, ke_halves=((6219.0, 50.0), (6637.0, 25.0)))
+    rising = dataclasses.replace(steady, ke_halves=((6219.0, 198.0), (6637.0, 25.0)))
     row = steady_check(box, rising)
     assert not rising.plateau and row.verdict == PARTLY
     assert "the KE/N rises by 6.7 % from the first half" in row.reason

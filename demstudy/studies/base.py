@@ -113,11 +113,12 @@ def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]
     """The rule of :data:`VERDICT_LEGEND` for the event-driven engine's TC model (Luding &
     McNamara: a pair colliding again within t_c is elastic; no thesis has it): every row
     resting on a run (``Check.runs``) whose ``shares`` (case name → (share of pair collisions
-    made elastic, t_c)) exceed the engine's warning level names the share in its reason, and
-    an agreement becomes *partly* (a weaker test); a disagreement stays, the TC model one
-    possible cause. A run in ``unchanged`` (case name → the evidence, e.g. its twins at
-    smaller t_c agree) keeps the row's verdict: its results were shown not to depend on t_c.
-    Rows about the TC model itself are the caller's to leave out (give them no ``runs``)."""
+    made elastic, t_c)) exceed the engine's warning level (a fixed cut: 5 %) names the share
+    in its reason, unless the reason discusses the TC model already, and an agreement becomes
+    *partly* (a weaker test); a disagreement stays, the TC model one possible cause. A run in
+    ``unchanged`` (case name → the evidence: a twin at another t_c with a share below the
+    level agrees) keeps the row's verdict. Rows about the TC model itself, and comparisons
+    with engines without it, are the caller's to leave out (give them no ``runs``)."""
     from ..engines.edmd.tc_share import WARN_SHARE
 
     unchanged = unchanged or {}
@@ -126,18 +127,20 @@ def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]
                  if n in shares and math.isfinite(shares[n][0]) and shares[n][0] > WARN_SHARE]
         if c.verdict == NOT_RUN or not large:
             continue
-        text = ", ".join(f"{n}: {100 * s:.1f} % (t_c = {tc:g})" for n, s, tc in large)
+        text = ", ".join(f"{n}: {100 * s:.1f} % (t_c = {tc:g} time units)" for n, s, tc in large)
         note = (f"The engine's TC model made more than {100 * WARN_SHARE:g} % of the pair "
                 f"collisions elastic ({text}; the thesis has no TC model)")
         shown = [unchanged[n] for n, _s, _tc in large if n in unchanged]
         if len(shown) == len(large):
-            note += ", but the results do not depend on it: " + "; ".join(dict.fromkeys(shown))
+            note += (", but a twin with a small share agrees: "
+                     + "; ".join(dict.fromkeys(shown)))
         else:
             note += (": the flow dissipates less than its restitution says, a weaker test "
                      "either way")
             if c.verdict == REPRODUCED:
                 c.verdict = PARTLY
-        c.reason = ". ".join(p for p in (c.reason.strip().rstrip("."), note) if p) + "."
+        if "TC model" not in c.reason:
+            c.reason = ". ".join(p for p in (c.reason.strip().rstrip("."), note) if p) + "."
 
 
 def not_run(ref: str, statement: str, thesis: str, needs: str | Sequence[str],

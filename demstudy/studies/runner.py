@@ -192,7 +192,6 @@ class _Forecasts:
             self.own = True
             return
         resumes = stopped_run(task.path, task.case.engine, task.scene_toml)
-        self.old = self.old or resumes
         try:
             plan = run(task.scene(), engine=task.case.engine, out=task.path, dry_run=True,
                        progress=False, **task.case.options)
@@ -206,9 +205,10 @@ class _Forecasts:
             self.lines.append(f"{name} no forecast ({plan.get('forecast', 'not measured')})")
             return
         name += " resumes;" if resumes else ""
-        like = self._like(task) if plan.get("forecast_kind") == "lower bound" else None
+        self.old = self.old or resumes  # the note goes with a line that says so
+        bound = plan.get("forecast_kind") == "lower bound"
+        like = self._like(task) if bound else None
         if like is None:
-            bound = plan.get("forecast_kind") == "lower bound"
             self.seconds[task.case.name] = float(s)
             self.lower = self.lower or bound
             self.lines.append(f"{name} {'probably more than ' if bound else ''}{_duration(s)}")

@@ -52,15 +52,20 @@ def _finish(fig, path: Path, note: str = "") -> Path:
 REFERENCE = "chute-30-bumpy"
 
 
+#: beyond tab10's ten: dark, saturated colours unlike any of tab10's (tab20's light halves of
+#: the same hues would sit beside their dark partners in one panel)
+EXTRA_COLOURS = ("navy", "maroon", "darkgoldenrod", "teal", "indigo", "lime", "deeppink")
+
+
 def run_colours(runs: Sequence[ChuteRun]) -> dict[str, Any]:
     """One colour per run of a figure, the same in each of its panels: the reference run
-    black, the others tab10's colours in the order they first appear (tab20's beyond ten
-    runs, so that no two runs of a figure share one)."""
+    black, the others tab10's colours in the order they first appear, then
+    ``EXTRA_COLOURS`` (no two runs of a figure share one up to 17 others)."""
     names = list(dict.fromkeys(r.name for r in runs))
     others = [n for n in names if n != REFERENCE]
-    size = 10 if len(others) <= 10 else 20
-    cmap = _plt().get_cmap(f"tab{size}")
-    return {n: ("k" if n == REFERENCE else cmap(others.index(n) % size)) for n in names}
+    palette = [*_plt().get_cmap("tab10").colors, *EXTRA_COLOURS]
+    return {n: ("k" if n == REFERENCE else palette[others.index(n) % len(palette)])
+            for n in names}
 
 
 def _bed(run: ChuteRun) -> np.ndarray:

@@ -127,6 +127,7 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     data = load_runs(runs, quick)
     checks = [c for check in CHECKS for c in check(data)]
     pc.tc_caveats(checks, data)
+    pc.common_motion_caveats(checks, data)
     if not quick:
         checks += [soft_row(data, runs, flow) for flow in SOFT_FLOWS]
     for c in checks:  # a statement without runs says so, never crashes
@@ -228,7 +229,9 @@ def _phi_figures(data: Runs, phi: float, out: Path, tag: str) -> list[Figure]:
                                        out / f"poiseuille-wall-gradients-phi{phi:g}.png",
                                        value=pc.wall_slope, panels=GRADIENT_PANELS),
                            "Wall gradients of U_x, ω_z, T and θ (bins 1-2 and 24-25, per d) "
-                           "against e, one curve per β (Fig 3.11)."))
+                           "against e, one curve per β (Fig 3.11); inward: the change from "
+                           "the wall into the flow of each wall value (ω_z: rolling along "
+                           "the wall > 0)."))
         figs.append(Figure(freepath_figure(by_beta[::-1], f"Malik Fig 3.9: free-path "
                                                           f"distribution in bin 13, "
                                                           f"φ = {phi:g}{tag}",

@@ -1079,10 +1079,15 @@ def _s_wave(data: Runs) -> Check:
                  runs=(d.flow.name,))
 
 
+def _x_share(modes: dict[str, tuple[float, float]]) -> float:
+    """The stronger x-modulated mode, (1, 0) or (1, ±1), in % of the (0, 1) mode's power."""
+    return 100 * max(modes["11"][0], modes["10"][0]) / modes["01"][0]
+
+
 def _beta_structure(data: Runs, beta: float) -> Check:
     """The β = 0 plug [L875] (Fig 4.3), or the β = -0.99 structure (Fig 4.1: no class in
     the thesis's text)."""
-    from .poiseuille_waves import s_wave_text, structure_class
+    from .poiseuille_waves import mode_ratios, s_wave_text, structure_class
 
     plug = beta == 0.0
     ref = "[L875], Fig 4.3" if plug else "Fig 4.1 [L861]"
@@ -1092,8 +1097,6 @@ def _beta_structure(data: Runs, beta: float) -> Check:
     d = data.get((0.1, beta, 0.7))
     if d is None:
         return not_run(ref, statement, thesis, f"the φ = 0.1, β = {beta:g}, e = 0.7 run")
-    from .poiseuille_waves import mode_ratios
-
     r = mode_ratios(d)
     kind, why = structure_class(r)
     measured = f"{kind}: {why}; {s_wave_text(r)}"
@@ -1108,9 +1111,8 @@ def _beta_structure(data: Runs, beta: float) -> Check:
     than = ""
     if other is not None:
         o = mode_ratios(other)
-        share = lambda m: 100 * max(m["11"][0], m["10"][0]) / m["01"][0]  # noqa: E731
-        than = (f" ({share(r):.2g} % of (0, 1) here against {share(o):.2g} % in the β = 0.99 "
-                "run the thesis calls an S-wave)")
+        than = (f" ({_x_share(r):.2g} % of (0, 1)'s power here against {_x_share(o):.2g} % "
+                "in the β = 0.99 run the thesis calls an S-wave)")
     return Check(ref, statement, thesis, measured, NOT_REPRODUCED,
                  f"not a plug: the density is modulated along the flow ({kind}){than}; the "
                  "thesis's plug is read off snapshots (one time), ours is the mean over the "
@@ -1148,24 +1150,26 @@ def freepath_checks(data: Runs) -> list[Check]:
           and "p_lambda" in d.stat("freepath")]
     if not ds:
         return [not_run(ref, statement, "figure only", "the φ = 0.01 runs")]
-    parts, ratios = [], []
+    parts, ratios, widths = [], [], []
     y = ds[0].y
     reach = float(min(y[CENTRE_BIN - 1], y[-1] + y[0] - y[CENTRE_BIN - 1]))  # to a wall
     for d in ds:
         ell, lam = tail_length(d.stat("freepath"), CENTRE_BIN - 1, WALL_REACH * reach)
         ratios.append(ell / lam)
+        widths.append((WALL_REACH * reach - lam) / ell)
         parts.append(f"{_tag(d)}: ℓ = {ell:.3g} d, λ = {lam:.3g} d (ℓ/λ {ell / lam:.2f})")
     lo, hi = np.nanmin(ratios), np.nanmax(ratios)
     return [Check(ref, statement, "figure only (no values in the text)",
-                  f"bin 13, tail exp(-l/ℓ) fitted over λ < l < {WALL_REACH * reach:.0f} d: "
+                  f"bin 13, exp(-l/ℓ) fitted over λ < l < {WALL_REACH * reach:.0f} d: "
                   + "; ".join(parts), NO_THESIS_VALUE,
-                  f"the tails decay as exp(-l/ℓ) with ℓ = {lo:.2f}-{hi:.2f} λ: a free flight "
-                  "ends at a rate set by the collision frequency, as in a dilute gas"
-                  + ("; ℓ above λ: fast particles fly further (a hard sphere's free path "
-                     "grows with its speed)" if lo > 1 else "")
-                  + f". Beyond the walls' distance ({reach:.0f} d from bin 13) P(l) has a "
-                  "shoulder and then drops: the walls end the longest flights (the figure); "
-                  "the thesis states no value to compare with." + _steady_note(ds),
+                  f"ℓ/λ = {lo:.2f}-{hi:.2f} over the fit window (about "
+                  f"{np.nanmean(widths):.1f} decay lengths wide; no error is given: a "
+                  "yardstick): the distribution falls off "
+                  "about as the exponential of a dilute gas with the run's own mean free "
+                  f"path. The walls, {reach:.0f} d from bin 13, end the longest flights: "
+                  "beyond that distance the figure's P(l) leaves the exponential, and the "
+                  "mean λ counts those shortened flights too. The thesis states no value to "
+                  "compare with." + _steady_note(ds),
                   runs=tuple(d.flow.name for d in ds))]
 
 
@@ -1174,15 +1178,16 @@ WALL_KEYS = (("ux", "U_x*"), ("omz", "ω_z*"), ("T", "T*"), ("theta", "θ*"))
 
 
 def wall_slope(d: FlowData, key: str) -> tuple[float, float]:
-    """The wall gradient of profile ``key`` (bins 1-2 and 24-25, per d): the mean magnitude
-    of the two walls' gradients, signed as at the lower wall (ω_z is antisymmetric: its two
-    walls' gradients have the same sign; the other profiles are symmetric: opposite)."""
+    """The wall gradient of profile ``key`` (bins 1-2 and 24-25, per d): the change per d
+    going from each wall into the flow of the quantity as its wall value reads it
+    (:meth:`FlowData.wall_value`: ω_z with the lower wall's sign flipped, so that rolling
+    along either wall is positive), the mean of the two walls."""
     v, e = d.series(key)
-    if key != "omz":
-        return wall_gradient(v, e, d.y)
-    dy = float(d.y[1] - d.y[0])
-    value = 0.5 * ((v[1] - v[0]) + (v[-1] - v[-2])) / dy
-    return float(value), 0.5 * math.sqrt(e[0] ** 2 + e[1] ** 2 + e[-1] ** 2 + e[-2] ** 2) / dy
+    value, err = wall_gradient(v, e, d.y)  # symmetric profiles: inward from both walls
+    if key == "omz":  # antisymmetric, read with the lower wall's sign flipped
+        dy = float(d.y[1] - d.y[0])
+        value = 0.5 * (-(v[1] - v[0]) + (v[-2] - v[-1])) / dy
+    return float(value), err
 
 
 def wall_value_checks(data: Runs) -> list[Check]:
@@ -1203,13 +1208,15 @@ def wall_value_checks(data: Runs) -> list[Check]:
         for beta in sorted({d.flow.beta for d in ds}):
             by_e = sorted((d for d in ds if d.flow.beta == beta), key=lambda d: d.flow.e)
             ends = [by_e[0], by_e[-1]] if len(by_e) > 1 else by_e
-            cells = [f"{name} " + " → ".join(pm(*value(d, key)) for d in ends)
-                     for key, name in WALL_KEYS]
+            slope = value is wall_slope
+            cells = [f"{f'd{name}/dy' if slope else name} "
+                     + " → ".join(pm(*value(d, key)) for d in ends) for key, name in WALL_KEYS]
             span = " → ".join(f"{d.flow.e:g}" for d in ends)
             parts.append(f"β = {beta:g}, e = {span}: " + ", ".join(cells))
         out.append(Check(ref, statement, "figures only (no values in the text)",
                          "; ".join(parts) + " (ω_z at the walls: positive when the spheres "
-                         "roll along them; gradients per d, signed as at the lower wall)",
+                         "roll along them; gradients: the change per d from the wall into the "
+                         "flow of that wall value)",
                          NO_THESIS_VALUE,
                          "the thesis plots these against e without stating values; its text's "
                          "one claim about the walls (much wall dissipation for β = 0) has its "
@@ -1276,6 +1283,29 @@ def _common_motion(ds: Sequence[FlowData]) -> str:
     if free:
         text += f". Uncorrelated (|C_aa| < 0.05 at every r) in bin 13: {', '.join(free)}"
     return text
+
+
+def common_motion_caveats(checks: list[Check], data: Runs) -> None:
+    """The VDF, Λ and Gaussian-limit rows of φ = 0.1 and 0.5 name the runs whose centre bin
+    moves as a block (far C_xx ≥ 0.5, rows 'Fig 4.14' and 'Fig 4.19'): their fluctuations
+    about the bin's run mean include that motion, which a temperature, a VDF's width and
+    Λ count as thermal."""
+    for phi in (0.1, 0.5):
+        block = []
+        for (p, _b, _e), d in sorted(data.items()):
+            vc = d.stat("vcorr") if p == phi else {}
+            if "C" in vc and correlation_at(vc, CENTRE_BIN - 1, 0, *FAR)[0] >= 0.5:
+                block.append(_tag(d))
+        if not block:
+            continue
+        note = (f" In bin 13 of {', '.join(block)} the fluctuations about the bin's run mean "
+                "are mostly motion common to the whole bin (far C_xx ≥ 0.5: the velocity-"
+                "correlation rows), which the VDFs and Λ count as thermal.")
+        pattern = re.compile(rf"^φ = {re.escape(f'{phi:g}')}[:,]")
+        for c in checks:
+            if (c.verdict != NOT_RUN and pattern.match(c.statement)
+                    and any(k in c.statement for k in ("VDF", "Λ", "Gaussian"))):
+                c.reason = (c.reason + note).strip()
 
 
 def vcorr_checks(data: Runs) -> list[Check]:

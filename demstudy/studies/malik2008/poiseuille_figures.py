@@ -12,7 +12,7 @@ T* = T/(gd), θ* = θ/(gd), y and r in d (every footer says so).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -250,17 +250,19 @@ def _lambda_inset(ax, datas: Sequence[FlowData]) -> None:
 #: Fig 3.10's panels: the wall values (FlowData.wall_value)
 WALL_PANELS = (("ux", "U_x,w* (slip)"), ("omz", "ω_z,w* (rotational slip)"), ("T", "T_w*"),
                ("theta", "θ_w*"))
-#: Fig 3.11's panels: the wall gradients (poiseuille_checks.wall_slope), per d
-GRADIENT_PANELS = (("ux", "dU_x*/dy at the wall [1/d]"), ("omz", "dω_z*/dy at the wall [1/d]"),
-                   ("T", "dT*/dy at the wall [1/d]"), ("theta", "dθ*/dy at the wall [1/d]"))
+#: Fig 3.11's panels: the wall gradients (poiseuille_checks.wall_slope): the change per d from
+#: the wall into the flow of each wall value (ω_z: rolling along the wall > 0)
+GRADIENT_PANELS = (("ux", "dU_x*/dy, inward [1/d]"), ("omz", "dω_z*/dy, inward [1/d]"),
+                   ("T", "dT*/dy, inward [1/d]"), ("theta", "dθ*/dy, inward [1/d]"))
 
 
 def wall_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: str,
-                out: Path, value=None, panels=WALL_PANELS) -> Path:
+                out: Path, value: Callable[[FlowData, str], tuple[float, float]] | None = None,
+                panels: Sequence[tuple[str, str]] = WALL_PANELS) -> Path:
     """Fig 3.10: against e, one curve per β: translational slip U_x,w, rotational slip
     ω_z,w (> 0: rolling along the walls), T_w and θ_w (the mean of bins 1 and 25); with
     ``value`` = ``wall_slope`` and ``GRADIENT_PANELS``, Fig 3.11's wall gradients."""
-    value = value or (lambda d, key: d.wall_value(key))
+    value = value or FlowData.wall_value
     fig, axes = new_figure(1, 4, width=3.0, height=3.0)
     colours = [run_colour(i) for i in range(len(by_beta))]
     for ax, (key, name) in zip(axes.flat, panels, strict=True):
@@ -296,13 +298,19 @@ def freepath_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: st
             ax.errorbar(x[ok], p[ok], yerr=e[ok], color=colours[d.flow.e], lw=1, ms=2,
                         marker="o", elinewidth=0.5)
             lam = float(fp["mean_free_path"][b])
-            ax.plot(x, np.exp(-x / lam) / lam, color=colours[d.flow.e], ls="--", lw=0.8)
+            span = x[x <= x[ok].max()] if ok.any() else x
+            ax.plot(span, np.exp(-span / lam) / lam, color=colours[d.flow.e], ls="--", lw=0.8)
+        if datas:  # the walls end flights longer than the bin's distance to them
+            y = datas[0].y
+            reach = float(min(y[b], y[-1] + y[0] - y[b]))
+            ax.axvline(reach, color="0.5", ls=":", lw=1)
         ax.set_yscale("log")
         ax.set_xlabel("free path l [d]")
         ax.set_ylabel("P(l) [1/d]")
         ax.set_title(label, fontsize=9)
-    labels = [f"e = {e:g}" for e in es] + ["exp(-l/λ)/λ, the run's λ"]
-    handles, labels = _legend(labels, [colours[e] for e in es] + ["0.3"],
-                              ["-"] * len(es) + ["--"])
+    labels = [f"e = {e:g}" for e in es] + ["exp(-l/λ)/λ, the run's λ",
+                                           "distance from the bin to a wall"]
+    handles, labels = _legend(labels, [colours[e] for e in es] + ["0.3", "0.5"],
+                              ["-"] * len(es) + ["--", ":"])
     finish(fig, _runs([d for _l, ds in by_beta for d in ds]), title, legend=(handles, labels))
     return save(fig, out)

@@ -76,9 +76,10 @@ def structure_class(r: dict[str, tuple[float, float]]) -> tuple[str, str]:
     (s, es), (g, eg), (p, _ep) = r["11"], r["10"], r["01"]
     top = max(s, g)
     if top < PLUG_SHARE * p or max(s - 2 * es, g - 2 * eg) <= 1.0:
-        return "plug", (f"(1, 0) and (1, ±1) at {100 * top / p:.2g} % of (0, 1): the density "
-                        "varies across y only")
-    modulated = f"x-modulated ((1, 0) and (1, ±1) up to {100 * top / p:.2g} % of (0, 1))"
+        return "plug", (f"(1, 0) and (1, ±1) at {100 * top / p:.2g} % of (0, 1)'s power: the "
+                        "density varies across y only")
+    modulated = (f"x-modulated ((1, 0) and (1, ±1) up to {100 * top / p:.2g} % of (0, 1)'s "
+                 f"power, {100 * (top / p) ** 0.5:.2g} % of its amplitude)")
     if s - g > 2 * float(np.hypot(es, eg)):
         return "s-wave", f"{modulated}, (1, ±1) above (1, 0) beyond 2σ"
     if g - s > 2 * float(np.hypot(es, eg)):

@@ -408,7 +408,7 @@ def steady_check(box: Box, run: RunWaves) -> Check:
         return Check(STEADY_REF, statement, thesis, measured, PARTLY,
                      f"energy balance holds, but the KE/N {'rises' if change > 0 else 'falls'} "
                      f"by {abs(change):.1f} % from the first half of the production to the "
-                     f"second (beyond 2σ + {100 * PLATEAU_TOL:g} %): gravity's input and the "
+                     f"second (beyond 2σ and {100 * PLATEAU_TOL:g} %): gravity's input and the "
                      "dissipation balance on average while the flow's energy still "
                      f"{'grows' if change > 0 else 'decays'} slowly, so a longer production "
                      "is needed to call it a plateau")
@@ -466,6 +466,7 @@ def _series_check(ref: str, statement: str, boxes: Sequence[Box],
                   measured: Mapping[str, RunWaves]) -> Check:
     """Figs 5.26/5.27: classes along a series; the digest gives none of the thesis's."""
     found = [f"{b.tag} e = {b.restitution:g}: {measured[b.name].modes.pattern}"
+             + ("" if measured[b.name].stationary else " (transient)")
              for b in boxes if b.name in measured]
     if not found:
         return Check(ref, statement, "not in the digest", "not run", NOT_RUN,
@@ -714,17 +715,22 @@ def _phase_checks(boxes: Sequence[Box], diagram: Sequence[Box],
                   measured: Mapping[str, RunWaves]) -> list[Check]:
     checks = []
     if diagram:
-        found = [f"{b.tag}: {measured[b.name].modes.pattern}" for b in diagram
+        found = [f"{b.tag}: {measured[b.name].modes.pattern}"
+                 + ("" if measured[b.name].stationary else " (transient)") for b in diagram
                  if b.name in measured]
+        transient = sum(1 for b in diagram if b.name in measured
+                        and not measured[b.name].stationary)
         ref = "Fig 5.25 [L1465] (digest §7)"
         statement = "phase diagram of the steady structures over (L/W, W/d), e = 0.7, H = W"
         if found:
             checks.append(Check(ref, statement, "classes not in the digest, except N = 50094 "
                                 "(L/W = 1.4, W/d = 50): slug", "; ".join(found),
                                 NO_THESIS_VALUE,
-                                f"{len(found)} of {len(diagram)} boxes run; the thesis's "
-                                "classes are not in the digest (the one it gives, N = 50094, "
-                                "is judged in that box's own row)"))
+                                f"{len(found)} of {len(diagram)} boxes run, {transient} of "
+                                "them with modes not stationary over the thesis's span "
+                                "(transient: the class of a flow still changing, not a steady "
+                                "structure); the thesis's classes are not in the digest (the "
+                                "one it gives, N = 50094, is judged in that box's own row)"))
         else:
             checks.append(Check(ref, statement, "not in the digest", "not run", NOT_RUN,
                                 "no box of the diagram run"))
