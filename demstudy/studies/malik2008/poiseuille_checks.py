@@ -37,6 +37,7 @@ from .poiseuille_data import (
     carnahan_starling,
     contact_value,
     vdf_bins,
+    wall_distance,
     wall_gradient,
 )
 
@@ -1152,7 +1153,7 @@ def freepath_checks(data: Runs) -> list[Check]:
         return [not_run(ref, statement, "figure only", "the φ = 0.01 runs")]
     parts, ratios, widths = [], [], []
     y = ds[0].y
-    reach = float(min(y[CENTRE_BIN - 1], y[-1] + y[0] - y[CENTRE_BIN - 1]))  # to a wall
+    reach = wall_distance(y, CENTRE_BIN - 1)
     for d in ds:
         ell, lam = tail_length(d.stat("freepath"), CENTRE_BIN - 1, WALL_REACH * reach)
         ratios.append(ell / lam)
@@ -1196,7 +1197,7 @@ def wall_value_checks(data: Runs) -> list[Check]:
     the rows give the values at the smallest and largest e of each β."""
     ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.01]
     rows = [("Fig 3.10 [L722]", "φ = 0.01: translational and rotational slip, T and θ at the "
-             "walls against e, one curve per β", lambda d, k: d.wall_value(k)),
+             "walls against e, one curve per β", FlowData.wall_value),
             ("Fig 3.11 [L732] (digest item 8)", "φ = 0.01: wall gradients of U_x, ω_z, T, θ "
              "against e, one curve per β", wall_slope)]
     out = []
@@ -1264,22 +1265,31 @@ COMMON_MOTION = (
     "it)")
 
 
+#: a centre bin whose far C_xx reaches this moves mostly as a block
+BLOCK = 0.5
+
+
+def _far_xx(d: FlowData) -> float | None:
+    """Bin 13's C_xx over the far range ``FAR`` (None without velocity correlations)."""
+    vc = d.stat("vcorr")
+    return correlation_at(vc, CENTRE_BIN - 1, 0, *FAR)[0] if "C" in vc else None
+
+
 def _common_motion(ds: Sequence[FlowData]) -> str:
     """COMMON_MOTION and, in the centre bin, which runs are dominated by common motion (far
-    C_xx ≥ 0.5) and which are uncorrelated as a molecular gas (|C_aa| < 0.05 at every r)."""
+    C_xx ≥ BLOCK) and which are uncorrelated as a molecular gas (|C_aa| < 0.05 at every r)."""
     block, free = [], []
     for d in ds:
-        vc = d.stat("vcorr")
-        if "C" not in vc:
+        far = _far_xx(d)
+        if far is None:
             continue
-        far = correlation_at(vc, CENTRE_BIN - 1, 0, *FAR)[0]
-        if far >= 0.5:
+        if far >= BLOCK:
             block.append(f"{_tag(d)} ({far:.2f})")
-        elif np.nanmax(np.abs(vc["C"][CENTRE_BIN - 1])) < 0.05:
+        elif np.nanmax(np.abs(d.stat("vcorr")["C"][CENTRE_BIN - 1])) < 0.05:
             free.append(_tag(d))
     text = COMMON_MOTION
     if block:
-        text += f". Bin 13's far C_xx ≥ 0.5 (mostly common motion): {', '.join(block)}"
+        text += f". Bin 13's far C_xx ≥ {BLOCK:g} (mostly common motion): {', '.join(block)}"
     if free:
         text += f". Uncorrelated (|C_aa| < 0.05 at every r) in bin 13: {', '.join(free)}"
     return text
@@ -1287,20 +1297,17 @@ def _common_motion(ds: Sequence[FlowData]) -> str:
 
 def common_motion_caveats(checks: list[Check], data: Runs) -> None:
     """The VDF, Λ and Gaussian-limit rows of φ = 0.1 and 0.5 name the runs whose centre bin
-    moves as a block (far C_xx ≥ 0.5, rows 'Fig 4.14' and 'Fig 4.19'): their fluctuations
+    moves as a block (far C_xx ≥ BLOCK, rows 'Fig 4.14' and 'Fig 4.19'): their fluctuations
     about the bin's run mean include that motion, which a temperature, a VDF's width and
     Λ count as thermal."""
     for phi in (0.1, 0.5):
-        block = []
-        for (p, _b, _e), d in sorted(data.items()):
-            vc = d.stat("vcorr") if p == phi else {}
-            if "C" in vc and correlation_at(vc, CENTRE_BIN - 1, 0, *FAR)[0] >= 0.5:
-                block.append(_tag(d))
+        block = [_tag(d) for (p, _b, _e), d in sorted(data.items())
+                 if p == phi and (_far_xx(d) or 0.0) >= BLOCK]
         if not block:
             continue
         note = (f" In bin 13 of {', '.join(block)} the fluctuations about the bin's run mean "
-                "are mostly motion common to the whole bin (far C_xx ≥ 0.5: the velocity-"
-                "correlation rows), which the VDFs and Λ count as thermal.")
+                f"are mostly motion common to the whole bin (far C_xx ≥ {BLOCK:g}: the "
+                "velocity-correlation rows), which the VDFs and Λ count as thermal.")
         pattern = re.compile(rf"^φ = {re.escape(f'{phi:g}')}[:,]")
         for c in checks:
             if (c.verdict != NOT_RUN and pattern.match(c.statement)
@@ -1312,39 +1319,29 @@ def vcorr_checks(data: Runs) -> list[Check]:
     """Figs 4.12-4.14 and 4.19: the spatial velocity correlations C_aa(r) (digest §4.9) that
     the thesis plots without stating values: measured near contact and at the far range,
     with what a far value that does not decay means."""
+    by_phi = {phi: [d for (p, _b, _e), d in sorted(data.items()) if p == phi]
+              for phi in (0.1, 0.5)}
+    rows = [  # ref, statement, thesis, runs, bins, what a missing run is called
+        ("Figs 4.12-4.13 [L978], [L988]",
+         "φ = 0.1, β = ∓0.99, e = 0.7, bins 1, 4, 13: velocity correlations C_xx, C_yy, C_zz "
+         "against r", "figures only (no values in the text)",
+         [data[k] for k in ((0.1, -0.99, 0.7), (0.1, 0.99, 0.7)) if k in data], (1, 4, 13),
+         "the φ = 0.1, e = 0.7 runs"),
+        ("Fig 4.14 [L992]", "φ = 0.1, bin 13, several e: C_xx, C_yy, C_zz for each β",
+         "figures only (no values in the text)", by_phi[0.1], (CENTRE_BIN,), "the φ = 0.1 runs"),
+        ("Fig 4.19 [L1036], [L1048]",
+         "φ = 0.5, bins 1, 3, 13: C_xx, C_yy, C_zz against r (compared with Orpe & Kudrolli's "
+         "experiments in the thesis)",
+         "figures only; Orpe & Kudrolli's values not in the digest", by_phi[0.5], (1, 3, 13),
+         "the φ = 0.5 run")]
     out = []
-    rows = [("Figs 4.12-4.13 [L978], [L988]", (0.1, -0.99), (0.1, 0.99), (1, 4, 13),
-             "φ = 0.1, β = ∓0.99, e = 0.7, bins 1, 4, 13: velocity correlations C_xx, C_yy, "
-             "C_zz against r")]
-    for ref, *keys, bins, statement in rows:
-        ds = [data[(p, b, 0.7)] for p, b in keys if (p, b, 0.7) in data]
+    for ref, statement, thesis, ds, bins, needs in rows:
         if not ds:
-            out.append(not_run(ref, statement, "figures only", "the φ = 0.1, e = 0.7 runs"))
+            out.append(not_run(ref, statement, "figures only", needs))
             continue
-        out.append(Check(ref, statement, "figures only (no values in the text)",
+        out.append(Check(ref, statement, thesis,
                          "; ".join(_correlation_text(d, bins) for d in ds), NO_THESIS_VALUE,
                          _common_motion(ds) + "." + _steady_note(ds),
-                         runs=tuple(d.flow.name for d in ds)))
-    ref = "Fig 4.14 [L992]"
-    statement = "φ = 0.1, bin 13, several e: C_xx, C_yy, C_zz for each β"
-    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.1]
-    if not ds:
-        out.append(not_run(ref, statement, "figures only", "the φ = 0.1 runs"))
-    else:
-        out.append(Check(ref, statement, "figures only (no values in the text)",
-                         "; ".join(_correlation_text(d, (CENTRE_BIN,)) for d in ds),
-                         NO_THESIS_VALUE, _common_motion(ds) + "." + _steady_note(ds),
-                         runs=tuple(d.flow.name for d in ds)))
-    ref = "Fig 4.19 [L1036], [L1048]"
-    statement = "φ = 0.5, bins 1, 3, 13: C_xx, C_yy, C_zz against r (compared with Orpe & "
-    statement += "Kudrolli's experiments in the thesis)"
-    ds = [d for (p, _b, _e), d in sorted(data.items()) if p == 0.5]
-    if not ds:
-        out.append(not_run(ref, statement, "figures only", "the φ = 0.5 run"))
-    else:
-        out.append(Check(ref, statement, "figures only; Orpe & Kudrolli's values not in the "
-                         "digest", "; ".join(_correlation_text(d, (1, 3, 13)) for d in ds),
-                         NO_THESIS_VALUE, _common_motion(ds) + "." + _steady_note(ds),
                          runs=tuple(d.flow.name for d in ds)))
     return out
 
@@ -1363,11 +1360,9 @@ def numbers_text(data: Runs) -> str:
         d = data[key]
         vc, cells = d.stat("vcorr"), []
         if "C" in vc:
-            k1, k3 = int(np.searchsorted(vc["r_edges"], 1.0 - 1e-9)), \
-                int(np.searchsorted(vc["r_edges"], 3.0 - 1e-9))
             b = CENTRE_BIN - 1
-            cells = [pm(vc["C"][b, a, k1], vc["C_err"][b, a, k1], 1) for a in range(3)]
-            cells.append(pm(vc["C"][b, 0, k3], vc["C_err"][b, 0, k3], 1))
+            cells = [pm(*correlation_at(vc, b, a, 1.0), 1) for a in range(3)]
+            cells.append(pm(*correlation_at(vc, b, 0, 3.0), 1))
         else:
             cells = ["n/a"] * 4
         kur = d.stat("vdf")

@@ -149,6 +149,12 @@ def load_flow(flow: Flow, path: Path, with_gr: bool = True) -> FlowData:
     return data
 
 
+def wall_distance(y: np.ndarray, b: int) -> float:
+    """The distance from bin ``b``'s centre (0-based, bin centres ``y`` spanning the channel
+    symmetrically) to the nearer wall, in d."""
+    return float(min(y[b], y[-1] + y[0] - y[b]))
+
+
 def wall_gradient(u: np.ndarray, e: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     """dU_x/dy at the walls from the profile ``u`` ± ``e`` on bin centres ``y`` (bins 1-2
     and 24-25: the symmetric profile's two gradients have opposite signs, this is their

@@ -20,7 +20,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
 from ...plots.common import LINESTYLES, MARKERS, Run, finish, new_figure, run_colour, save
-from .poiseuille_data import FlowData
+from .poiseuille_data import FlowData, wall_distance
 
 PROFILE_PANELS = (("phi", "φ"), ("ux", "U_x* = U_x/√(gd)"), ("omz", "ω_z* = ω_z/√(g/d)"),
                   ("T", "T* = T/(gd)"), ("theta", "θ* = θ/(gd)"), ("Kn", "Kn = λ/W"))
@@ -301,9 +301,7 @@ def freepath_figure(by_beta: Sequence[tuple[str, Sequence[FlowData]]], title: st
             span = x[x <= x[ok].max()] if ok.any() else x
             ax.plot(span, np.exp(-span / lam) / lam, color=colours[d.flow.e], ls="--", lw=0.8)
         if datas:  # the walls end flights longer than the bin's distance to them
-            y = datas[0].y
-            reach = float(min(y[b], y[-1] + y[0] - y[b]))
-            ax.axvline(reach, color="0.5", ls=":", lw=1)
+            ax.axvline(wall_distance(datas[0].y, b), color="0.5", ls=":", lw=1)
         ax.set_yscale("log")
         ax.set_xlabel("free path l [d]")
         ax.set_ylabel("P(l) [1/d]")
