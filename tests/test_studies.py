@@ -532,3 +532,33 @@ def test_the_tc_rule_weakens_agreements_resting_on_a_run_the_tc_model_changed():
                   "the TC model's share is the cause here", runs=("hot",))
     tc_caveats([named], shares)
     assert named.verdict == PARTLY and named.reason == "the TC model's share is the cause here"
+
+
+def test_a_twin_with_a_large_share_is_quoted_but_exempts_nothing():
+    """A twin at another t_c whose own share is large shows whether the results converged in
+    t_c, not a reference free of the TC model: its finding is quoted, the agreement still
+    becomes "partly"."""
+    from demstudy.studies.base import PARTLY, REPRODUCED, tc_caveats
+
+    row = Check("ref", "statement", "thesis", "value", REPRODUCED, "", runs=("hot",))
+    tc_caveats([row], {"hot": (0.06, 1e-5)}, {}, {"hot": "the twin of hot gives the same"})
+    assert row.verdict == PARTLY and "(the twin of hot gives the same)" in row.reason
+    # a run in both maps is exempted, and the twin's finding is not repeated
+    row = Check("ref", "statement", "thesis", "value", REPRODUCED, "", runs=("hot",))
+    tc_caveats([row], {"hot": (0.06, 1e-5)}, {"hot": "small twin agrees"}, {"hot": "told"})
+    assert row.verdict == REPRODUCED and "small twin agrees" in row.reason
+    assert "told" not in row.reason
+
+
+def test_twin_comparison_allows_two_sigma_and_the_tolerance():
+    from demstudy.studies.base import TWIN_TOLERANCE, twin_comparison
+
+    base = {"a": (1.0, 0.01), "b": (2.0, 0.0), "skip": (float("nan"), 0.0)}
+    labels = {"a": "A", "b": "B", "skip": "S", "absent": "X"}
+    same, text = twin_comparison(base, {"a": (1.0 + TWIN_TOLERANCE, 0.01), "b": (2.0, 0.0),
+                                        "skip": (1.0, 0.0)}, labels)
+    # 2σ of √2 · 0.01 plus 10 % of 1: a 10 % change passes; NaN and absent keys are left out
+    assert same and text == "A 1.100 ± 0.010 (+10.0 %), B 2 (+0.0 %)" and "S " not in text
+    assert not twin_comparison(base, {"a": (1.0 + TWIN_TOLERANCE + 0.03, 0.01),
+                                      "b": (2.0, 0.0)}, labels)[0]
+    assert not twin_comparison(base, {"c": (1.0, 0.0)}, labels)[0]  # nothing in common

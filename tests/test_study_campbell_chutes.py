@@ -205,3 +205,68 @@ def test_each_run_has_one_colour_in_a_figure_and_the_reference_is_black(accelera
     colours = run_colours(runs)
     assert colours["chute-30-bumpy"] == "k" and len(colours) == 14
     assert len({str(c) for n, c in colours.items() if n != "chute-30-bumpy"}) == 13
+
+
+def _with_angles(run, approach: float):
+    """``run`` with a two-level P(θ): ``approach`` of the collisions in 90°-180°."""
+    theta = (np.arange(50) + 0.5) * math.pi / 50
+    p = np.where(theta > math.pi / 2, 2 * approach, 2 * (1 - approach)) / math.pi
+    err = np.full(50, 0.01)
+    from demstudy.studies.campbell1982.couette_measure import approach_share
+
+    return dataclasses.replace(run, angles={"theta": theta, "p": p, "p_err": err,
+                                            "collisions": 1e4,
+                                            "approach": approach_share(p, err, theta)})
+
+
+def test_the_chutes_collision_angles_row_wants_the_approach_quadrant(accelerating):
+    """C9 (Fig 3.33): the 40° beds' share of collisions in 90°-180° beyond ½ + 2σ; an
+    isotropic distribution is not the thesis's; without a collision log the row is not run."""
+    from demstudy.studies.campbell1982.chute_checks import c9_angles
+
+    run = summarise("chute-40-flat", accelerating)
+    assert run.angles == {}  # the fixture kept no collision log
+    assert c9_angles({"chute-40-flat": run}).verdict == NOT_RUN
+    row = c9_angles({"chute-40-flat": _with_angles(run, 0.75)})
+    assert row.verdict == REPRODUCED and "share in 90°-180° 0.750" in row.measured
+    assert "P(θ) largest at θ ≈ 92°" in row.measured
+    assert c9_angles({"chute-40-flat": _with_angles(run, 0.5)}).verdict == NOT_REPRODUCED
+
+
+def test_the_angle_distribution_is_read_from_a_run_with_a_collision_log(tmp_path):
+    """A short 40° run with the angles statistic: P(θ) normalised over 0-180°, the pooled
+    share between 0 and 1, and the collision count of the log."""
+    from demstudy.studies.campbell1982.chute_cases import MEASURE_ANGLES
+
+    path = tmp_path / "c9.h5"
+    scene = ds.load_scene("campbell1982/chute-40", run={"equilibration": 2.0,
+                                                        "production": 10.0},
+                          measure=MEASURE_ANGLES)
+    ds.run(scene, engine="edmd", out=path, progress=False)
+    a = summarise("chute-40-flat", path).angles
+    width = math.pi / a["theta"].size
+    assert np.sum(a["p"]) * width == pytest.approx(1.0, rel=1e-6)
+    assert 0.0 < a["approach"][0] < 1.0 and a["collisions"] > 100
+
+
+def test_local_bagnold_coefficients_of_a_uniform_shear(accelerating):
+    """f = τ/(ρ_p R² (du/dy)²) strip by strip: a linear u and a known τ give f exactly; the
+    base's strip, dilute strips and strips without resolved shear are left out."""
+    from demstudy.analysis.derived import MATERIAL_DENSITY
+    from demstudy.studies.campbell1982.chute_measure import local_bagnold
+
+    run = summarise("chute-40-flat", accelerating)
+    y = np.arange(8) + 0.5
+    nu = np.array([0.5, 0.6, 0.6, 0.6, 0.6, 0.6, 0.1, 0.6])
+    prof = {**run.profiles, "y": y, "nu": nu, "nu_err": 0 * y, "u": 2.0 * y,
+            "u_err": np.full(8, 0.01)}
+    tau = 3.0 * np.ones(8)
+    stress = {"balance_tau_xy": tau, "balance_tau_xy_err": 0 * tau,
+              "balance_tau_yy": 2 * tau, "balance_tau_yy_err": 0 * tau}
+    out = local_bagnold(dataclasses.replace(run, profiles=prof, stress=stress))
+    rho, radius = MATERIAL_DENSITY[2], 0.5
+    assert list(out["y"]) == [1.5, 2.5, 3.5, 4.5, 5.5, 7.5]  # not the base, not ν = 0.1
+    assert out["f_s"] == pytest.approx(3.0 / (rho * radius**2 * 4.0))
+    assert out["f_N"] == pytest.approx(2 * out["f_s"])
+    flat = {**prof, "u": np.ones(8)}
+    assert local_bagnold(dataclasses.replace(run, profiles=flat, stress=stress))["nu"].size == 0

@@ -210,3 +210,85 @@ def test_verdicts_on_a_real_short_run(short_runs: dict[str, Path], tmp_path: Pat
     chi = next(c for s, c in by_ref.items() if "equation of state" in s)
     assert chi.verdict in (REPRODUCED, PARTLY), chi.measured
     assert ana.figures and all(f.path.is_file() for f in ana.figures)
+
+
+def _history(name: str, trend: float, within: float, drift: float = 0.0) -> RunSummary:
+    return RunSummary(name, values={"ke_trend": (trend, 0.02), "ke_within": (within, 0.0),
+                                    "gap_drift": (drift, 0.0)})
+
+
+def test_campbells_convergence_criterion_for_the_cells_energy() -> None:
+    """K7 (Fig 2.4): no trend beyond 20 % (2σ) and nine samples in ten within ±20 %; a servo
+    cell still moving its walls is named as such, the rough cells' swings as block slip."""
+    steady = {"a": _history("a", 0.05, 1.0), "b": _history("b", -0.1, 0.95)}
+    row = ck.energy_history(steady, ["a", "b"], ["ν = 0.35", "ν = 0.45"])
+    assert row.verdict == REPRODUCED and "ν = 0.35: trend 0.050 ± 0.020" in row.measured
+    assert ck.ke_converged(_history("x", 0.22, 1.0)) == (True, True)  # 0.22 − 2σ < 0.2
+    assert ck.ke_converged(_history("x", 0.25, 1.0)) == (False, True)
+    assert ck.ke_converged(_history("x", 0.5, 0.6)) == (False, False)
+    mixed = {**steady, "c": _history("c", 0.46, 0.88, drift=0.25),
+             "d": _history("d", -0.1, 0.5)}
+    row = ck.energy_history(mixed, ["a", "c", "d"], ["ν = 0.35", "K2 σ_n×0.5", "K1 σ_n×1"])
+    assert row.verdict == PARTLY
+    assert "K2 σ_n×0.5 (a trend and swings beyond ±20 %)" in row.reason
+    assert "K1 σ_n×1 (swings beyond ±20 %)" in row.reason
+    assert "K2 σ_n×0.5 (gap +25 % over the production): not at its servo" in row.reason
+    assert "slips as a block" in row.reason
+    row = ck.energy_history({"d": _history("d", 0.6, 0.5)}, ["d"], ["ν = 0.55"])
+    assert row.verdict == NOT_REPRODUCED and "slips as a block" not in row.reason
+
+
+def test_a_servo_cell_still_moving_its_walls_weakens_the_density_row() -> None:
+    def cell(nu: float, drift: float) -> RunSummary:
+        return RunSummary("x", values={"nu_cell": (nu, 0.001), "gap_drift": (drift, 0.0)})
+
+    runs = {"a": cell(0.4, 0.0), "b": cell(0.5, 0.01), "c": cell(0.6, -0.02)}
+    names = ["a", "b", "c"]
+    assert ck.servo_density(runs, "K2", names, (0.5, 1, 2), "Fig 3.16",
+                            "no-slip").verdict == REPRODUCED
+    runs["a"] = cell(0.4, 0.25)
+    row = ck.servo_density(runs, "K2", names, (0.5, 1, 2), "Fig 3.16", "no-slip")
+    assert row.verdict == PARTLY and "σ_n×0.5 (gap +25 % over the production)" in row.reason
+
+
+def test_a_tc_twin_exempts_its_cell_only_with_a_small_share() -> None:
+    """couette.tc_twins: the same values from a twin below the warning level exempt the cell;
+    from a twin with a large share they are only quoted; other values are quoted as such."""
+    values = {"nu": (0.66, 0.005), "S_text": (1.15, 0.04), "f_s": (6.7, 0.7)}
+
+    def run(share: float, **change: tuple[float, float]) -> RunSummary:
+        return RunSummary("x", values={**values, **change},
+                          attrs={"tc_elastic_fraction": share, "tc": 1e-6})
+
+    base, twin = "couette-fixed-nu65", couette.TC_TWINS["couette-fixed-nu65"]
+    unchanged, told = couette.tc_twins({base: run(0.06), twin: run(0.02)})
+    assert base in unchanged and not told and "the same values" in unchanged[base]
+    unchanged, told = couette.tc_twins({base: run(0.06), twin: run(0.066)})
+    assert not unchanged and "no run free of the model" in told[base]
+    unchanged, told = couette.tc_twins({base: run(0.06), twin: run(0.02, S_text=(2.0, 0.04))})
+    assert not unchanged and "gives other values" in told[base]
+    assert couette.tc_twins({base: run(0.06)}) == ({}, {})
+
+
+def test_chute_strips_are_compared_with_the_cells_f_curve() -> None:
+    """Figs 3.21-3.24: strips on the cells' log-linear f(ν) within 2σ + 20 % count; a strip
+    ×3 off does not; strips outside the cells' ν range are not compared; the layered ν = 0.75
+    cell is not part of the curve."""
+    def cell(nu: float, f: float) -> RunSummary:
+        return RunSummary(f"c{nu}", values={"nu": (nu, 0.001), "f_s": (f, 0.01 * f),
+                                            "f_N": (2 * f, 0.02 * f)})
+
+    runs = {"a": cell(0.35, 1.0), "b": cell(0.55, 4.0), "c": cell(0.75, 0.5)}
+    names = ["a", "b", "c"]
+    curve, _ = ck.couette_curve([runs["a"], runs["b"]], "f_s", np.array([0.45, 0.3]))
+    assert curve[0] == pytest.approx(2.0) and np.isnan(curve[1])  # geometric mean; outside
+    strips = {"nu": np.array([0.45, 0.5, 0.7]), "f_s": np.array([2.1, 2.8, 99.0]),
+              "f_s_err": np.full(3, 0.05), "f_N": np.array([4.0, 5.7, 99.0]),
+              "f_N_err": np.full(3, 0.05)}
+    row = ck.chute_on_curve(runs, names, {"chute-30-bumpy": strips})
+    assert row.verdict == REPRODUCED and "4 of 4 strip values" in row.reason
+    assert "ν 0.70" not in row.measured and row.runs[-1] == "chute-30-bumpy"
+    off = {**strips, "f_s": np.array([6.3, 2.8, 99.0])}
+    row = ck.chute_on_curve(runs, names, {"chute-30-bumpy": off})
+    assert row.verdict == PARTLY and "3 of 4" in row.reason and "×3.15" in row.measured
+    assert ck.chute_on_curve(runs, names, {}).verdict == NOT_RUN

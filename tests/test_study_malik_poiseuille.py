@@ -45,7 +45,11 @@ def test_case_names_unique_and_quick_is_the_named_subset():
     # the thesis's grid: 3 β × 4 e at φ = 0.01 and at φ = 0.1, one dense flow
     assert sum("phi0.01-" in n and n.endswith("-edmd") for n in names) == 12
     assert sum("phi0.1-" in n for n in names) == 12
-    assert sum("phi0.5-" in n for n in names) == 1
+    assert sum("phi0.5-" in n and "-tc" not in n for n in names) == 1
+    # the dense flow's TC twin: the same flow at t_c = 1e-6
+    twin = next(c for c in full if "-tc" in c.name)
+    assert twin.name == "poiseuille-phi0.5-b0.9-e0.9-tc1e-06-edmd"
+    assert twin.options == {"tc": 1e-6} and twin.sections == case_of(Flow(0.5, 0.9, 0.9)).sections
 
 
 @pytest.mark.parametrize("quick", [False, True])
@@ -226,8 +230,8 @@ def test_a_large_tc_share_caps_the_verdicts_and_says_so(tiny_run, tmp_path):
                 continue  # the plateau statement is about the run's length, not its model
             if capped:
                 assert b.verdict == (PARTLY if a.verdict == REPRODUCED else a.verdict)
-                assert "TC model made a large share" in b.reason, b.statement
-                assert "20.0 % (t_c = 1e-05" in b.reason
+                assert "TC model made more than 5 %" in b.reason, b.statement
+                assert "20.0 % (t_c = 1e-05 time units)" in b.reason
             else:
                 assert (b.verdict, b.reason) == (a.verdict, a.reason)
 
@@ -940,3 +944,38 @@ def test_vdf_and_lambda_rows_name_the_runs_whose_centre_moves_as_a_block():
     assert all("In bin 13 of β = 0, e = 0.7 the fluctuations" in r.reason for r in rows[:2])
     assert "β = 0.99" not in rows[0].reason.split("In bin 13 of")[1].split("the")[0]
     assert rows[2].reason == "why." and rows[3].reason == ""
+
+
+def test_the_tc_twin_row_and_its_evidence():
+    """The dense flow's TC twin: the same values within 2σ + 10 % at a small share exempt the
+    flow's rows and make the own row "reproduced"; the same values at a large share are
+    quoted but exempt nothing ("partly"); other values give "not reproduced"; no twin, not
+    run."""
+    from demstudy.studies.malik2008.poiseuille_checks import (
+        tc_twin_evidence,
+        tc_twin_rows,
+    )
+
+    def run(flow, share, tc, u=10.0):
+        values = {"ux": (u, 0.1), "phi": (0.6, 0.01), "T": (1.0, 0.05),
+                  "theta": (0.5, 0.05)}
+        return SimpleNamespace(
+            flow=flow, centre_value=values.__getitem__, wall_value=values.__getitem__,
+            mean_temperature=lambda: (1.0, 0.05),
+            run_info=lambda: {"tc_fraction": share, "tc": tc, "steady": True, "trend": 0.0})
+
+    base_flow, twin_flow = Flow(0.5, 0.9, 0.9), Flow(0.5, 0.9, 0.9, tc=1e-6)
+    data = {(0.5, 0.9, 0.9): run(base_flow, 0.16, 1e-5)}
+    small = [run(twin_flow, 0.02, 1e-6)]
+    unchanged, told = tc_twin_evidence(data, small)
+    assert base_flow.name in unchanged and not told
+    assert "1e-06 √(d/g) (2.0 % elastic) gives the same values" in unchanged[base_flow.name]
+    (row,) = tc_twin_rows(data, small, [twin_flow])
+    assert row.verdict == REPRODUCED and row.own and "TC share 16.0 %" in row.measured
+    (row,) = tc_twin_rows(data, [run(twin_flow, 0.15, 1e-6)], [twin_flow])
+    assert row.verdict == PARTLY and "re-collisions" in row.reason
+    assert tc_twin_evidence(data, [run(twin_flow, 0.15, 1e-6)])[0] == {}
+    (row,) = tc_twin_rows(data, [run(twin_flow, 0.02, 1e-6, u=14.0)], [twin_flow])
+    assert row.verdict == NOT_REPRODUCED and "u_x centre 14.00 ± 0.10 (+40.0 %)" in row.measured
+    (row,) = tc_twin_rows(data, [], [twin_flow])
+    assert row.verdict == NOT_RUN and twin_flow.name in row.reason

@@ -109,7 +109,8 @@ class Check:
 
 
 def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]],
-               unchanged: Mapping[str, str] | None = None) -> None:
+               unchanged: Mapping[str, str] | None = None,
+               twins: Mapping[str, str] | None = None) -> None:
     """The rule of :data:`VERDICT_LEGEND` for the event-driven engine's TC model (Luding &
     McNamara: a pair colliding again within t_c is elastic; no thesis has it): every row
     resting on a run (``Check.runs``) whose ``shares`` (case name → (share of pair collisions
@@ -117,11 +118,14 @@ def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]
     in its reason, unless the reason discusses the TC model already, and an agreement becomes
     *partly* (a weaker test); a disagreement stays, the TC model one possible cause. A run in
     ``unchanged`` (case name → the evidence: a twin at another t_c with a share below the
-    level agrees) keeps the row's verdict. Rows about the TC model itself, and comparisons
-    with engines without it, are the caller's to leave out (give them no ``runs``)."""
+    level agrees) keeps the row's verdict. ``twins`` (case name → what a twin at another t_c
+    whose own share is large found, :func:`twin_comparison`) is quoted in the reason but
+    exempts nothing: with both shares large there is no reference free of the model. Rows
+    about the TC model itself, and comparisons with engines without it, are the caller's to
+    leave out (give them no ``runs``)."""
     from ..engines.edmd.tc_share import WARN_SHARE
 
-    unchanged = unchanged or {}
+    unchanged, twins = unchanged or {}, twins or {}
     for c in checks:
         large = [(n, *shares[n]) for n in c.runs
                  if n in shares and math.isfinite(shares[n][0]) and shares[n][0] > WARN_SHARE]
@@ -137,10 +141,39 @@ def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]
         else:
             note += (": the flow dissipates less than its restitution says, a weaker test "
                      "either way")
+            told = [twins[n] for n, _s, _tc in large if n in twins and n not in unchanged]
+            if told:
+                note += " (" + "; ".join(dict.fromkeys(told)) + ")"
             if c.verdict == REPRODUCED:
                 c.verdict = PARTLY
         if "TC model" not in c.reason:
             c.reason = ". ".join(p for p in (c.reason.strip().rstrip("."), note) if p) + "."
+
+
+#: how far a TC twin (the same run at another t_c) may differ from its run and still count
+#: as the same flow: 2σ of the two runs' combined errors plus this fraction of the value
+TWIN_TOLERANCE = 0.10
+
+
+def twin_comparison(base: Mapping[str, tuple[float, float]],
+                    twin: Mapping[str, tuple[float, float]],
+                    labels: Mapping[str, str]) -> tuple[bool, str]:
+    """Whether ``twin`` gives ``base``'s values (key → (value, error)) for every key of
+    ``labels`` (key → the name to print) within 2σ of the combined errors plus
+    :data:`TWIN_TOLERANCE`, and the comparison as text, e.g. ``"S 1.121 ± 0.041 (-2.9 %)"``;
+    keys missing from either side are left out (none in common: not the same)."""
+    same, parts = True, []
+    for key, label in labels.items():
+        if key not in base or key not in twin:
+            continue
+        (x, xe), (y, ye) = base[key], twin[key]
+        if not all(map(math.isfinite, (x, y))):
+            continue
+        err = math.hypot(xe, ye) if math.isfinite(xe) and math.isfinite(ye) else 0.0
+        same &= within(y, err, x, 2.0, TWIN_TOLERANCE * abs(x))
+        change = f" ({100 * (y - x) / x:+.1f} %)" if x else ""
+        parts.append(f"{label} {pm(y, ye)}{change}")
+    return same and bool(parts), ", ".join(parts)
 
 
 def not_run(ref: str, statement: str, thesis: str, needs: str | Sequence[str],

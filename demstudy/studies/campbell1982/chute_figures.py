@@ -233,6 +233,37 @@ def plug_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
     return _finish_legend(fig, path, 5, "The profiles average the production window.")
 
 
+def angles_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
+    """Fig 3.33: P(θ) of the pair collisions (text θ, from the flow direction) with ±2σ, the
+    isotropic 1/π and the approach quadrant 90°-180° shaded; one panel per run."""
+    runs = [r for r in runs if r.angles]
+    if not runs:
+        return None
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(runs), figsize=(max(4.2 * len(runs), 8.0), 4.4),
+                             sharey=True, squeeze=False)
+    colours = run_colours(runs)
+    for ax, r in zip(axes[0], runs, strict=True):
+        a = r.angles
+        deg = np.degrees(a["theta"])
+        ax.axvspan(90, 180, color="0.93", zorder=0)
+        ax.axhline(1 / math.pi, color="grey", lw=0.8, ls=":", zorder=1)
+        ax.errorbar(deg, a["p"], yerr=2 * a["p_err"], fmt=".", ms=4, color=colours[r.name],
+                    elinewidth=0.8, zorder=2)
+        share, err = a["approach"]
+        ax.set_title(f"{r.name} ({r.angle:g}°, {r.base} base)\nshare in 90°-180°: "
+                     f"{share:.3f} ± {err:.3f}", fontsize=9)
+        ax.set(xlabel="θ from the flow direction [deg]", xlim=(0, 180),
+               xticks=[0, 45, 90, 135, 180])
+    axes[0][0].set_ylabel("P(θ) per radian, ±2σ")
+    top = max(float(np.max(r.angles["p"] + 2 * r.angles["p_err"])) for r in runs)
+    axes[0][0].set_ylim(0, 1.12 * top)
+    fig.suptitle("Collision angles in the chute, Campbell Fig 3.33 (shaded: the approach "
+                 "quadrant; dotted: isotropic 1/π)", fontsize=10)
+    return _finish(fig, path, "Here the bars are ±2σ. Every pair collision of the "
+                   "production; the 40° beds accelerate (a transient's distribution).")
+
+
 def flat_scan_figure(flat: Sequence[ChuteRun], bumpy: ChuteRun | None, path: Path) -> Path | None:
     """Why the bumpy base: the flat base's force ratio against α and the energy histories."""
     if not flat:

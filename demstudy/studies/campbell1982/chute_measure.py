@@ -117,6 +117,8 @@ class ChuteRun:
     seed: int = 12345
     profiles: dict[str, np.ndarray] = field(default_factory=dict)
     stress: dict[str, Any] = field(default_factory=dict)
+    #: the collision-angle distribution (:func:`collision_angles`), empty without a log
+    angles: dict[str, Any] = field(default_factory=dict)
 
     @property
     def tan_alpha(self) -> float:
@@ -193,6 +195,30 @@ def _stress(res: Any, prof: dict[str, np.ndarray], g: np.ndarray) -> dict[str, A
     return out
 
 
+def collision_angles(res: Any) -> dict[str, Any]:
+    """Campbell's collision-angle distribution (Fig 3.33): P(θ) of every pair collision of the
+    production (θ, the text's convention: the line of centres from the flow direction,
+    0-180°; his code counted every particle collision, digest §3.8), pooled over the strips
+    by their collision counts, its block error, and the share in the approach quadrant
+    90°-180° (where du/dy > 0 brings particles together). Empty when the run kept no
+    collision log (``measure.statistics`` without ``angles``)."""
+    from .couette_measure import approach_share
+
+    ang = res.groups.get("statistics/angles")
+    if ang is None or "p_text" not in ang:
+        return {}
+    pairs = np.asarray(ang["pair_collisions"], float)
+    if pairs.sum() <= 0:
+        return {}
+    p = np.nan_to_num(np.asarray(ang["p_text"], float))
+    pe = np.nan_to_num(np.asarray(ang["p_text_err"], float))
+    theta = np.asarray(ang["theta"], float)
+    out = {"theta": theta, "p": pairs @ p / pairs.sum(),
+           "p_err": np.sqrt((pairs**2) @ pe**2) / pairs.sum(), "collisions": float(pairs.sum())}
+    out["approach"] = approach_share(out["p"], out["p_err"], theta)
+    return out
+
+
 def summarise(name: str, path: str | Path) -> ChuteRun:
     """Read one chute run's results file (``demstudy.load``) into a :class:`ChuteRun`."""
     import demstudy as ds
@@ -237,6 +263,7 @@ def summarise(name: str, path: str | Path) -> ChuteRun:
         tc_share=float(res.attrs.get("tc_elastic_fraction", np.nan)),
         wall_seconds=float(res.attrs.get("wall_seconds", np.nan)),
         seed=int(scene.run.seed), profiles=prof, stress=_stress(res, prof, g),
+        angles=collision_angles(res),
     )
 
 
@@ -248,6 +275,31 @@ def summarise_all(runs: dict[str, Path]) -> dict[str, ChuteRun]:
             out[name] = summarise(name, path)
         except (OSError, KeyError, ValueError) as exc:  # an unreadable or partial file
             print(f"warning: {name}: {path} not analysed ({exc})")
+    return out
+
+
+def local_bagnold(run: ChuteRun) -> dict[str, np.ndarray]:
+    """Campbell's f_s and f_N strip by strip in a chute (Figs 3.21-3.24 put chute strips
+    beside the Couette cells): τ_xy, τ_yy from the momentum balance (with the unsteady term),
+    du/dy from the cubic spline through the strips' u (``demstudy.analysis.derived``), f =
+    τ/(ρ_p R² (du/dy)²). Only strips inside the bed (ν ≥ 0.3, above the base's strip) whose
+    shear rate is resolved (du/dy > 2σ) are kept: elsewhere f is noise or undefined (a plug,
+    H12). Arrays ``y``, ``nu``, ``f_s``, ``f_N`` with ``*_err``; empty without stresses."""
+    from ...analysis.derived import bagnold_coefficients, shear_rate
+
+    p, st = run.profiles, run.stress
+    if not p or "balance_tau_xy" not in st:
+        return {}
+    zero = np.zeros_like(p["u"])
+    du, du_err = shear_rate({"y": p["y"], "velocity": np.stack([p["u"], zero], axis=1),
+                             "velocity_err": np.stack([p["u_err"], zero], axis=1)})
+    keep = ((np.nan_to_num(p["nu"]) >= 0.3) & (np.arange(p["y"].size) > 0)
+            & (np.nan_to_num(du) > 2 * np.nan_to_num(du_err, nan=np.inf)))
+    out = {"y": p["y"][keep], "nu": p["nu"][keep], "nu_err": p["nu_err"][keep]}
+    for key, tau in (("f_s", "balance_tau_xy"), ("f_N", "balance_tau_yy")):
+        f, err = bagnold_coefficients(st[tau], du, 2, tau_err=st[f"{tau}_err"],
+                                      rate_err=du_err)
+        out[key], out[f"{key}_err"] = f[keep], err[keep]
     return out
 
 

@@ -62,6 +62,10 @@ def _figures(runs: Mapping[str, ChuteRun], out: Path) -> list[Figure]:
                          out / "chute_plug_20.png"),
         "Fig 3.14 form: the 20° bed, ν and u/u_max against y/H (π/4 and ν_m marked), and its "
         "energy: it stops.")
+    add(figs.angles_figure(_pick(runs, ["chute-40-flat", "chute-40-bumpy", "chute-30-bumpy"]),
+                           out / "chute_angles.png"),
+        "Fig 3.33 form: the collision-angle distribution P(θ) of the 40° chutes (C9) and the "
+        "steady 30° bumpy chute, ±2σ; the approach quadrant shaded.")
     flat = _pick(runs, ["chute-24-flat", "chute-26-flat", "chute-30-flat"])
     add(figs.flat_scan_figure(flat, runs.get("chute-30-bumpy"), out / "chute_flat_base.png"),
         "Why the bumpy base: on Campbell's flat sticking base the force ratio stays ≈ 0.5 in "

@@ -19,7 +19,7 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from ..base import Analysis, Case, pm, tc_caveats
+from ..base import Analysis, Case, pm, tc_caveats, twin_comparison
 from . import couette_checks as ck
 from . import couette_figures as figs
 from .couette_cases import FIXED_NU, SERVO_FACTORS, SHEAR_RATES, all_cases, nu_tag
@@ -39,6 +39,68 @@ LARGER = "couette-cause-20x8-nu75"
 CAUSE_FIXED = ["couette-cause-20x8-nu55", "couette-cause-20x8-nu75"]
 CAUSE_ROUGH = ["couette-cause-rough-nu55", "couette-cause-rough-nu75"]
 
+#: TC twins: a cell → the same cell at t_c = 1e-6 (the cause runs); the dense no-slip cells
+#: and the rough servo cell make 4-13 % of their pair collisions elastic at the default 1e-5
+TC_TWINS = {"couette-fixed-nu65": "couette-cause-tc1e-06-nu65",
+            "couette-fixed-nu75": "couette-cause-tc1e-06-nu75",
+            K1[1]: "couette-cause-tc1e-06-rough-servo-s1"}
+#: what a twin must reproduce (values key → name in the report)
+TWIN_VALUES = {"nu": "ν", "S_text": "S", "f_s": "f_s", "f_N": "f_N", "T_mean": "T(H/U_T)²",
+               "rot_share": "rotational share", "approach_share": "approach share",
+               "layering": "layering"}
+
+
+def _tc_share(r: RunSummary) -> tuple[float, float]:
+    return r.attrs.get("tc_elastic_fraction", math.nan), r.attrs.get("tc", math.nan)
+
+
+def tc_twins(s: Mapping[str, RunSummary]) -> tuple[dict[str, str], dict[str, str]]:
+    """What the TC twins say about their cells, for :func:`..base.tc_caveats`: (cells a twin
+    with a share below the warning level reproduces → the evidence, cells whose twin has a
+    large share itself → what it found). A smaller t_c need not lower the share: in these
+    dense cells 6.0 % at 1e-5 became 6.6 % at 1e-6 (the elastic collisions are re-collisions
+    within clusters, which come closer in time as t_c falls), so a twin can show the results
+    converged in t_c without being a reference free of the model."""
+    from ...engines.edmd.tc_share import WARN_SHARE
+
+    unchanged, told = {}, {}
+    for base, twin in TC_TWINS.items():
+        if base not in s or twin not in s:
+            continue
+        same, text = twin_comparison(s[base].values, s[twin].values, TWIN_VALUES)
+        share, tc = _tc_share(s[twin])
+        found = (f"the twin of {base} at t_c = {tc:g} ({100 * share:.1f} % elastic) gives "
+                 + ("the same values within 2σ + 10 %" if same else "other values")
+                 + f": {text}")
+        if same and share < WARN_SHARE:
+            unchanged[base] = found
+        else:
+            told[base] = found + ("; the twin's own share is large too, so no run free of "
+                                  "the model exists" if share >= WARN_SHARE else "")
+    return unchanged, told
+
+
+#: the chute runs this part reads: Figs 3.21-3.24 put the steady chute's strips on f(ν)
+CHUTE_F = ("chute-30-bumpy",)
+
+
+def reads(quick: bool) -> tuple[str, ...]:
+    """Other parts' runs the Couette analysis uses (module demstudy.studies.parts)."""
+    return CHUTE_F
+
+
+def _chute_strips(paths: Mapping[str, Path]) -> dict[str, dict]:
+    from .chute_measure import local_bagnold
+    from .chute_measure import summarise as chute_summary
+
+    out = {}
+    for name, path in paths.items():
+        try:
+            out[name] = local_bagnold(chute_summary(name, path))
+        except (OSError, KeyError, ValueError) as exc:  # a damaged file: the row says not run
+            print(f"warning: {name}: {path} not read for f(ν) ({exc})")
+    return out
+
 
 def cases(quick: bool) -> list[Case]:
     """Every Couette case; ``quick`` marks the subset in ``--quick`` (the runner picks it)."""
@@ -47,17 +109,33 @@ def cases(quick: bool) -> list[Case]:
 
 def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     out.mkdir(parents=True, exist_ok=True)
-    summaries = {name: summarise(name, Path(path)) for name, path in sorted(runs.items())}
+    chute = _chute_strips({n: Path(runs[n]) for n in CHUTE_F if n in runs})
+    summaries = {name: summarise(name, Path(path)) for name, path in sorted(runs.items())
+                 if name not in CHUTE_F}
     ana = Analysis()
-    ana.checks = checks(summaries)
-    tc_caveats(ana.checks, {n: (r.attrs.get("tc_elastic_fraction", math.nan),
-                                r.attrs.get("tc", math.nan)) for n, r in summaries.items()})
-    ana.figures = figures(summaries, out)
+    ana.checks = checks(summaries, chute)
+    chute_shares = _chute_shares({n: Path(runs[n]) for n in chute})
+    unchanged, told = tc_twins(summaries)
+    tc_caveats(ana.checks, {**{n: _tc_share(r) for n, r in summaries.items()},
+                            **chute_shares}, unchanged, told)
+    ana.figures = figures(summaries, out, chute)
     ana.sections = sections(summaries, quick)
     return ana
 
 
-def checks(s: dict[str, RunSummary]) -> list:
+def _chute_shares(paths: Mapping[str, Path]) -> dict[str, tuple[float, float]]:
+    """The chute runs' TC shares (their rows carry the TC rule too)."""
+    import h5py
+
+    out = {}
+    for name, path in paths.items():
+        with h5py.File(path, "r") as f:
+            out[name] = (float(f.attrs.get("tc_elastic_fraction", math.nan)),
+                         float(f.attrs.get("tc", math.nan)))
+    return out
+
+
+def checks(s: dict[str, RunSummary], chute: Mapping[str, dict] | None = None) -> list:
     fixed_here = [n for n in FIXED if n in s]
     fixed_nu = [FIXED_NU[FIXED.index(n)] for n in fixed_here]
     # the trends use every fixed-gap run present (at least two), else they are not run
@@ -66,7 +144,9 @@ def checks(s: dict[str, RunSummary]) -> list:
     part_here = [n for n in PARTITION if n in s]
     part_names = part_here if len(part_here) >= 2 else PARTITION
     part_nu = [PARTITION_NU[PARTITION.index(n)] for n in part_names]
+    history = [n for n in FIXED + K2 + K1 if n in s] or FIXED
     out = [
+        ck.energy_history(s, history, [_short(n) for n in history]),
         ck.servo_density(s, "K1", K1, SERVO_FACTORS, "Fig 3.15", "rough"),
         ck.servo_density(s, "K2", K2, SERVO_FACTORS, "Fig 3.16", "no-slip"),
         ck.wall_slip(s, K1[1], K2[1]),
@@ -74,6 +154,7 @@ def checks(s: dict[str, RunSummary]) -> list:
         ck.s_order_one(s, trend_names, trend_nu),
         ck.s_trend(s, trend_names, trend_nu, LARGER),
         *ck.bagnold_steep(s, trend_names, trend_nu, LARGER),
+        ck.chute_on_curve(s, trend_names, chute or {}),
         ck.chi_check(s, trend_names, trend_nu),
         ck.rotational_share(s, part_names, part_nu),
         ck.vdf_maxwellian(s, trend_names, trend_nu),
@@ -87,12 +168,28 @@ def checks(s: dict[str, RunSummary]) -> list:
     return out
 
 
+def _short(name: str) -> str:
+    """A cell's name in a row: 'ν = 0.35' for the fixed-gap cells, 'K1 σ_n×0.5' for servo."""
+    if name in FIXED:
+        return f"ν = {FIXED_NU[FIXED.index(name)]:g}"
+    key, _wall, _servo, factor = name.removeprefix("couette-").split("-")[:4]
+    return f"{key.upper()} σ_n×{factor.removeprefix('s')}"
+
+
 def _present(s: dict[str, RunSummary], names: list[str], labels: list[str]):
     return [(lab, s[n]) for n, lab in zip(names, labels, strict=False) if n in s]
 
 
-def figures(s: dict[str, RunSummary], out: Path) -> list:
+def figures(s: dict[str, RunSummary], out: Path, chute: Mapping[str, dict] | None = None
+            ) -> list:
     made = []
+    history = [(title, [(_short(n), s[n]) for n in names if n in s and "ke" in s[n].arrays])
+               for title, names in (("fixed gap, no-slip walls", FIXED),
+                                    ("servo, no-slip walls (K2)", K2),
+                                    ("servo, rough walls (K1)", K1))]
+    history = [g for g in history if g[1]]
+    if history:
+        made.append(figs.energy_history(history, out))
     k1 = _present(s, K1, [f"rough, σ_n×{f:g}" for f in SERVO_FACTORS])
     if LAMMPS in s:
         k1.append(("rough, σ_n×1, LAMMPS (soft)", s[LAMMPS]))
@@ -117,7 +214,7 @@ def figures(s: dict[str, RunSummary], out: Path) -> list:
     groups = {k: v for k, v in groups.items() if v}
     if groups:
         made.append(figs.s_of_nu(groups, out))
-        made.append(figs.bagnold(groups, out))
+        made.append(figs.bagnold(groups, out, chute or {}))
     part = [(n, s[name]) for n, name in zip(PARTITION_NU, PARTITION, strict=False) if name in s]
     if len(part) >= 2:
         made.append(figs.partition([r for _, r in part], [n for n, _ in part], out))
@@ -202,7 +299,7 @@ def causes(s: dict[str, RunSummary]) -> str:
     """Where demstudy's dense cells differ (no steep f rise, no plug), the candidate causes
     side by side with the baseline fixed-gap runs."""
     rows = []
-    for nu in (0.55, 0.75):
+    for nu in (0.55, 0.65, 0.75):
         tag = nu_tag(nu)
         base = f"couette-fixed-nu{tag}"
         for name, what in ((base, "baseline: no-slip, 10 × 4, t_c = 1e-5"),

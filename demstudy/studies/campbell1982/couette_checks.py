@@ -12,9 +12,11 @@ errors. A check whose runs are missing says "not run".
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
-from ..base import NOT_REPRODUCED, PARTLY, REPRODUCED, Check, not_run, pm
+import numpy as np
+
+from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, not_run, pm
 from .couette_measure import RunSummary
 
 Runs = dict[str, RunSummary]
@@ -64,6 +66,71 @@ def fmt(points: Sequence[tuple[float, float]], labels: Sequence[str]) -> str:
     return "; ".join(f"{lab}: {pm(v, e)}" for lab, (v, e) in zip(labels, points, strict=False))
 
 
+#: the fixed-gap cell at ν = 0.75 keeps its square start lattice (layering row): cells at or
+#: above this ν are left out of the f(ν) curve the chute is compared with
+LAYERED_NU = 0.7
+#: a servo cell whose gap changes by more than this over the production has not reached its
+#: servo equilibrium: its ν (an output) is a transient's
+GAP_DRIFT = 0.05
+
+
+def drifting(labels: Sequence[str], rs: Sequence[RunSummary]) -> list[str]:
+    """The cells (by label) whose servo still moves the walls, with the gap's change."""
+    return [f"{lab} (gap {100 * r.v('gap_drift'):+.0f} % over the production)"
+            for lab, r in zip(labels, rs, strict=True)
+            if abs(r.values.get("gap_drift", (0.0, 0.0))[0]) > GAP_DRIFT]
+
+
+#: Campbell's convergence band (±20 % of the mean) must hold this share of the production's
+#: samples for "fluctuates within about 20 %" (his judgement was "necessarily subjective")
+BAND_SHARE = 0.9
+
+
+def ke_converged(r: RunSummary) -> tuple[bool, bool]:
+    """(no trend: the fitted change over the production below 20 % within 2σ, as the
+    chutes'; the ±20 % band holds :data:`BAND_SHARE` of the samples)."""
+    trend, err = r.values["ke_trend"]
+    no_trend = math.isfinite(trend) and abs(trend) - 2 * (err if math.isfinite(err) else 0.0) < 0.2
+    return no_trend, r.v("ke_within") >= BAND_SHARE
+
+
+def energy_history(runs: Runs, names: Sequence[str], labels: Sequence[str]) -> Check:
+    """K7, Fig 2.4: the Couette cell's kinetic energy converges (Campbell's criterion)."""
+    ref = "K7; Fig 2.4, §2.5 L574-586, L178"
+    statement = ("the Couette cell's total kinetic energy per disc converges: it fluctuates "
+                 "within about 20 % of its mean with no trend (Fig 2.4 at R/H = 0.1; R/H is "
+                 "the shear rate in Campbell's units, which only sets the time scale)")
+    thesis = "within ≈ ±20 %, no trend"
+
+    def body(rs: list[RunSummary]) -> Check:
+        parts, bad = [], []
+        for lab, r in zip(labels, rs, strict=True):
+            trend_ok, band_ok = ke_converged(r)
+            parts.append(f"{lab}: trend {pm(*r.values['ke_trend'])}, "
+                         f"{100 * r.v('ke_within'):.0f} % within ±20 %")
+            if not (trend_ok and band_ok):
+                bad.append(f"{lab} ({'a trend' if not trend_ok else ''}"
+                           f"{' and ' if not trend_ok and not band_ok else ''}"
+                           f"{'swings beyond ±20 %' if not band_ok else ''})")
+        verdict = REPRODUCED if not bad else PARTLY if len(bad) < len(rs) else NOT_REPRODUCED
+        reason = (f"criterion: no trend beyond 20 % within 2σ and at least "
+                  f"{100 * BAND_SHARE:.0f} % of the production's samples within ±20 % of the "
+                  "mean; the energy includes the mean flow's (≈ U_T²/6 per disc for a linear "
+                  "profile), which steadies it")
+        if bad:
+            reason += "; not met: " + ", ".join(bad)
+            moving = drifting(labels, rs)
+            if moving:
+                reason += ("; the servo still moves the walls of " + ", ".join(moving)
+                           + ": not at " + ("their" if len(moving) > 1 else "its")
+                           + " servo equilibrium")
+            if any(lab.startswith("K1") for lab in bad):
+                reason += ("; between rough walls the bed slips as a block (slip row), so "
+                           "its energy swings")
+        return Check(ref, statement, thesis, "; ".join(parts), verdict, reason)
+    return guarded(ref, statement, thesis, runs, names, body)
+
+
 # ---------------------------------------------------------------- servo cells (K1, K2, K3)
 def servo_density(runs: Runs, key: str, names: Sequence[str], factors: Sequence[float],
                   figure: str, wall: str) -> Check:
@@ -72,6 +139,12 @@ def servo_density(runs: Runs, key: str, names: Sequence[str], factors: Sequence[
     def body(rs: list[RunSummary]) -> Check:
         pts = [r.values["nu_cell"] for r in rs]
         verdict, why = trend_verdict(pts)
+        moving = drifting([f"σ_n×{f:g}" for f in factors], rs)
+        if moving:
+            why = ". ".join(p for p in (why, "The servo still moves the walls in "
+                                        + ", ".join(moving) + ": that ν is a transient's, "
+                                        "not the servo's equilibrium") if p)
+            verdict = PARTLY if verdict == REPRODUCED else verdict
         return Check(f"{figure} ({key}, L1117-1123)", statement,
                      "ν an output (L855-857); values not in the digest",
                      "ν = " + fmt(pts, [f"σ_n×{f:g}" for f in factors]), verdict, why)
@@ -225,6 +298,70 @@ def bagnold_steep(runs: Runs, names: Sequence[str], nus: Sequence[float],
     return out
 
 
+#: how far a chute strip's f may lie from the Couette cells' curve and still be on it: 2σ of
+#: both plus this fraction (the curve is interpolated between cells 0.1 in ν apart)
+CURVE_TOLERANCE = 0.2
+
+
+def couette_curve(rs: Sequence[RunSummary], key: str, nu: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The cells' f(ν) at ``nu``: log-linear between the cells (by their centre ν), with the
+    relative error interpolated the same way; NaN outside their range."""
+    order = np.argsort([r.v("nu") for r in rs])
+    x = np.array([rs[i].v("nu") for i in order])
+    f = np.array([rs[i].v(key) for i in order])
+    rel = np.array([rs[i].e(key) / rs[i].v(key) for i in order])
+    inside = (nu >= x[0]) & (nu <= x[-1])
+    value = np.where(inside, np.exp(np.interp(nu, x, np.log(f))), np.nan)
+    return value, value * np.interp(nu, x, rel)
+
+
+def chute_on_curve(runs: Runs, names: Sequence[str], chute: Mapping[str, Mapping]) -> Check:
+    """Figs 3.21-3.24 (L1215): the chute strips' f_s, f_N on the fixed-gap cells' f(ν)."""
+    ref = "Figs 3.21-3.24, L1215"
+    statement = ("f_s(ν) and f_N(ν) from the chute's strips (τ from the momentum balance, "
+                 "du/dy from the cubic spline) fall on the Couette cells' curve: one f(ν) "
+                 "for both flows, as the figures plot them together")
+    thesis = "chute points and Couette cells on one f(ν) (figures)"
+    needs = [*names, *chute]
+    if not chute or not all(n in runs for n in names):
+        return not_run(ref, statement, thesis, [n for n in needs if n not in runs
+                                                  and n not in chute])
+
+    def body(rs: list[RunSummary]) -> Check:
+        cells = [r for r in rs if r.v("nu") < LAYERED_NU]
+        parts, met, total = [], 0, 0
+        for name, strips in chute.items():
+            if not len(strips.get("nu", ())):
+                parts.append(f"{name}: no strip with resolved shear")
+                continue
+            for key in ("f_s", "f_N"):
+                curve, curve_err = couette_curve(cells, key, strips["nu"])
+                on = ~np.isnan(curve)
+                f, fe = strips[key][on], strips[f"{key}_err"][on]
+                ok = np.abs(f - curve[on]) <= (2 * np.hypot(fe, curve_err[on])
+                                               + CURVE_TOLERANCE * curve[on])
+                met, total = met + int(ok.sum()), total + int(on.sum())
+                parts.append(f"{name} {key}: " + ", ".join(
+                    f"ν {n:.2f}: {pm(v, e)} (curve {c:.3g}, ×{v / c:.2f})"
+                    for n, v, e, c in zip(strips["nu"][on], f, fe, curve[on], strict=True)))
+        if total == 0:
+            return Check(ref, statement, thesis, "; ".join(parts), NOT_RUN,
+                         "no chute strip inside the cells' range of ν "
+                         f"({min(r.v('nu') for r in cells):.2f}-"
+                         f"{max(r.v('nu') for r in cells):.2f})")
+        verdict = (REPRODUCED if met == total else PARTLY if met >= total / 2
+                   else NOT_REPRODUCED)
+        reason = (f"{met} of {total} strip values on the curve within 2σ + "
+                  f"{100 * CURVE_TOLERANCE:.0f} % (the curve: the fixed-gap cells below "
+                  f"ν = {LAYERED_NU:g}, log-linear between them; the layered ν = 0.75 cell "
+                  "left out; strips with ν ≥ 0.3 and du/dy > 2σ only)")
+        return Check(ref, statement, thesis, "; ".join(parts), verdict, reason)
+    check = guarded(ref, statement, thesis, runs, names, body)
+    check.runs = (*check.runs, *chute)
+    return check
+
+
 def chi_check(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> Check:
     ref = "L1027-1033, L1235"
     statement = ("equation of state p = ρ_p χ(ν)(⟨u'²⟩ + ⟨v'²⟩): χ ~ ν at low ν, rising "
@@ -276,7 +413,7 @@ def vdf_maxwellian(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> Ch
 
 
 def angles_approach(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> Check:
-    ref = "Figs 3.32-3.33, L1349-1359"
+    ref = "Fig 3.32 (K5), L1349-1359"
     statement = ("collision angles prefer the approach quadrant (θ from the flow direction "
                  "in 90°-180° for du/dy > 0; the listing's θ_code = 90° − θ maps that "
                  "quadrant onto itself, so the share is the same in both conventions)")

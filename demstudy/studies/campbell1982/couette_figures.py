@@ -90,10 +90,17 @@ def s_of_nu(points: dict[str, list[RunSummary]], out: Path) -> Figure:
                  "S′ with the mean spacing as length scale", bottom=0.25)
 
 
-def bagnold(points: dict[str, list[RunSummary]], out: Path) -> Figure:
-    """f_s, f_N against ν, log axis (Figs 3.21-3.24)."""
+def bagnold(points: dict[str, list[RunSummary]], out: Path,
+            chute: dict[str, dict] | None = None) -> Figure:
+    """f_s, f_N against ν, log axis (Figs 3.21-3.24), with the chute's strips (``chute``:
+    run name → :func:`.chute_measure.local_bagnold`) as black triangles."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 5.6), sharey=True)
     for ax, key in zip(axes, ("f_s", "f_N"), strict=False):
+        for name, strips in (chute or {}).items():
+            if len(strips.get("nu", ())):
+                val, err = strips[key], 2 * strips[f"{key}_err"]
+                ax.errorbar(strips["nu"], val, yerr=[np.minimum(err, 0.95 * val), err],
+                            fmt="^", color="k", ms=5, label=f"{name}: strips (thesis f)")
         for k, (label, rs) in enumerate(points.items()):
             nu = [r.v("nu") for r in rs]
             for suffix, mk, fill in (("", "o", True), ("_listing", "s", False)):
@@ -156,6 +163,40 @@ def vdfs(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:
                  fontsize=10)
     return _save(fig, out, "couette-vdf.png", "Velocity distributions X1-X5 against the "
                  "folded Maxwellians (a = ½, ½, ½, 1, 3/2)")
+
+
+#: how much of the settling the energy history shows before averaging starts (strain units)
+SETTLING_SHOWN = 100.0
+
+
+def energy_history(groups: Sequence[tuple[str, Sequence[tuple[str, RunSummary]]]],
+                   out: Path) -> Figure:
+    """Fig 2.4: kinetic energy per disc over its production mean against the strain from the
+    start of averaging (the last 100 strain units of the settling before it: the cells settle
+    for different lengths), one panel per group, with Campbell's ±20 % band."""
+    fig, axes = plt.subplots(1, len(groups), figsize=(4.6 * len(groups), 4.4), sharey=True,
+                             squeeze=False)
+    for ax, (title, runs) in zip(axes[0], groups, strict=True):
+        ax.axhspan(0.8, 1.2, color="0.92", zorder=0)
+        longest = 0.0
+        for k, (label, r) in enumerate(runs):
+            strain = r.arrays["ke_strain"] - float(r.arrays["ke_start"])
+            show = strain >= -SETTLING_SHOWN
+            ax.plot(strain[show], r.arrays["ke"][show] / r.v("ke_mean"), lw=0.6,
+                    color=COLOURS[k % 10],
+                    label=f"{label} ({100 * r.v('ke_within'):.0f} % in band)")
+            longest = max(longest, float(strain[-1]))
+        ax.axvline(0.0, color="k", ls="--", lw=0.8)
+        ax.set(xlabel="strain γ̇(t − t_avg) from the start of averaging", title=title,
+               ylim=(0, 3.0), xlim=(-SETTLING_SHOWN, longest))
+        ax.title.set_fontsize(9)
+        ax.legend(fontsize=7, loc="upper right", ncol=2 if len(runs) > 3 else 1)
+    axes[0][0].set_ylabel("kinetic energy per disc / production mean")
+    fig.suptitle("Kinetic-energy history, Campbell Fig 2.4 (band: ±20 %; dashed: averaging "
+                 "starts, t_avg)", fontsize=10)
+    return _save(fig, out, "couette-energy.png", "Fig 2.4 form: total kinetic energy per "
+                 "disc (translation + rotation, mean flow included) over its production mean "
+                 "against the strain, with Campbell's ±20 % band", bottom=0.07)
 
 
 def angles(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:

@@ -35,6 +35,7 @@ import numpy as np
 from ...analysis import derived as dv
 from ...analysis.blocking import split_mean
 from ...analysis.profiles import ProfileAnalysis
+from ...analysis.steady import energy_trend
 from ...io.results import read_results
 
 #: bins closer than this (d) to a wall are left out of the centre averages
@@ -101,6 +102,10 @@ def summarise(name: str, path: Path) -> RunSummary:
     speed = ts.get("wall_velocity_upper", np.full(keep.shape, scene.wall("upper").velocity))
     speed = np.asarray(speed, float)[keep]
     out.values["gap"] = split_mean(gap)
+    # a servo cell still moving its walls: the gap's change from the production's first
+    # tenth to its last, relative (0 for a fixed gap)
+    tenth = max(gap.size // 10, 1)
+    out.values["gap_drift"] = (float(gap[-tenth:].mean() / gap[:tenth].mean() - 1.0), 0.0)
     out.values["width"] = split_mean(width)
     out.values["U_T"] = split_mean(speed)
     out.values["nu_cell"] = split_mean(n * math.pi / 4 / (gap * width))
@@ -146,6 +151,7 @@ def summarise(name: str, path: Path) -> RunSummary:
     _temperatures(out, prof, centre, rate)
     _distributions(out, res, (float(edges[0]), float(edges[-1])) if not servo else
                    (float(res.profiles["edges"][0]), float(res.profiles["edges"][-1])))
+    _energy_history(out, ts, keep, n, u_t)
     out.attrs["tc_elastic_fraction"] = float(res.attrs.get("tc_elastic_fraction", math.nan))
     out.attrs["tc"] = float(res.attrs.get("tc", math.nan))  # the event-driven engine's t_c
     out.attrs["engine"] = res.attrs.get("engine", "?")
@@ -153,6 +159,28 @@ def summarise(name: str, path: Path) -> RunSummary:
     out.attrs["eps"] = (scene.walls[0].restitution, scene.contact.restitution)
     out.attrs["wall_model"] = scene.walls[0].tangential.model
     return out
+
+
+def _energy_history(out: RunSummary, ts: dict, keep: np.ndarray, n: int, u_t: float) -> None:
+    """Fig 2.4: the kinetic energy per disc (translation + rotation, in m U_T²) against the
+    strain γ̇t, and Campbell's convergence numbers over the production: the fitted relative
+    change (``ke_trend``, its error from 8 block means) and the share of samples within ±20 %
+    of the mean (``ke_within``; his "fluctuates within about 20 %", L578)."""
+    from .chute_measure import BAND, trend_error
+
+    if "kinetic_energy" not in ts or not keep.any():
+        return
+    t = np.asarray(ts["time"], float)
+    energy = (np.asarray(ts["kinetic_energy"], float)
+              + np.asarray(ts.get("rotational_energy", 0 * t), float)) / n / u_t**2
+    rate = out.v("shear_rate_nominal")
+    out.arrays.update(ke_strain=t * rate, ke=energy,
+                      ke_start=np.array(float(t[keep][0]) * rate))
+    prod_t, prod_e = t[keep], energy[keep]
+    out.values["ke_trend"] = (energy_trend(prod_t, prod_e), trend_error(prod_t, prod_e))
+    out.values["ke_within"] = (float(np.mean(np.abs(prod_e / prod_e.mean() - 1.0) <= BAND)),
+                               0.0)
+    out.values["ke_mean"] = split_mean(prod_e)
 
 
 def wall_relative_profiles(res: Any, scene: Any, start: float, gap: float) -> dict:
@@ -272,14 +300,14 @@ def _distributions(out: RunSummary, res: Any, walls: tuple[float, float]) -> Non
                 key = f"sj_{conv}_{length}"
                 if key in ang:
                     out.arrays[key] = w @ np.nan_to_num(np.asarray(ang[key], float)) / w.sum()
-        out.values["approach_share"] = _approach_share(out.arrays["p_text"],
+        out.values["approach_share"] = approach_share(out.arrays["p_text"],
                                                        out.arrays["p_text_err"], theta)
         # Savage-Jeffrey's approach share with S, with the text's S' = S·C/R and with the
         # listing's QRH = S·C/(2R) (S from √(⟨u'²⟩+⟨v'²⟩), its own angle convention:
         # θ_code = 90° − θ maps the approach quadrant 90°-180° onto itself)
         for key, name in (("sj_text_R", "R"), ("sj_text_C", "C"), ("sj_listing_C", "listing")):
             if key in out.arrays:
-                out.values[f"approach_share_sj_{name}"] = _approach_share(
+                out.values[f"approach_share_sj_{name}"] = approach_share(
                     out.arrays[key], np.zeros_like(theta), theta)
         out.values["collisions"] = (float(np.sum(pairs)), 0.0)
     st = res.groups.get("statistics/structure")
@@ -290,7 +318,7 @@ def _distributions(out: RunSummary, res: Any, walls: tuple[float, float]) -> Non
                                            out.arrays["st_normal_err"])
 
 
-def _approach_share(p: np.ndarray, err: np.ndarray, theta: np.ndarray) -> tuple[float, float]:
+def approach_share(p: np.ndarray, err: np.ndarray, theta: np.ndarray) -> tuple[float, float]:
     """Share of collisions with θ (text convention) in the approach quadrant 90°-180°."""
     width = math.pi / theta.size
     sel = theta > math.pi / 2

@@ -20,7 +20,16 @@ from ...errors import BadInputFile
 from ...io.results import read_results
 from ..base import NOT_RUN, UNITS_NOTE, Analysis, Check, Figure
 from . import poiseuille_checks as pc
-from .poiseuille_cases import BETAS, QUICK, RESTITUTIONS, SOFT_FLOWS, Flow, cases, flows
+from .poiseuille_cases import (
+    BETAS,
+    QUICK,
+    RESTITUTIONS,
+    SOFT_FLOWS,
+    TC_TWINS,
+    Flow,
+    cases,
+    flows,
+)
 from .poiseuille_data import (
     BINS,
     BINS_DENSE,
@@ -71,18 +80,29 @@ def _drifting(data: Mapping) -> str:
 
 
 def _known_flows(quick: bool) -> dict[str, Flow]:
-    return {f.name: f for f in (QUICK if quick else flows())}
+    """The event-driven flows of the (quick) study by case name, the TC twins included."""
+    return {f.name: f for f in (QUICK if quick else (*flows(), *TC_TWINS))}
 
 
 def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
-    """The part's runs present in ``runs``, read (in-bin g(r) computed from their frames)."""
+    """The part's runs present in ``runs``, read (in-bin g(r) computed from their frames);
+    the TC twins apart (:func:`load_twins`)."""
     known = _known_flows(quick)
     out: Runs = {}
     for name, path in runs.items():
         flow = known.get(name)
-        if flow is not None and flow.engine == "edmd" and Path(path).is_file():
+        if (flow is not None and flow.engine == "edmd" and flow.tc is None
+                and Path(path).is_file()):
             out[(flow.phi, flow.beta, flow.e)] = load_flow(flow, Path(path))
     return out
+
+
+def load_twins(runs: Mapping[str, Path], quick: bool) -> list[FlowData]:
+    """The TC twins present in ``runs`` (full study), read."""
+    if quick:
+        return []
+    return [load_flow(f, Path(runs[f.name])) for f in TC_TWINS
+            if f.name in runs and Path(runs[f.name]).is_file()]
 
 
 def soft_row(data: Runs, runs: Mapping[str, Path], flow: Flow) -> Check:
@@ -125,11 +145,13 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     """Checks, figures and report sections of the Poiseuille part (cases missing from
     ``runs`` give "not run" checks)."""
     data = load_runs(runs, quick)
+    twins = load_twins(runs, quick)
     checks = [c for check in CHECKS for c in check(data)]
-    pc.tc_caveats(checks, data)
+    pc.tc_caveats(checks, data, pc.tc_twin_evidence(data, twins))
     pc.common_motion_caveats(checks, data)
     if not quick:
         checks += [soft_row(data, runs, flow) for flow in SOFT_FLOWS]
+        checks += pc.tc_twin_rows(data, twins, TC_TWINS)
     for c in checks:  # a statement without runs says so, never crashes
         if c.verdict == NOT_RUN and not c.reason:
             c.reason = "its runs are not in this run of the study"
@@ -297,8 +319,10 @@ def sections(data: Runs, runs: Mapping[str, Path], quick: bool) -> list[tuple[st
                      f"{_percent(info['tc_fraction'])} | {info['wall_seconds']:.0f} |")
     lines += ["", "TC-elastic share: the pair collisions the engine's TC model (Luding & "
               "McNamara, t_c = 10⁻⁵ √(d/g) unless stated) made elastic, absent from the "
-              "thesis's model; above 5 % an agreement in the rows of that φ counts as "
-              "\"partly\" and a mismatch names the share as one possible cause.", "",
+              "thesis's model; above 5 % an agreement in the rows resting on that run (a "
+              "statement about a φ rests on all its runs) counts as \"partly\", unless a "
+              "twin at a smaller t_c with a share below 5 % gives the same values, and a "
+              "mismatch names the share as one possible cause.", "",
               f"The thesis averaged Λ over 7·10⁴ (φ = 0.01, 0.1) and 8·10⁴ (φ = 0.5) "
               f"collisions per particle; demstudy averaged over "
               f"{collisions_text(list(data.values()))} (table).", "",

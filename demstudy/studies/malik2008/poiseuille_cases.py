@@ -56,10 +56,13 @@ class Flow:
     e: float
     beta: float
     engine: str = "edmd"
+    #: the event-driven engine's TC time when not the default (a TC twin, :data:`TC_TWINS`)
+    tc: float | None = None
 
     @property
     def name(self) -> str:
-        return f"poiseuille-phi{self.phi:g}-b{self.beta:g}-e{self.e:g}-{self.engine}"
+        twin = "" if self.tc is None else f"-tc{self.tc:g}"
+        return f"poiseuille-phi{self.phi:g}-b{self.beta:g}-e{self.e:g}{twin}-{self.engine}"
 
 
 def case_of(flow: Flow, quick: bool = False) -> Case:
@@ -75,8 +78,10 @@ def case_of(flow: Flow, quick: bool = False) -> Case:
         sections["measure"]["statistics"] = [s for s in STATISTICS if s != "freepath"]
         sections = merge(sections, SOFT_SECTIONS)
     quick_sections = {"run": QUICK_RUN[flow.phi]} if quick else {}
+    options = {} if flow.tc is None else {"tc": flow.tc}
     return Case(flow.name, SCENES[flow.phi], engine=flow.engine, sections=sections,
-                quick=quick, quick_sections=quick_sections, group=f"phi{flow.phi:g}")
+                quick=quick, quick_sections=quick_sections, group=f"phi{flow.phi:g}",
+                options=options)
 
 
 def flows() -> list[Flow]:
@@ -102,6 +107,10 @@ SOFT_FLOWS = (SOFT, Flow(0.01, 0.8, 0.99, engine="liggghts"))
 SOFT_SECTIONS = {"run": {"equilibration": 200.0, "production": 400.0, "sample_interval": 4.0},
                  "soft": {"steps_per_contact": 10}}
 QUICK = (Flow(0.01, 0.8, 0.99), Flow(0.01, 0.8, -0.99), Flow(0.5, *DENSE))
+#: TC twins (full study): the dense φ = 0.5 channel makes 16 % of its pair collisions
+#: elastic at the default t_c = 1e-5 √(d/g); the same flow at t_c = 1e-6 says whether its
+#: rows depend on the TC model (the "TC model" row, :func:`poiseuille_checks.tc_twin_row`)
+TC_TWINS = (Flow(0.5, *DENSE, tc=1e-6),)
 
 
 def cases(quick: bool) -> list[Case]:
@@ -109,4 +118,5 @@ def cases(quick: bool) -> list[Case]:
     quick: ``QUICK`` only, shortened."""
     if quick:
         return [case_of(f, quick=True) for f in QUICK]
-    return [case_of(f, quick=f in QUICK) for f in flows()] + [case_of(f) for f in SOFT_FLOWS]
+    return ([case_of(f, quick=f in QUICK) for f in flows()] + [case_of(f) for f in SOFT_FLOWS]
+            + [case_of(f) for f in TC_TWINS])

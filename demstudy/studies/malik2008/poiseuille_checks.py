@@ -12,6 +12,7 @@ check. Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from collections.abc import Sequence
@@ -28,9 +29,10 @@ from ..base import (
     Check,
     not_run,
     pm,
+    twin_comparison,
     within,
 )
-from .poiseuille_cases import BETAS, RESTITUTIONS
+from .poiseuille_cases import BETAS, RESTITUTIONS, Flow
 from .poiseuille_data import (
     CENTRE_BIN,
     FlowData,
@@ -57,12 +59,6 @@ def _mean(v: np.ndarray, e: np.ndarray) -> tuple[float, float]:
 
 def _tag(d: FlowData) -> str:
     return f"β = {d.flow.beta:g}, e = {d.flow.e:g}"
-
-
-def _tc_large(d: FlowData) -> bool:
-    """Whether the engine's TC model made more than WARN_SHARE of the run's pair collisions
-    elastic (the thesis has no TC model: its dissipation is then not the thesis's)."""
-    return d.run_info()["tc_fraction"] > WARN_SHARE
 
 
 def _unsteady(ds: FlowData | Sequence[FlowData]) -> list[FlowData]:
@@ -92,28 +88,108 @@ def _cap(verdict: str, ds: FlowData | Sequence[FlowData]) -> str:
     return PARTLY if verdict == REPRODUCED and _unsteady(ds) else verdict
 
 
-def tc_caveats(checks: list[Check], data: Runs) -> None:
-    """Every statement about a φ whose runs the TC model changed (more than WARN_SHARE of
-    their pair collisions made elastic; the thesis has none) gets the share and t_c in its
-    reason, and an agreement is weakened to "partly" (a mismatch stays "not reproduced",
-    the TC model one possible cause); the plateau statements, about the runs' length, not."""
+def tc_caveats(checks: list[Check], data: Runs,
+               twins: tuple[dict[str, str], dict[str, str]] | None = None) -> None:
+    """The studies' one TC rule (:func:`..base.tc_caveats`: a row resting on a run whose TC
+    model made more than WARN_SHARE of its pair collisions elastic names the share, and an
+    agreement becomes "partly" unless a twin with a small share agrees) on this part's rows.
+    A statement about a φ ("φ = 0.5: …") that names no runs rests on every run of that φ,
+    except the plateau statements, which are about the runs' length. ``twins``: (runs a
+    small-share twin reproduced → evidence, runs whose twin says something else → what), as
+    :func:`tc_twin_evidence` gives them."""
+    from ..base import tc_caveats as rule
+
     for phi in sorted({p for p, _b, _e in data}):
-        large = [d for (p, _b, _e), d in sorted(data.items()) if p == phi and _tc_large(d)]
-        if not large:
-            continue
-        shares = ", ".join(f"{_tag(d)}: {100 * d.run_info()['tc_fraction']:.1f} % (t_c = "
-                           f"{d.run_info()['tc']:g} √(d/g))" for d in large)
-        note = (f" The engine's TC model made a large share of the pair collisions elastic "
-                f"({shares}; the thesis has no TC model): the flow dissipates less than e "
-                "says, a weaker test either way.")
+        names = tuple(d.flow.name for (p, _b, _e), d in sorted(data.items()) if p == phi)
         pattern = re.compile(rf"^φ = {re.escape(f'{phi:g}')}[:,]")
         for c in checks:
-            if (c.verdict == NOT_RUN or not pattern.match(c.statement)
-                    or "plateau of the kinetic energy" in c.statement):
-                continue
-            c.reason = (c.reason + note).strip()
-            if c.verdict == REPRODUCED:  # a weaker test; a mismatch stays one (TC: a cause)
-                c.verdict = PARTLY
+            if (not c.runs and pattern.match(c.statement)
+                    and "plateau of the kinetic energy" not in c.statement):
+                c.runs = names
+    shares = {d.flow.name: (d.run_info()["tc_fraction"], d.run_info()["tc"])
+              for d in data.values()}
+    unchanged, told = twins or ({}, {})
+    rule(checks, shares, unchanged, told)
+
+
+#: what a TC twin must reproduce of its flow (key → name in the report)
+TWIN_VALUES = {"u_centre": "u_x centre", "u_wall": "u_x wall", "phi_centre": "φ centre",
+               "phi_wall": "φ wall", "T_centre": "T centre", "T_mean": "mean T",
+               "theta_centre": "θ centre"}
+
+
+def twin_values(d: FlowData) -> dict[str, tuple[float, float]]:
+    """The values of run ``d`` a TC twin is compared on (:data:`TWIN_VALUES`)."""
+    return {"u_centre": d.centre_value("ux"), "u_wall": d.wall_value("ux"),
+            "phi_centre": d.centre_value("phi"), "phi_wall": d.wall_value("phi"),
+            "T_centre": d.centre_value("T"), "T_mean": d.mean_temperature(),
+            "theta_centre": d.centre_value("theta")}
+
+
+def _twin_of(data: Runs, twin: FlowData) -> FlowData | None:
+    return data.get((twin.flow.phi, twin.flow.beta, twin.flow.e))
+
+
+def tc_twin_evidence(data: Runs, twins: Sequence[FlowData]
+                     ) -> tuple[dict[str, str], dict[str, str]]:
+    """What the TC twins (the same flow at a smaller t_c) say, for :func:`tc_caveats`:
+    (runs a twin with a share below WARN_SHARE reproduces within 2σ + 10 % → the evidence,
+    runs whose twin differs or has a large share itself → what it found)."""
+    unchanged, told = {}, {}
+    for twin in twins:
+        base = _twin_of(data, twin)
+        if base is None:
+            continue
+        same, text = twin_comparison(twin_values(base), twin_values(twin), TWIN_VALUES)
+        info = twin.run_info()
+        found = (f"its twin at t_c = {info['tc']:g} √(d/g) ({100 * info['tc_fraction']:.1f} "
+                 f"% elastic) gives " + ("the same values within 2σ + 10 %" if same else
+                                          "other values") + f": {text}")
+        if same and info["tc_fraction"] < WARN_SHARE:
+            unchanged[base.flow.name] = found
+        else:
+            told[base.flow.name] = found
+    return unchanged, told
+
+
+def tc_twin_rows(data: Runs, twins: Sequence[FlowData], wanted: Sequence) -> list[Check]:
+    """demstudy's own rows: each flow of ``wanted`` (Flows with a t_c) against its run at the
+    default t_c. Reproduced: the same values within 2σ + 10 % and a small share at the
+    smaller t_c; partly: the same values, but the twin's share is large too (no run free of
+    the model); not reproduced: the values depend on t_c."""
+    out = []
+    for flow in wanted:
+        ref = f"TC model, φ = {flow.phi:g} (demstudy; not in the thesis)"
+        statement = (f"the φ = {flow.phi:g} flow (β = {flow.beta:g}, e = {flow.e:g}) does not "
+                     f"depend on the event-driven engine's t_c (10⁻⁵ against {flow.tc:g} "
+                     "√(d/g)), and the TC-elastic share is small at the smaller t_c")
+        thesis = "— (the thesis's collisions all dissipate: no TC model)"
+        twin = next((t for t in twins if t.flow == flow), None)
+        base = None if twin is None else _twin_of(data, twin)
+        if twin is None or base is None:
+            out.append(not_run(ref, statement, thesis,
+                               [f.name for f, d in ((flow, twin), (base_flow(flow), base))
+                                if d is None], own=True))
+            continue
+        same, text = twin_comparison(twin_values(base), twin_values(twin), TWIN_VALUES)
+        b, t = base.run_info(), twin.run_info()
+        small = t["tc_fraction"] < WARN_SHARE
+        measured = (f"t_c {b['tc']:g}: TC share {100 * b['tc_fraction']:.1f} %; t_c "
+                    f"{t['tc']:g}: TC share {100 * t['tc_fraction']:.1f} %, " + text)
+        verdict = (REPRODUCED if same and small else PARTLY if same else NOT_REPRODUCED)
+        reason = ("every value within 2σ + 10 %" if same else
+                  "a value differs by more than 2σ + 10 %: the flow depends on t_c")
+        if not small:
+            reason += ("; the smaller t_c does not bring the share below 5 %: the elastic "
+                       "collisions are the dense core's rapid re-collisions, not set by t_c")
+        reason += _steady_note([base, twin])
+        out.append(Check(ref, statement, thesis, measured, verdict, reason, own=True))
+    return out
+
+
+def base_flow(flow: Flow) -> Flow:
+    """The flow at the default t_c of TC twin ``flow``."""
+    return dataclasses.replace(flow, tc=None)
 
 
 # ------------------------------------------------------------------ steady state
