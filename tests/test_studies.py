@@ -146,7 +146,12 @@ def test_a_finished_run_of_the_same_kind_turns_a_lower_bound_into_an_estimate(
 
     import demstudy.api as api
     from demstudy.scene import load_scene, scene_to_toml
-    from demstudy.studies.runner import CALIBRATED_NOTE, LOWER_BOUND_NOTE, tasks_of
+    from demstudy.studies.runner import (
+        CALIBRATED_NOTE,
+        LOWER_BOUND_NOTE,
+        OTHER_TC_NOTE,
+        tasks_of,
+    )
 
     def plan(scene, **kw):
         return {"forecast_seconds": 30.0, "forecast_kind": "lower bound"}
@@ -155,11 +160,11 @@ def test_a_finished_run_of_the_same_kind_turns_a_lower_bound_into_an_estimate(
     made = tasks_of(TOY, False, tmp_path)[0]  # cell-a
     made.path.parent.mkdir(parents=True)
 
-    def finished(scene_toml: str) -> list[str]:
+    def finished(scene_toml: str, tc: float = 1e-5) -> list[str]:
         with h5py.File(made.path, "w") as f:
             f.attrs.update({"engine": "edmd", "forecast_kind": "lower bound",
                             "forecast_seconds": 30.0, "wall_seconds": 90.0,
-                            "scene_toml": scene_toml, "tc": 1e-5})
+                            "scene_toml": scene_toml, "tc": tc})
         lines: list[str] = []
         run_study("toy", out=tmp_path, dry_run=True, workers=1, echo=lines.append,
                   only=["cell-b"])
@@ -170,15 +175,20 @@ def test_a_finished_run_of_the_same_kind_turns_a_lower_bound_into_an_estimate(
     assert any(s.endswith("cell-b (edmd): about 90 s (its lower bound 30 s × 3.00: cell-a, "
                           "N = 40, took 90 s against a lower bound of 30 s)") for s in lines)
     assert LOWER_BOUND_NOTE not in lines and CALIBRATED_NOTE in lines
+    assert OTHER_TC_NOTE not in lines
+    # made at another t_c: still the guide, and the line and a note say so
+    lines = finished(made.scene_toml, tc=1e-6)
+    assert any("cell-a, N = 40, made at t_c = 1e-06, took 90 s" in s for s in lines), lines
+    assert OTHER_TC_NOTE in lines
     lines = finished(scene_to_toml(load_scene("campbell1982/chute-20")))
     assert lines[1].startswith("forecast: probably more than 30 s"), lines
     assert LOWER_BOUND_NOTE in lines
 
 
 def test_a_calibrating_run_has_the_same_engine_options_and_is_the_closest(tmp_path):
-    """Another t_c is another kind (its runs cost differently); among runs of the kind the
-    closest in N, length, e and β calibrates; a made run counts from its record when its
-    results file is gone."""
+    """Another t_c costs differently: a run at the same t_c calibrates first, one at another
+    t_c only when there is none; among them the closest in N, length, e and β; a made run
+    counts from its record when its results file is gone."""
     from demstudy.scene import load_scene
     from demstudy.studies.runner import Took, _made, calibration, tasks_of
 
@@ -187,9 +197,12 @@ def test_a_calibrating_run_has_the_same_engine_options_and_is_the_closest(tmp_pa
     far = Took("far", "edmd", load_scene("campbell1982/couette-rough",
                                          ["run.production=1000"]), 900.0, 30.0, 1e-5)
     assert calibration(scene, "edmd", [far, near]) is near
-    assert calibration(scene, "edmd", [far, near], {"tc": 1e-6}) is None
-    assert calibration(scene, "edmd", [Took("twin", "edmd", scene, 9.0, 3.0, 1e-6)],
-                       {"tc": 1e-6}).name == "twin"
+    # no run at its t_c: the closest at another t_c (the forecast line says so), but a run
+    # at its t_c is preferred however far
+    assert calibration(scene, "edmd", [far, near], {"tc": 1e-6}) is near
+    twin = Took("twin", "edmd", load_scene("campbell1982/couette-rough",
+                                           ["run.production=1000"]), 9.0, 3.0, 1e-6)
+    assert calibration(scene, "edmd", [near, twin], {"tc": 1e-6}) is twin
     assert calibration(scene, "lammps", [far, near]) is None
     records = tmp_path / "records"
     records.mkdir()

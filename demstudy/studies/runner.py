@@ -153,6 +153,7 @@ def forecast(tasks: Sequence[StudyTask], workers: int,
     total = makespan(list(each.seconds.values()), workers) if each.seconds else 0.0
     notes = [note for note, used in ((OWN_PACE_NOTE, each.own), (OLD_CHECKPOINT_NOTE, each.old),
                                      (CALIBRATED_NOTE, bool(each.again)),
+                                     (OTHER_TC_NOTE, each.other_tc),
                                      # the runs' lower bounds: the study takes longer,
                                      # by how much is unknown
                                      (LOWER_BOUND_NOTE, each.lower)) if used]
@@ -173,6 +174,7 @@ class _Forecasts:
     lower: bool = False  # an uncalibrated lower bound among the runs
     own: bool = False  # a stopped run counted at its own pace
     old: bool = False  # a checkpoint without a progress file: the whole run's forecast
+    other_tc: bool = False  # a lower bound calibrated by a made run at another t_c
     #: made run → its lower bound forecast again now
     again: dict[str, float] = field(default_factory=dict)
     made: list[Took] | None = None  # read when a lower bound first needs it
@@ -217,9 +219,13 @@ class _Forecasts:
             self.again[like.name] = _bound_now(like, task.path.parent)
         ratio = like.wall / self.again[like.name]
         self.seconds[task.case.name] = float(s) * ratio
+        tc = _tc(task.case.engine, task.case.options)
+        other = like.tc is not None and tc is not None and not math.isclose(like.tc, tc)
+        self.other_tc = self.other_tc or other
         self.lines.append(
             f"{name} about {_duration(s * ratio)} (its lower bound {_duration(s)} × "
-            f"{ratio:.2f}: {like.name}, N = {like.scene.n_particles}, took "
+            f"{ratio:.2f}: {like.name}, N = {like.scene.n_particles}"
+            + (f", made at t_c = {like.tc:g}" if other else "") + ", took "
             f"{_duration(like.wall)} against a lower bound of "
             f"{_duration(self.again[like.name])})")
 
@@ -300,13 +306,14 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     if not scene.solid_fraction > 0:
         return None
     like = [t for t in finished if t.engine == engine and drive(t.scene) == drive(scene)
-            and t.scene.run.unit == scene.run.unit
-            and (t.tc is None) == (tc is None)
-            and (tc is None or math.isclose(t.tc, tc, rel_tol=1e-9))
+            and t.scene.run.unit == scene.run.unit and (t.tc is None) == (tc is None)
             and similar_fraction(scene, t.scene)]
+    # the same t_c first: another t_c costs differently (a TC twin at 1e-6 took ×1.0–2.1
+    # its 1e-5 run's time in Malik's wave study), but is a far better guide than none
+    same = [t for t in like if tc is None or math.isclose(t.tc, tc, rel_tol=1e-9)]
     if not like:
         return None
-    return min(like, key=lambda t: (family_distance(scene, t.scene), t.name))
+    return min(same or like, key=lambda t: (family_distance(scene, t.scene), t.name))
 
 
 #: under a forecast that resumes a checkpoint without a progress file of its own
@@ -320,6 +327,10 @@ OWN_PACE_NOTE = ("  (a stopped run: what is left of it at its own pace over its 
 CALIBRATED_NOTE = ("  (about: a lower bound × what a made run of its kind took against its "
                    "own; such estimates met ×0.30–4.0 of the actual time, ×2 or better in "
                    "14 of 20 of Malik's runs: benchmarks/bench_study_forecast.py)")
+#: under the list of runs when a lower bound was calibrated by a run at another t_c
+OTHER_TC_NOTE = ("  (made at another t_c: no made run of its kind has its t_c; a TC twin at "
+                 "t_c = 1e-6 took ×1.0–2.1 the time of its run at 1e-5 in Malik's wave study, "
+                 "so expect more)")
 #: under the list of runs when some forecast is a lower bound (the total then is one too)
 LOWER_BOUND_NOTE = ("  (probably more: a flow that gravity accelerates outruns its pilot; "
                     "such forecasts met ×0.7–2.3 of the actual time in the forecast "

@@ -190,6 +190,14 @@ def figures(s: dict[str, RunSummary], out: Path, chute: Mapping[str, dict] | Non
     history = [g for g in history if g[1]]
     if history:
         made.append(figs.energy_history(history, out))
+    # Campbell's snapshots are at ν = 0.56, 0.63, 0.76: the fixed-gap cells nearest them
+    shots = [(lab, s[n]) for n, lab in ((FIXED[2], "10 × 4, ν = 0.55"),
+                                        (FIXED[3], "10 × 4, ν = 0.65"),
+                                        (FIXED[4], "10 × 4, ν = 0.75"),
+                                        (LARGER, "20 × 8, ν = 0.75"))
+             if n in s and "snapshot" in s[n].arrays]
+    if shots:
+        made.append(figs.snapshots(shots, out))
     k1 = _present(s, K1, [f"rough, σ_n×{f:g}" for f in SERVO_FACTORS])
     if LAMMPS in s:
         k1.append(("rough, σ_n×1, LAMMPS (soft)", s[LAMMPS]))

@@ -476,7 +476,7 @@ def elastic_lower_s(runs: Runs, elastic: str, inelastic: str) -> Check:
 
 
 def layering(runs: Runs, names: Sequence[str], nus: Sequence[float]) -> Check:
-    ref = "Figs 3.35-3.39 (K5), L1416-1428"
+    ref = "Figs 3.35-3.39 (K5), L1416-1428; snapshots Fig 2.3"
     statement = ("structure: the normal distribution is nearly flat at low ν and shows "
                  "layers (peaks at one layer spacing) at high ν")
     def body(rs: list[RunSummary]) -> Check:

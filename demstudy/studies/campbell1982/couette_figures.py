@@ -165,6 +165,38 @@ def vdfs(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:
                  "folded Maxwellians (a = ½, ½, ½, 1, 3/2)")
 
 
+def snapshots(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:
+    """Fig 2.3: the discs of each cell in its last frame (x periodic: discs across the edge
+    drawn on both sides), the walls as thick lines, lengths in d."""
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle
+
+    sizes = [r.arrays["snapshot_box"][1] - r.arrays["snapshot_box"][0] for _, r in runs]
+    widths = [float(sz[0]) for sz in sizes]
+    height = max(float(sz[1]) for sz in sizes)
+    fig, axes = plt.subplots(1, len(runs), figsize=(1.5 + 0.42 * sum(widths),
+                                                    0.36 * height + 1.8),
+                             gridspec_kw={"width_ratios": widths}, squeeze=False)
+    for ax, (label, r) in zip(axes[0], runs, strict=True):
+        (x0, y0), (x1, y1) = r.arrays["snapshot_box"]
+        pos, rad = r.arrays["snapshot"], r.arrays["snapshot_radius"]
+        circles = []
+        for (x, y), a in zip(pos, rad, strict=True):
+            for shift in (-(x1 - x0), 0.0, x1 - x0):  # periodic images across x
+                if x0 - a < x + shift < x1 + a:
+                    circles.append(Circle((x + shift, y), a))
+        ax.add_collection(PatchCollection(circles, facecolor="0.8", edgecolor="k", lw=0.6))
+        for y in (y0, y1):
+            ax.axhline(y, color="k", lw=2.5)
+        ax.set(xlim=(x0, x1), ylim=(y0 - 0.3, y1 + 0.3), aspect="equal",
+               xlabel="x [d]", title=f"{label}\n(centre strips {r.v('nu'):.2f})")
+        ax.title.set_fontsize(9)
+    axes[0][0].set_ylabel("y [d] (walls: thick lines)")
+    fig.suptitle("Snapshots at the end of the run, Campbell Fig 2.3", fontsize=10)
+    return _save(fig, out, "couette-snapshots.png", "Fig 2.3 form: the cells' discs in "
+                 "their last frame (the upper wall moves to the right)", bottom=0.1)
+
+
 #: how much of the settling the energy history shows before averaging starts (strain units)
 SETTLING_SHOWN = 100.0
 

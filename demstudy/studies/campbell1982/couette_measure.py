@@ -152,6 +152,11 @@ def summarise(name: str, path: Path) -> RunSummary:
     _distributions(out, res, (float(edges[0]), float(edges[-1])) if not servo else
                    (float(res.profiles["edges"][0]), float(res.profiles["edges"][-1])))
     _energy_history(out, ts, keep, n, u_t)
+    if res.frames and "position" in res.frames:  # the last frame: Fig 2.3's snapshot
+        out.arrays.update(snapshot=np.asarray(res.frames["position"][-1], float),
+                          snapshot_radius=np.asarray(res.frames["radius"][-1], float),
+                          snapshot_box=np.array([res.frames["box_lo"][-1],
+                                                 res.frames["box_hi"][-1]], float))
     out.attrs["tc_elastic_fraction"] = float(res.attrs.get("tc_elastic_fraction", math.nan))
     out.attrs["tc"] = float(res.attrs.get("tc", math.nan))  # the event-driven engine's t_c
     out.attrs["engine"] = res.attrs.get("engine", "?")
