@@ -40,19 +40,27 @@ def _save(fig: plt.Figure, out: Path, name: str, caption: str, bottom: float = 0
 
 def profiles(runs: Sequence[tuple[str, RunSummary]], out: Path, name: str,
              title: str) -> Figure:
-    """u/U_T and ν against y/H (y/H vertical, Campbell's Figs 3.15-3.16); the legend sits
+    """u/U_T, ν and the temperature QFL/3 = (⟨u'²⟩ + ⟨v'²⟩ + β⟨ω'²⟩)(H/U_T)²/3 (Campbell's
+    print, R = 1) against y/H (y/H vertical, Campbell's Figs 3.15-3.16); the legend sits
     below the axes, off the data."""
-    fig, (a, b) = plt.subplots(1, 2, figsize=(8, 5.4), sharey=True)
+    fig, (a, b, t) = plt.subplots(1, 3, figsize=(11, 5.4), sharey=True)
     for k, (label, r) in enumerate(runs):
         c = COLOURS[k % 10]
         yh = r.arrays["y_over_h"]
         a.errorbar(r.arrays["u_over_ut"], yh, xerr=2 * r.arrays["u_err"], fmt="o-", ms=3,
                    color=c, label=label)
         b.errorbar(r.arrays["nu"], yh, xerr=2 * r.arrays["nu_err"], fmt="o-", ms=3, color=c)
+        if "Tw_err" in r.arrays:
+            qfl = (r.arrays["Tu"] + r.arrays["Tv"] + r.arrays["Tw"]) / 3
+            err = np.sqrt(r.arrays["Tu_err"] ** 2 + r.arrays["Tv_err"] ** 2
+                          + r.arrays["Tw_err"] ** 2) / 3
+            t.errorbar(qfl, yh, xerr=2 * err, fmt="o-", ms=3, color=c)
     a.plot([0, 1], [0, 1], "k:", lw=0.8, label="no slip, uniform shear")
     a.set_xlabel("u / U_T")
     a.set_ylabel("y / H (H: wall gap; servo cells: strips follow the walls)")
     b.set_xlabel("solid fraction ν")
+    t.set_xlabel("T (H/U_T)² = QFL/3, lengths in R")
+    t.set_xlim(left=0)
     a.set_ylim(0, 1)
     a.set_xlim(0, 1)
     fig.legend(*a.get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=7.5,

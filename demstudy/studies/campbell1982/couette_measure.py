@@ -252,6 +252,7 @@ def _temperatures(out: RunSummary, prof: dict, centre: np.ndarray, rate: float) 
         m, s = centre_mean(v * scale, e * scale, centre)
         out.values[key] = (m, s)
         out.arrays[key] = v * scale
+        out.arrays[f"{key}_err"] = np.nan_to_num(e) * scale
     total = sum(out.v(k) for k in parts)
     total_err = math.sqrt(sum(out.e(k) ** 2 for k in parts))
     out.values["T_total"] = (total, total_err)

@@ -83,6 +83,14 @@ def _spectrum(ax, run: RunWaves, plane: str, letter: str) -> None:
                zip(ka.ravel(), kb.ravel(), strict=True)]
     ax.bar3d(ka.ravel() - 0.3, kb.ravel() - 0.3, 0 * top.ravel(), 0.6, 0.6, top.ravel(),
              color=colours, shade=True)
+    # ±2σ whiskers (jackknife over the production's blocks) above each bar's centre
+    err = np.asarray(run.modes.results.get(f"family_power_{plane}_err",
+                                           np.zeros_like(power)), float)[: na + 1, : nb + 1]
+    for (i, j), p, e in zip(zip(ka.ravel(), kb.ravel(), strict=True), top.ravel(),
+                            np.nan_to_num(err).ravel(), strict=True):
+        if p > 0 and e > 0:
+            ax.plot([i, i], [j, j], [max(p - 2 * e, 0.0), p + 2 * e], color="k", lw=0.9,
+                    zorder=10)
     ax.set_xlabel(f"k_{plane[0]}", fontsize=7, labelpad=-2)
     ax.set_ylabel(f"k_{plane[1]}", fontsize=7, labelpad=-2)
     ax.set_zlabel("P_F", fontsize=7, labelpad=0)
@@ -90,7 +98,7 @@ def _spectrum(ax, run: RunWaves, plane: str, letter: str) -> None:
     ax.set_xticks(range(na + 1))
     ax.set_yticks(range(nb + 1))
     ax.set_title(f"({letter}) power {plane}: P = 2|X|²/(N1N2)², ± modes summed,\nmean over "
-                 "the production; red: dominant", fontsize=7.5)
+                 "the production, ±2σ whiskers; red: dominant", fontsize=7.5)
 
 
 def _energy(ax, run: RunWaves) -> None:
