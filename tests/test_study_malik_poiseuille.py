@@ -43,7 +43,7 @@ def test_case_names_unique_and_quick_is_the_named_subset():
         ("poiseuille-phi0.01-b0.99-e0.8-lammps", "lammps"),
         ("poiseuille-phi0.01-b0.99-e0.8-liggghts", "liggghts")]
     # the thesis's grid: 3 β × 4 e at φ = 0.01 and at φ = 0.1, one dense flow
-    assert sum("phi0.01-" in n and n.endswith("-edmd") for n in names) == 12
+    assert sum("phi0.01-" in n and n.endswith("-edmd") and "-n" not in n for n in names) == 12
     assert sum("phi0.1-" in n for n in names) == 12
     assert sum("phi0.5-" in n and "-tc" not in n for n in names) == 1
     # the dense flow's TC twin: the same flow at t_c = 1e-6
@@ -60,6 +60,8 @@ def test_scenes_validate_with_the_thesis_n_box_e_beta_and_25_bins(quick):
                     if f.name == case.name)
         scene = case.load(quick)
         n, box = THESIS_SYSTEM[flow.phi]
+        if flow.n is not None:  # the validation box: N in a cube at φ (its own test)
+            n, box = flow.n, (flow.side,) * 3
         assert scene.particles.count == n, case.name
         assert tuple(scene.box.size) == box, case.name
         assert scene.contact.restitution == flow.e
@@ -979,3 +981,29 @@ def test_the_tc_twin_row_and_its_evidence():
     assert row.verdict == NOT_REPRODUCED and "u_x centre 14.00 ± 0.10 (+40.0 %)" in row.measured
     (row,) = tc_twin_rows(data, [], [twin_flow])
     assert row.verdict == NOT_RUN and twin_flow.name in row.reason
+
+
+def test_the_validation_box_is_figure_2_11s_system(tiny_run):
+    """§3.5's validation box: N = 1000 in a cube at φ = 0.01 (37.4 d, 25 bins of W/25), its
+    own case; its rows lead with it and name Ch. 3's 2744-particle flow beside it, resting on
+    the box's run."""
+    from demstudy.studies.malik2008.poiseuille_cases import VALIDATION
+    from demstudy.studies.malik2008.poiseuille_checks import REF, validation_checks
+    from demstudy.studies.malik2008.poiseuille_data import load_flow
+
+    scene = case_of(VALIDATION).load()
+    assert scene.n_particles == 1000 and scene.solid_fraction == pytest.approx(0.01)
+    assert scene.box.size[0] == pytest.approx(37.41, abs=0.01)
+    assert scene.box.size[1] / scene.measure.bin_width == pytest.approx(25)
+    assert VALIDATION.name == "poiseuille-phi0.01-b0.99-e0.8-n1000-edmd"
+    assert VALIDATION.name in {c.name for c in cases(False)}
+    flow, path, _out = tiny_run
+    main = load_flow(flow, path, with_gr=False)
+    box = load_flow(VALIDATION, path, with_gr=False)  # the same file stands in for the box
+    rows = validation_checks({REF: main}, box)
+    assert len(rows) == 5 and all(r.runs == (VALIDATION.name,) for r in rows)
+    assert all(r.measured.startswith("N = 1000 in 37.4³ (Fig 2.11's system): ")
+               for r in rows)
+    assert all("; Ch. 3's N = 2744 in 50³: " in r.measured for r in rows)
+    plain = validation_checks({REF: main})
+    assert all(r.runs == (flow.name,) and "N = 1000" not in r.measured for r in plain)

@@ -10,7 +10,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts): speeds in √(
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +26,7 @@ from .poiseuille_cases import (
     RESTITUTIONS,
     SOFT_FLOWS,
     TC_TWINS,
+    VALIDATION,
     Flow,
     cases,
     flows,
@@ -80,8 +81,9 @@ def _drifting(data: Mapping) -> str:
 
 
 def _known_flows(quick: bool) -> dict[str, Flow]:
-    """The event-driven flows of the (quick) study by case name, the TC twins included."""
-    return {f.name: f for f in (QUICK if quick else (*flows(), *TC_TWINS))}
+    """The event-driven flows of the (quick) study by case name, the TC twins and the
+    validation box included."""
+    return {f.name: f for f in (QUICK if quick else (*flows(), *TC_TWINS, VALIDATION))}
 
 
 def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
@@ -92,16 +94,18 @@ def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
     for name, path in runs.items():
         flow = known.get(name)
         if (flow is not None and flow.engine == "edmd" and flow.tc is None
-                and Path(path).is_file()):
+                and flow.n is None and Path(path).is_file()):
             out[(flow.phi, flow.beta, flow.e)] = load_flow(flow, Path(path))
     return out
 
 
-def load_twins(runs: Mapping[str, Path], quick: bool) -> list[FlowData]:
-    """The TC twins present in ``runs`` (full study), read."""
+def load_twins(runs: Mapping[str, Path], quick: bool,
+               which: tuple[Flow, ...] = TC_TWINS) -> list[FlowData]:
+    """The runs of ``which`` (the TC twins, or the validation box) present in ``runs`` (full
+    study), read."""
     if quick:
         return []
-    return [load_flow(f, Path(runs[f.name])) for f in TC_TWINS
+    return [load_flow(f, Path(runs[f.name])) for f in which
             if f.name in runs and Path(runs[f.name]).is_file()]
 
 
@@ -146,7 +150,9 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     ``runs`` give "not run" checks)."""
     data = load_runs(runs, quick)
     twins = load_twins(runs, quick)
-    checks = [c for check in CHECKS for c in check(data)]
+    box = next(iter(load_twins(runs, quick, (VALIDATION,))), None)
+    checks = [c for check in CHECKS for c in
+              (check(data, box) if check is pc.validation_checks else check(data))]
     pc.tc_caveats(checks, data, pc.tc_twin_evidence(data, twins))
     pc.common_motion_caveats(checks, data)
     if not quick:
@@ -156,7 +162,18 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
         if c.verdict == NOT_RUN and not c.reason:
             c.reason = "its runs are not in this run of the study"
     figures = make_figures(data, Path(out), quick)
-    return Analysis(checks, figures, sections(data, runs, quick))
+    if box is not None:
+        shown = [box, *([data[pc.REF]] if pc.REF in data else [])]
+        path = profiles_figure(shown, ["N = 1000 in 37.4³ (Fig 2.11's system)",
+                                       "N = 2744 in 50³ (Ch. 3)"][: len(shown)],
+                               "Malik Fig 2.11: the validation flow, φ = 0.01, β = 0.99, "
+                               "e = 0.8", Path(out) / "poiseuille-validation.png",
+                               across=True)
+        figures.insert(0, Figure(path, "Fig 2.11's form: U_x*, ω_z*, φ, T*, θ* and Kn "
+                                       "against y/W for the validation box (N = 1000) beside "
+                                       "Ch. 3's N = 2744 flow at the same φ, β, e."))
+    return Analysis(checks, figures, sections(data, runs, quick,
+                                              [*twins, *([box] if box else [])]))
 
 
 def _label(d: FlowData) -> str:
@@ -283,8 +300,10 @@ def _over_e(ds: list[FlowData], name: str, phi: float, b: float,
     ]
 
 
-def sections(data: Runs, runs: Mapping[str, Path], quick: bool) -> list[tuple[str, str]]:
-    """The report's text: what ran, for how long against the thesis, what did not run."""
+def sections(data: Runs, runs: Mapping[str, Path], quick: bool,
+             extra: Sequence[FlowData] = ()) -> list[tuple[str, str]]:
+    """The report's text: what ran (the flows, then ``extra``: the TC twins and the
+    validation box), for how long against the thesis, what did not run."""
     known = [*_known_flows(quick), *([] if quick else [f.name for f in SOFT_FLOWS])]
     made = sorted(n for n in known if n in runs)
     missing = sorted(n for n in known if n not in runs)
@@ -307,8 +326,7 @@ def sections(data: Runs, runs: Mapping[str, Path], quick: bool) -> list[tuple[st
              "| run | steady (plateau) | averaged over (√(d/g)) | collisions/particle "
              "averaged | Kn from t = (√(d/g)) | TC-elastic share | CPU s |",
              "|---|---|---|---|---|---|---|"]
-    for key in sorted(data):
-        d = data[key]
+    for d in [data[key] for key in sorted(data)] + list(extra):
         info = d.run_info()
         fp = d.res.group_attrs.get("statistics/freepath", {})
         window = f"{fp.get('window_start', float('nan')):.0f}-" \

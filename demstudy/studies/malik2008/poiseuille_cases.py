@@ -14,6 +14,7 @@ collision times apart are nearly independent, which the block errors need anyway
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -58,11 +59,21 @@ class Flow:
     engine: str = "edmd"
     #: the event-driven engine's TC time when not the default (a TC twin, :data:`TC_TWINS`)
     tc: float | None = None
+    #: N in a cube of solid fraction φ when not the thesis's system (:data:`VALIDATION`)
+    n: int | None = None
 
     @property
     def name(self) -> str:
         twin = "" if self.tc is None else f"-tc{self.tc:g}"
-        return f"poiseuille-phi{self.phi:g}-b{self.beta:g}-e{self.e:g}{twin}-{self.engine}"
+        box = "" if self.n is None else f"-n{self.n}"
+        return (f"poiseuille-phi{self.phi:g}-b{self.beta:g}-e{self.e:g}{box}{twin}-"
+                f"{self.engine}")
+
+    @property
+    def side(self) -> float | None:
+        """The cube's side (d) of an N-particle validation box at exactly φ (digest §1.5:
+        37.4 for N = 1000 at φ = 0.01); None for the thesis's systems."""
+        return None if self.n is None else (self.n * math.pi / 6 / self.phi) ** (1 / 3)
 
 
 def case_of(flow: Flow, quick: bool = False) -> Case:
@@ -77,6 +88,10 @@ def case_of(flow: Flow, quick: bool = False) -> Case:
     if flow.engine != "edmd":  # soft spheres: the collision log (free paths) is edmd's
         sections["measure"]["statistics"] = [s for s in STATISTICS if s != "freepath"]
         sections = merge(sections, SOFT_SECTIONS)
+    if flow.side is not None:  # Malik's 25 bins across the validation box's W
+        sections["box"] = {"size": [flow.side] * 3}
+        sections["particles"] = {"count": flow.n}
+        sections["measure"]["bin_width"] = flow.side / 25
     quick_sections = {"run": QUICK_RUN[flow.phi]} if quick else {}
     options = {} if flow.tc is None else {"tc": flow.tc}
     return Case(flow.name, SCENES[flow.phi], engine=flow.engine, sections=sections,
@@ -111,6 +126,9 @@ QUICK = (Flow(0.01, 0.8, 0.99), Flow(0.01, 0.8, -0.99), Flow(0.5, *DENSE))
 #: elastic at the default t_c = 1e-5 √(d/g); the same flow at t_c = 1e-6 says whether its
 #: rows depend on the TC model (the "TC model" row, :func:`poiseuille_checks.tc_twin_row`)
 TC_TWINS = (Flow(0.5, *DENSE, tc=1e-6),)
+#: the code validation of §3.5 (Fig 2.11): N = 1000 at φ = 0.01 in a cube (37.4 d), e = 0.8,
+#: β = 0.99 (the thesis's system for Ch. 3 is 2744 in 50³: REF in poiseuille_checks)
+VALIDATION = Flow(0.01, 0.8, 0.99, n=1000)
 
 
 def cases(quick: bool) -> list[Case]:
@@ -119,4 +137,4 @@ def cases(quick: bool) -> list[Case]:
     if quick:
         return [case_of(f, quick=True) for f in QUICK]
     return ([case_of(f, quick=f in QUICK) for f in flows()] + [case_of(f) for f in SOFT_FLOWS]
-            + [case_of(f) for f in TC_TWINS])
+            + [case_of(f) for f in (*TC_TWINS, VALIDATION)])

@@ -214,8 +214,13 @@ def steady_checks(data: Runs) -> list[Check]:
 
 
 # ------------------------------------------------------------------ §3.5 validation
-def validation_checks(data: Runs) -> list[Check]:
-    d = data.get(REF)
+def validation_checks(data: Runs, box: FlowData | None = None) -> list[Check]:
+    """§3.5's qualitative results of the code validation (Fig 2.11): on the validation box
+    ``box`` (N = 1000 in a 37.4 d cube, the figure's system) when it ran, else on Ch. 3's
+    2744 in 50³ at the same φ, β, e (REF); the other φ = 0.01 runs say whether each holds
+    beyond this one flow."""
+    main = data.get(REF)
+    d = box if box is not None else main
     items = (("slip", "considerable wall slip", _slip),
              ("gradient", "larger velocity gradient near the walls", _gradient),
              ("spin", "ω_z < 0 in the lower half and > 0 in the upper half", _spin_sign),
@@ -230,12 +235,17 @@ def validation_checks(data: Runs) -> list[Check]:
             out.append(not_run(ref, full, statement, "the φ = 0.01, β = 0.99, e = 0.8 run"))
             continue
         measured, verdict, reason = fn(d)
+        if box is not None:
+            measured = f"N = 1000 in {box.flow.side:.1f}³ (Fig 2.11's system): " + measured
         others = [x for (p, _b, _e), x in data.items() if p == 0.01 and x is not d]
         if others:
             holds = sum(fn(x)[1] == REPRODUCED for x in others)
-            measured += f"; holds in {holds} of {len(others)} other φ = 0.01 runs"
+            ch3 = ("" if box is None or main is None else
+                   f"; Ch. 3's N = 2744 in 50³: {'holds' if fn(main)[1] == REPRODUCED else 'not'}")
+            measured += (f"{ch3}; holds in {holds} of {len(others)} "
+                         f"{'' if box is not None else 'other '}φ = 0.01 runs of Ch. 3")
         out.append(Check(ref, full, statement, measured, _cap(verdict, d),
-                         reason + _steady_note(d)))
+                         reason + _steady_note(d), runs=(d.flow.name,)))
     return out
 
 
@@ -254,10 +264,11 @@ def _gradient(d: FlowData) -> tuple[str, str, str]:
     u, e = d.series("ux")
     dy = float(d.y[1] - d.y[0])
     gw, ew = wall_gradient(u, e, d.y)
-    gi = 0.5 * ((u[6] - u[5]) + (u[-7] - u[-6])) / dy  # bins 6-7 and 19-20: y ≈ 12 and 38
+    gi = 0.5 * ((u[6] - u[5]) + (u[-7] - u[-6])) / dy  # bins 6-7 and 19-20: y ≈ W/4, 3W/4
     ei = 0.5 * math.sqrt(e[5] ** 2 + e[6] ** 2 + e[-6] ** 2 + e[-7] ** 2) / dy
     ok = gw - gi > 2 * math.hypot(ew, ei)
-    return (f"dU_x*/dy at the walls (bins 1-2) {pm(gw, ew)}, at y ≈ 12 (bins 6-7) "
+    y_in = 0.5 * float(d.y[5] + d.y[6])
+    return (f"dU_x*/dy at the walls (bins 1-2) {pm(gw, ew)}, at y ≈ {y_in:.0f} (bins 6-7) "
             f"{pm(gi, ei)} (per d)", REPRODUCED if ok else NOT_REPRODUCED,
             "" if ok else "the wall gradient is not larger beyond 2σ")
 

@@ -41,18 +41,24 @@ def _legend(labels: Sequence[str], colours: Sequence, styles: Sequence[str] | No
 
 
 def profiles_figure(datas: Sequence[FlowData], labels: Sequence[str], title: str,
-                    out: Path) -> Path:
-    """Six panels against y (Malik's Figs 3.3, 4.2): φ, U_x*, ω_z*, T*, θ*, Kn."""
+                    out: Path, across: bool = False) -> Path:
+    """Six panels against y (Malik's Figs 3.3, 4.2): φ, U_x*, ω_z*, T*, θ*, Kn; ``across``:
+    against y/W, for channels of different widths W side by side."""
     fig, axes = new_figure(2, 3, width=3.6, height=2.9)
     colours = [run_colour(i) for i in range(len(datas))]
     for ax, (key, name) in zip(axes.flat, PROFILE_PANELS, strict=True):
         for i, d in enumerate(datas):
             v, e = d.series(key)
-            ax.errorbar(d.y, v, yerr=e, color=colours[i], marker=MARKERS[i % len(MARKERS)],
-                        ms=3, lw=1, capsize=2)
-        ax.set_xlabel("y/d (wall-normal; walls at 0 and 50)")
+            width = float(d.res.scene.box.size[1]) if across else 1.0
+            ax.errorbar(d.y / width, v, yerr=e, color=colours[i],
+                        marker=MARKERS[i % len(MARKERS)], ms=3, lw=1, capsize=2)
+        if across:
+            ax.set_xlabel("y/W (wall-normal; walls at 0 and 1)")
+            ax.set_xlim(0, 1)
+        else:
+            ax.set_xlabel("y/d (wall-normal; walls at 0 and 50)")
+            ax.set_xlim(0, 50)
         ax.set_ylabel(name)
-        ax.set_xlim(0, 50)
         if key == "omz":
             ax.axhline(0, color="0.6", lw=0.6)
         if key == "Kn":

@@ -247,56 +247,56 @@ def tc_row(tag: str) -> str:
     return f"TC model, {tag}"
 
 
-def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
-              agreed: Sequence[str] = (), tag: str = "",
-              disagreed: Mapping[str, str] | None = None) -> Check:
-    """``check`` of a run whose pair collisions the engine's TC model made elastic in a large
-    share (> WARN_SHARE; the thesis has no TC model): the share in the reason (the dense
-    clumps dissipate less than e says) and an agreement weakened to "partly" (a mismatch
-    stays "not reproduced", the TC model one possible cause). ``own_twin``: the TC row of
-    this box's own twin at a smaller t_c; when it is "reproduced" (same class and KE, small
-    share) the share is shown not to matter and the verdict is kept. ``agreed`` and
-    ``disagreed``: the tags of other boxes whose twins agreed, and those whose did not
-    (tag → the twin row's verdict: "not reproduced" changed the class, "partly" kept it
-    but its KE/N or share differ), all named in the reason (none decides for this box).
-    ``tag``: this box's tag, naming its twin's row; without it the row is read off the
-    twin's reference."""
-    if not run.tc_fraction > WARN_SHARE:
-        return check
+def tc_evidence(own_twin: Check | None = None, agreed: Sequence[str] = (), tag: str = "",
+                disagreed: Mapping[str, str] | None = None) -> tuple[bool, str]:
+    """What the TC twins say about a box, for the studies' one TC rule
+    (:func:`..base.tc_caveats`): (whether its own twin exempts it, the evidence in words).
+    ``own_twin``: the TC row of this box's own twin at a smaller t_c; "reproduced" (same
+    class and KE within 2σ + 5 %, small share) exempts it, "partly"/"not reproduced" are
+    named. ``agreed`` and ``disagreed``: the tags of other boxes whose twins agreed, and
+    those whose did not (tag → the twin row's verdict), named when the box has no twin of
+    its own (none decides for this box). ``tag``: this box's tag, naming its twin's row;
+    without it the row is read off the twin's reference."""
     if not tag and own_twin is not None:
         tag = own_twin.ref.split(" (")[0].removeprefix(tc_row(""))
-    share = (f"The engine's TC model made {100 * run.tc_fraction:.1f} % of the pair "
-             "collisions elastic (t_c = 10⁻⁵ √(d/g); the thesis has no TC model)")
     row = f"row \"{tc_row(tag)}\""
     if own_twin is not None and own_twin.verdict == REPRODUCED:
-        check.reason = (check.reason + f" {share}, but its twin at t_c = {TC_TWIN_TC:g} "
-                        f"gives the same class and KE/N within 2σ + 5 % with a small share "
-                        f"({row}): the share does not change the structure here.").strip()
-        return check
+        return True, (f"its twin at t_c = {TC_TWIN_TC:g} gives the same class and KE/N "
+                      f"within 2σ + 5 % ({row}): the share does not change the structure "
+                      "here")
     if own_twin is not None and own_twin.verdict in (PARTLY, NOT_REPRODUCED):
         found = ("changes the class, so the structure depends on the engine's TC model"
                  if own_twin.verdict == NOT_REPRODUCED else "keeps the class, but its KE or "
                  "share differ, so an effect of the TC model is not ruled out")
-        check.reason = (check.reason + f" {share}: its twin at t_c = {TC_TWIN_TC:g} {found} "
-                        f"({row}).").strip()
-    else:
-        said = []
-        if agreed:
-            said.append(f"the TC twin{'s' * (len(agreed) > 1)} of {', '.join(agreed)} at "
-                        f"t_c = {TC_TWIN_TC:g} kept {'their' if len(agreed) > 1 else 'its'} "
-                        "class")
-        for verdict, what in ((NOT_REPRODUCED, "changed the class"),
-                              (PARTLY, "kept the class but not the KE/N or a small share")):
-            tags = [t for t, v in (disagreed or {}).items() if v == verdict]
-            if tags:
-                said.append(f"the TC twin{'s' * (len(tags) > 1)} of {', '.join(tags)} "
-                            f"{what}")
-        tested = ("" if not said else
-                  f" ({'; '.join(said)}: rows \"TC model\"; this box's share is not tested)")
-        check.reason = (check.reason + f" {share}: the dense clumps dissipate less than e "
-                        f"says, a weaker test either way{tested}.").strip()
-    if check.verdict == REPRODUCED:
-        check.verdict = PARTLY
+        return False, f"its twin at t_c = {TC_TWIN_TC:g} {found} ({row})"
+    said = []
+    if agreed:
+        said.append(f"the TC twin{'s' * (len(agreed) > 1)} of {', '.join(agreed)} at "
+                    f"t_c = {TC_TWIN_TC:g} kept {'their' if len(agreed) > 1 else 'its'} "
+                    "class")
+    for verdict, what in ((NOT_REPRODUCED, "changed the class"),
+                          (PARTLY, "kept the class but not the KE/N or a small share")):
+        tags = [t for t, v in (disagreed or {}).items() if v == verdict]
+        if tags:
+            said.append(f"the TC twin{'s' * (len(tags) > 1)} of {', '.join(tags)} {what}")
+    return False, ("" if not said else
+                   f"{'; '.join(said)}: rows \"TC model\"; this box's share is not tested")
+
+
+def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
+              agreed: Sequence[str] = (), tag: str = "",
+              disagreed: Mapping[str, str] | None = None) -> Check:
+    """``check`` of a box run under the studies' one TC rule (:func:`..base.tc_caveats`):
+    above WARN_SHARE the share in the reason and an agreement "partly" (a mismatch stays,
+    the TC model one possible cause) unless the box's own twin exempts it; the twins'
+    evidence (:func:`tc_evidence`) quoted."""
+    from ..base import tc_caveats as rule
+
+    name = tag or "this box"
+    exempt, text = tc_evidence(own_twin, agreed, tag, disagreed)
+    check.runs = (name,)
+    rule([check], {name: (run.tc_fraction, DEFAULT_TC)}, {name: text} if exempt else {},
+         {name: text} if text and not exempt else {})
     return check
 
 
