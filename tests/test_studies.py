@@ -564,14 +564,23 @@ def test_a_twin_with_a_large_share_is_quoted_but_exempts_nothing():
 
 
 def test_twin_comparison_allows_two_sigma_and_the_tolerance():
-    from demstudy.studies.base import TWIN_TOLERANCE, twin_comparison
+    from demstudy.studies.base import TWIN_TOLERANCE, twin_comparison, twin_evidence
 
     base = {"a": (1.0, 0.01), "b": (2.0, 0.0), "skip": (float("nan"), 0.0)}
     labels = {"a": "A", "b": "B", "skip": "S", "absent": "X"}
-    same, text = twin_comparison(base, {"a": (1.0 + TWIN_TOLERANCE, 0.01), "b": (2.0, 0.0),
-                                        "skip": (1.0, 0.0)}, labels)
+    same, text, off = twin_comparison(base, {"a": (1.0 + TWIN_TOLERANCE, 0.01),
+                                             "b": (2.0, 0.0), "skip": (1.0, 0.0)}, labels)
     # 2σ of √2 · 0.01 plus 10 % of 1: a 10 % change passes; NaN and absent keys are left out
-    assert same and text == "A 1.100 ± 0.010 (+10.0 %), B 2 (+0.0 %)" and "S " not in text
-    assert not twin_comparison(base, {"a": (1.0 + TWIN_TOLERANCE + 0.03, 0.01),
-                                      "b": (2.0, 0.0)}, labels)[0]
+    assert same and text == "A 1.100 ± 0.010 (+10.0 %), B 2 (+0.0 %)" and off == []
+    same, _text, off = twin_comparison(base, {"a": (1.0 + TWIN_TOLERANCE + 0.03, 0.01),
+                                              "b": (2.0, 0.0)}, labels)
+    assert not same and off == ["A +13 %"]
     assert not twin_comparison(base, {"c": (1.0, 0.0)}, labels)[0]  # nothing in common
+    # the evidence: a small share exempts; a large one, or other values, is only told
+    pairs = [("r1", base, base, 0.02, 1e-6), ("r2", base, base, 0.07, 1e-6),
+             ("r3", base, {"a": (2.0, 0.01), "b": (2.0, 0.0)}, 0.02, 1e-6)]
+    unchanged, told = twin_evidence(pairs, labels)
+    assert list(unchanged) == ["r1"] and "the twin of r1 at t_c = 1e-06 (2.0 % elastic) " \
+        "gives the same values within 2σ + 10 %" == unchanged["r1"]
+    assert "the twin's own share is large too" in told["r2"]
+    assert told["r3"].endswith("gives other values (A +100 %)")

@@ -216,7 +216,9 @@ def _with_angles(run, approach: float):
 
     return dataclasses.replace(run, angles={"theta": theta, "p": p, "p_err": err,
                                             "collisions": 1e4,
-                                            "approach": approach_share(p, err, theta)})
+                                            "approach": approach_share(p, err, theta),
+                                            "window": (50.0, 99.0, 50.0, 400.0),
+                                            "halves": (approach, approach)})
 
 
 def test_the_chutes_collision_angles_row_wants_the_approach_quadrant(accelerating):
@@ -229,7 +231,8 @@ def test_the_chutes_collision_angles_row_wants_the_approach_quadrant(acceleratin
     assert c9_angles({"chute-40-flat": run}).verdict == NOT_RUN
     row = c9_angles({"chute-40-flat": _with_angles(run, 0.75)})
     assert row.verdict == REPRODUCED and "share in 90°-180° 0.750" in row.measured
-    assert "P(θ) largest at θ ≈ 92°" in row.measured
+    assert "logged over t = 50-99 of the production 50-400" in row.measured
+    assert "only of its logged start" in row.reason
     assert c9_angles({"chute-40-flat": _with_angles(run, 0.5)}).verdict == NOT_REPRODUCED
 
 
@@ -247,6 +250,10 @@ def test_the_angle_distribution_is_read_from_a_run_with_a_collision_log(tmp_path
     width = math.pi / a["theta"].size
     assert np.sum(a["p"]) * width == pytest.approx(1.0, rel=1e-6)
     assert 0.0 < a["approach"][0] < 1.0 and a["collisions"] > 100
+    t0, t1, start, end = a["window"]
+    assert start == pytest.approx(2.0) and end == pytest.approx(12.0)
+    assert start <= t0 < t1 <= end  # a short run: the log spans its production
+    assert all(0.0 < h < 1.0 for h in a["halves"])
 
 
 def test_local_bagnold_coefficients_of_a_uniform_shear(accelerating):

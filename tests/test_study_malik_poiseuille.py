@@ -963,7 +963,7 @@ def test_the_tc_twin_row_and_its_evidence():
                   "theta": (0.5, 0.05)}
         return SimpleNamespace(
             flow=flow, centre_value=values.__getitem__, wall_value=values.__getitem__,
-            mean_temperature=lambda: (1.0, 0.05),
+            mean_temperature=lambda: (1.0, 0.05), stat=lambda name: {}, gr={},
             run_info=lambda: {"tc_fraction": share, "tc": tc, "steady": True, "trend": 0.0})
 
     base_flow, twin_flow = Flow(0.5, 0.9, 0.9), Flow(0.5, 0.9, 0.9, tc=1e-6)
@@ -971,7 +971,7 @@ def test_the_tc_twin_row_and_its_evidence():
     small = [run(twin_flow, 0.02, 1e-6)]
     unchanged, told = tc_twin_evidence(data, small)
     assert base_flow.name in unchanged and not told
-    assert "1e-06 √(d/g) (2.0 % elastic) gives the same values" in unchanged[base_flow.name]
+    assert "at t_c = 1e-06 (2.0 % elastic) gives the same values" in unchanged[base_flow.name]
     (row,) = tc_twin_rows(data, small, [twin_flow])
     assert row.verdict == REPRODUCED and row.own and "TC share 16.0 %" in row.measured
     (row,) = tc_twin_rows(data, [run(twin_flow, 0.15, 1e-6)], [twin_flow])
@@ -979,8 +979,12 @@ def test_the_tc_twin_row_and_its_evidence():
     assert tc_twin_evidence(data, [run(twin_flow, 0.15, 1e-6)])[0] == {}
     (row,) = tc_twin_rows(data, [run(twin_flow, 0.02, 1e-6, u=14.0)], [twin_flow])
     assert row.verdict == NOT_REPRODUCED and "u_x centre 14.00 ± 0.10 (+40.0 %)" in row.measured
-    (row,) = tc_twin_rows(data, [], [twin_flow])
+    (row,) = tc_twin_rows(data, [], [twin_flow])  # the twin missing, its flow there
     assert row.verdict == NOT_RUN and twin_flow.name in row.reason
+    assert base_flow.name not in row.reason
+    (row,) = tc_twin_rows({}, small, [twin_flow])  # the flow missing, its twin there
+    assert row.verdict == NOT_RUN and base_flow.name in row.reason
+    assert twin_flow.name not in row.reason
 
 
 def test_the_validation_box_is_figure_2_11s_system(tiny_run):

@@ -157,12 +157,13 @@ TWIN_TOLERANCE = 0.10
 
 def twin_comparison(base: Mapping[str, tuple[float, float]],
                     twin: Mapping[str, tuple[float, float]],
-                    labels: Mapping[str, str]) -> tuple[bool, str]:
+                    labels: Mapping[str, str]) -> tuple[bool, str, list[str]]:
     """Whether ``twin`` gives ``base``'s values (key → (value, error)) for every key of
     ``labels`` (key → the name to print) within 2σ of the combined errors plus
-    :data:`TWIN_TOLERANCE`, and the comparison as text, e.g. ``"S 1.121 ± 0.041 (-2.9 %)"``;
-    keys missing from either side are left out (none in common: not the same)."""
-    same, parts = True, []
+    :data:`TWIN_TOLERANCE`, the comparison as text (e.g. ``"S 1.121 ± 0.041 (-2.9 %)"``) and
+    the values that differ (e.g. ``"T +74 %"``); keys missing from either side are left out
+    (none in common: not the same)."""
+    parts, off = [], []
     for key, label in labels.items():
         if key not in base or key not in twin:
             continue
@@ -170,10 +171,33 @@ def twin_comparison(base: Mapping[str, tuple[float, float]],
         if not all(map(math.isfinite, (x, y))):
             continue
         err = math.hypot(xe, ye) if math.isfinite(xe) and math.isfinite(ye) else 0.0
-        same &= within(y, err, x, 2.0, TWIN_TOLERANCE * abs(x))
         change = f" ({100 * (y - x) / x:+.1f} %)" if x else ""
         parts.append(f"{label} {pm(y, ye)}{change}")
-    return same and bool(parts), ", ".join(parts)
+        if not within(y, err, x, 2.0, TWIN_TOLERANCE * abs(x)):
+            off.append(f"{label} {100 * (y - x) / x:+.0f} %" if x else label)
+    return bool(parts) and not off, ", ".join(parts), off
+
+
+def twin_evidence(pairs: Sequence[tuple[str, Mapping, Mapping, float, float]],
+                  labels: Mapping[str, str]) -> tuple[dict[str, str], dict[str, str]]:
+    """What TC twins say, for :func:`tc_caveats`: ``pairs`` of (run name, its values, its
+    twin's values, the twin's TC-elastic share and t_c) give (runs a twin with a share below
+    the warning level reproduces → the evidence, runs whose twin differs or has a large share
+    itself → what it found), each compared by :func:`twin_comparison` on ``labels``."""
+    from ..engines.edmd.tc_share import WARN_SHARE
+
+    unchanged, told = {}, {}
+    for name, base, twin, share, tc in pairs:
+        same, _text, off = twin_comparison(base, twin, labels)
+        found = (f"the twin of {name} at t_c = {tc:g} ({100 * share:.1f} % elastic) gives "
+                 + ("the same values within 2σ + 10 %" if same else
+                    "other values (" + ", ".join(off) + ")"))
+        if same and share < WARN_SHARE:
+            unchanged[name] = found
+        else:
+            told[name] = found + ("; the twin's own share is large too, so no run free of "
+                                  "the model exists" if same else "")
+    return unchanged, told
 
 
 def not_run(ref: str, statement: str, thesis: str, needs: str | Sequence[str],

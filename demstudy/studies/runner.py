@@ -330,7 +330,8 @@ CALIBRATED_NOTE = ("  (about: a lower bound × what a made run of its kind took 
 #: under the list of runs when a lower bound was calibrated by a run at another t_c
 OTHER_TC_NOTE = ("  (made at another t_c: no made run of its kind has its t_c; a TC twin at "
                  "t_c = 1e-6 took ×1.0–2.1 the time of its run at 1e-5 in Malik's wave study, "
-                 "so expect more)")
+                 "so a run at a smaller t_c than its guide's may take longer, at a larger one "
+                 "less)")
 #: under the list of runs when some forecast is a lower bound (the total then is one too)
 LOWER_BOUND_NOTE = ("  (probably more: a flow that gravity accelerates outruns its pilot; "
                     "such forecasts met ×0.7–2.3 of the actual time in the forecast "

@@ -27,7 +27,9 @@ from .chute_measure import ChuteRun, basal_layer, centre_plug
 
 NU_SQUARE = math.pi / 4
 #: "little effect", "insignificant changes": a difference within 2σ + 10 % (of the reference)
-SAME = TWIN_TOLERANCE  # 2σ + 10 %: the one twin tolerance of the studies (studies.base)
+#: how far two runs of the 40-disc flow may differ and count as the same flow (2σ + 10 %,
+#: the C6, width and t_c rows), the same as the studies' TC-twin tolerance
+SAME = TWIN_TOLERANCE
 #: wall slip: Campbell's initial-profile fit gives F(0) = 0.20; its own precision (a fit to a
 #: profile the thesis does not show) taken as ±0.05
 SLIP_THESIS, SLIP_TOL = 0.20, 0.05
@@ -354,15 +356,20 @@ def c9_angles(runs: Mapping[str, ChuteRun]) -> Check:
     for name in have:
         a = runs[name].angles
         share, err = a["approach"]
-        peak = math.degrees(float(a["theta"][int(np.argmax(a["p"]))]))
-        parts.append(f"{name}: share in 90°-180° {pm(share, err)}, P(θ) largest at "
-                     f"θ ≈ {peak:.0f}° ({a['collisions']:.3g} pair collisions)")
+        t0, t1, start, end = a["window"]
+        first, second = a["halves"]
+        parts.append(f"{name}: share in 90°-180° {pm(share, err)} ({a['collisions']:.3g} "
+                     f"pair collisions logged over t = {t0:.0f}-{t1:.0f} of the production "
+                     f"{start:.0f}-{end:.0f} √(d/g); halves of that window {first:.3f}, "
+                     f"{second:.3f})")
         if name.startswith("chute-40"):
             ok.append(share - 0.5 > 2 * err)
     verdict = REPRODUCED if all(ok) else PARTLY if any(ok) else NOT_REPRODUCED
     reason = ("criterion: share − ½ beyond 2σ (isotropic collisions give ½); the 40° beds "
               "accelerate (row C3), so this is the distribution of a transient, as the "
-              "thesis's own 40° bed was; the steady 30° bumpy bed beside it")
+              "thesis's own 40° bed was, and only of its logged start (the engine keeps the "
+              "production's first 2·10⁵ collisions, the base's included); the steady 30° "
+              "bumpy bed beside it")
     return Check(ref, statement, thesis, "; ".join(parts), verdict, reason)
 
 

@@ -251,8 +251,9 @@ def angles_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
         ax.errorbar(deg, a["p"], yerr=2 * a["p_err"], fmt=".", ms=4, color=colours[r.name],
                     elinewidth=0.8, zorder=2)
         share, err = a["approach"]
-        ax.set_title(f"{r.name} ({r.angle:g}°, {r.base} base)\nshare in 90°-180°: "
-                     f"{share:.3f} ± {err:.3f}", fontsize=9)
+        t0, t1 = a["window"][:2]
+        ax.set_title(f"{r.name} ({r.angle:g}°, {r.base} base)\nt = {t0:.0f}-{t1:.0f} √(d/g); "
+                     f"share in 90°-180°: {share:.3f} ± {err:.3f}", fontsize=9)
         ax.set(xlabel="θ from the flow direction [deg]", xlim=(0, 180),
                xticks=[0, 45, 90, 135, 180])
     axes[0][0].set_ylabel("P(θ) per radian, ±2σ")
@@ -260,8 +261,9 @@ def angles_figure(runs: Sequence[ChuteRun], path: Path) -> Path | None:
     axes[0][0].set_ylim(0, 1.12 * top)
     fig.suptitle("Collision angles in the chute, Campbell Fig 3.33 (shaded: the approach "
                  "quadrant; dotted: isotropic 1/π)", fontsize=10)
-    return _finish(fig, path, "Here the bars are ±2σ. Every pair collision of the "
-                   "production; the 40° beds accelerate (a transient's distribution).")
+    return _finish(fig, path, "Here the bars are ±2σ. The pair collisions of the logged "
+                   "window (the production's first 2·10⁵ collisions, the base's included); "
+                   "the 40° beds accelerate (a transient's distribution).")
 
 
 def flat_scan_figure(flat: Sequence[ChuteRun], bumpy: ChuteRun | None, path: Path) -> Path | None:

@@ -50,6 +50,14 @@ SURFACE_NU = 0.05
 BAND = 0.2
 
 
+def no_trend(trend: float, err: float) -> bool:
+    """Campbell's "no trend" made quantitative, for every history of the study: the fitted
+    change over the production is below the criterion's 20 % (BAND) of the mean, or its
+    excess over 20 % is within 2σ."""
+    return is_steady(trend) or bool(np.isfinite(trend) and np.isfinite(err)
+                                    and abs(trend) - 2 * err < BAND)
+
+
 def trend_error(t: np.ndarray, energy: np.ndarray, blocks: int = 8) -> float:
     """Standard error of ``energy_trend`` from ``blocks`` block means (taken as independent:
     blocks of 200 √(d/g) are longer than the energy's correlation time) about their line."""
@@ -127,8 +135,7 @@ class ChuteRun:
     @property
     def converged(self) -> bool:
         """Campbell's criterion: no trend (|fitted change| < 20 % of the mean) within 2σ."""
-        return is_steady(self.trend) or bool(
-            np.isfinite(self.trend_err) and abs(self.trend) - 2 * self.trend_err < 0.2)
+        return no_trend(self.trend, self.trend_err)
 
     @property
     def balanced(self) -> bool:
@@ -196,13 +203,15 @@ def _stress(res: Any, prof: dict[str, np.ndarray], g: np.ndarray) -> dict[str, A
 
 
 def collision_angles(res: Any) -> dict[str, Any]:
-    """Campbell's collision-angle distribution (Fig 3.33): P(θ) of every pair collision of the
-    production (θ, the text's convention: the line of centres from the flow direction,
+    """Campbell's collision-angle distribution (Fig 3.33): P(θ) of the logged pair collisions
+    of the production (θ, the text's convention: the line of centres from the flow direction,
     0-180°; his code counted every particle collision, digest §3.8), pooled over the strips
-    by their collision counts, its block error, and the share in the approach quadrant
-    90°-180° (where du/dy > 0 brings particles together). Empty when the run kept no
-    collision log (``measure.statistics`` without ``angles``)."""
-    from .couette_measure import approach_share
+    by their collision counts, its block error, the share in the approach quadrant 90°-180°
+    (where du/dy > 0 brings particles together), the logged ``window`` (:func:`log_window`:
+    the log holds the production's first 2·10⁵ collisions, walls included) and the share in
+    its two ``halves``. Empty when the run kept no collision log (``measure.statistics``
+    without ``angles``)."""
+    from .couette_measure import approach_share, log_window
 
     ang = res.groups.get("statistics/angles")
     if ang is None or "p_text" not in ang:
@@ -216,7 +225,24 @@ def collision_angles(res: Any) -> dict[str, Any]:
     out = {"theta": theta, "p": pairs @ p / pairs.sum(),
            "p_err": np.sqrt((pairs**2) @ pe**2) / pairs.sum(), "collisions": float(pairs.sum())}
     out["approach"] = approach_share(out["p"], out["p_err"], theta)
+    out["window"] = log_window(res.groups["collisions"]["time"], res)
+    out["halves"] = _approach_halves(res.groups["collisions"], out["window"][2])
     return out
+
+
+def _approach_halves(log: dict, start: float) -> tuple[float, float]:
+    """The share of the production's logged pair collisions in the approach quadrant
+    (θ = atan2(n_y, n_x) mod π in 90°-180°) in the first and the second half of the logged
+    window: a drifting share marks a transient."""
+    t = np.asarray(log["time"], float)
+    pair = (np.asarray(log["kind"]) == 0) & (t >= start)
+    n = np.asarray(log["normal"], float)[pair]
+    t = t[pair]
+    if t.size < 2:
+        return math.nan, math.nan
+    theta = np.mod(np.arctan2(n[:, 1], n[:, 0]), math.pi)
+    mid = 0.5 * (t.min() + t.max())
+    return tuple(float(np.mean(theta[sel] > math.pi / 2)) for sel in (t <= mid, t > mid))
 
 
 def summarise(name: str, path: str | Path) -> ChuteRun:

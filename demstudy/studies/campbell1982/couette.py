@@ -19,7 +19,9 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from ..base import Analysis, Case, pm, tc_caveats, twin_comparison
+import numpy as np
+
+from ..base import Analysis, Case, pm, tc_caveats, twin_evidence
 from . import couette_checks as ck
 from . import couette_figures as figs
 from .couette_cases import FIXED_NU, SERVO_FACTORS, SHEAR_RATES, all_cases, nu_tag
@@ -44,9 +46,11 @@ CAUSE_ROUGH = ["couette-cause-rough-nu55", "couette-cause-rough-nu75"]
 TC_TWINS = {"couette-fixed-nu65": "couette-cause-tc1e-06-nu65",
             "couette-fixed-nu75": "couette-cause-tc1e-06-nu75",
             K1[1]: "couette-cause-tc1e-06-rough-servo-s1"}
-#: what a twin must reproduce (values key → name in the report)
-TWIN_VALUES = {"nu": "ν", "S_text": "S", "f_s": "f_s", "f_N": "f_N", "T_mean": "T(H/U_T)²",
-               "rot_share": "rotational share", "approach_share": "approach share",
+#: what a twin must reproduce (values key → name in the report): an agreeing twin exempts
+#: every row resting on its cell, so the comparison spans the kinds of quantity they use
+TWIN_VALUES = {"nu": "ν", "S_text": "S", "f_s": "f_s", "f_N": "f_N", "chi": "χ",
+               "T_mean": "T(H/U_T)²", "rot_share": "rotational share",
+               "kurtosis_u": "kurtosis of u", "approach_share": "approach share",
                "layering": "layering"}
 
 
@@ -55,29 +59,14 @@ def _tc_share(r: RunSummary) -> tuple[float, float]:
 
 
 def tc_twins(s: Mapping[str, RunSummary]) -> tuple[dict[str, str], dict[str, str]]:
-    """What the TC twins say about their cells, for :func:`..base.tc_caveats`: (cells a twin
-    with a share below the warning level reproduces → the evidence, cells whose twin has a
-    large share itself → what it found). A smaller t_c need not lower the share: in these
-    dense cells 6.0 % at 1e-5 became 6.6 % at 1e-6 (the elastic collisions are re-collisions
-    within clusters, which come closer in time as t_c falls), so a twin can show the results
-    converged in t_c without being a reference free of the model."""
-    from ...engines.edmd.tc_share import WARN_SHARE
-
-    unchanged, told = {}, {}
-    for base, twin in TC_TWINS.items():
-        if base not in s or twin not in s:
-            continue
-        same, text = twin_comparison(s[base].values, s[twin].values, TWIN_VALUES)
-        share, tc = _tc_share(s[twin])
-        found = (f"the twin of {base} at t_c = {tc:g} ({100 * share:.1f} % elastic) gives "
-                 + ("the same values within 2σ + 10 %" if same else "other values")
-                 + f": {text}")
-        if same and share < WARN_SHARE:
-            unchanged[base] = found
-        else:
-            told[base] = found + ("; the twin's own share is large too, so no run free of "
-                                  "the model exists" if share >= WARN_SHARE else "")
-    return unchanged, told
+    """What the TC twins say about their cells, for :func:`..base.tc_caveats`
+    (:func:`..base.twin_evidence`; their values side by side: the causes section). A smaller
+    t_c need not lower the share: the ν = 0.65 cell makes 6.0 % elastic at 1e-5 and 6.6 % at
+    1e-6 (re-collisions within clusters, which come closer in time as t_c falls), so a twin
+    can show the results converged in t_c without being a reference free of the model."""
+    return twin_evidence([(base, s[base].values, s[twin].values, *_tc_share(s[twin]))
+                          for base, twin in TC_TWINS.items() if base in s and twin in s],
+                         TWIN_VALUES)
 
 
 #: the chute runs this part reads: Figs 3.21-3.24 put the steady chute's strips on f(ν)
@@ -222,7 +211,9 @@ def figures(s: dict[str, RunSummary], out: Path, chute: Mapping[str, dict] | Non
     groups = {k: v for k, v in groups.items() if v}
     if groups:
         made.append(figs.s_of_nu(groups, out))
-        made.append(figs.bagnold(groups, out, chute or {}))
+        fixed_cells = [s[n] for n in FIXED if n in s and s[n].v("nu") < ck.LAYERED_NU]
+        made.append(figs.bagnold(groups, out, chute or {},
+                                 max((r.v("nu") for r in fixed_cells), default=np.inf)))
     part = [(n, s[name]) for n, name in zip(PARTITION_NU, PARTITION, strict=False) if name in s]
     if len(part) >= 2:
         made.append(figs.partition([r for _, r in part], [n for n, _ in part], out))

@@ -99,16 +99,23 @@ def s_of_nu(points: dict[str, list[RunSummary]], out: Path) -> Figure:
 
 
 def bagnold(points: dict[str, list[RunSummary]], out: Path,
-            chute: dict[str, dict] | None = None) -> Figure:
+            chute: dict[str, dict] | None = None, compared_up_to: float = np.inf) -> Figure:
     """f_s, f_N against ν, log axis (Figs 3.21-3.24), with the chute's strips (``chute``:
-    run name → :func:`.chute_measure.local_bagnold`) as black triangles."""
+    run name → :func:`.chute_measure.local_bagnold`) as black triangles, open beyond
+    ``compared_up_to`` (the cells' ν range the row compares them in)."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 5.6), sharey=True)
     for ax, key in zip(axes, ("f_s", "f_N"), strict=False):
         for name, strips in (chute or {}).items():
             if len(strips.get("nu", ())):
                 val, err = strips[key], 2 * strips[f"{key}_err"]
-                ax.errorbar(strips["nu"], val, yerr=[np.minimum(err, 0.95 * val), err],
-                            fmt="^", color="k", ms=5, label=f"{name}: strips (thesis f)")
+                compared = strips["nu"] <= compared_up_to
+                for sel, fill, what in ((compared, "k", "compared"),
+                                        (~compared, "none", "beyond the cells' ν")):
+                    if sel.any():
+                        ax.errorbar(strips["nu"][sel], val[sel],
+                                    yerr=[np.minimum(err, 0.95 * val)[sel], err[sel]],
+                                    fmt="^", color="k", mfc=fill, ms=5,
+                                    label=f"{name}: strips, {what} (thesis f)")
         for k, (label, rs) in enumerate(points.items()):
             nu = [r.v("nu") for r in rs]
             for suffix, mk, fill in (("", "o", True), ("_listing", "s", False)):
@@ -119,7 +126,7 @@ def bagnold(points: dict[str, list[RunSummary]], out: Path,
                             color=COLOURS[k], mfc=COLOURS[k] if fill else "none",
                             label=f"{label}{'' if fill else ' (÷π, listing)'}")
         ax.set_yscale("log")
-        ax.set_xlabel("solid fraction ν (centre strips)")
+        ax.set_xlabel("solid fraction ν (cells: centre strips; chute: each strip)")
         ax.set_title(f"{key}: τ = ρ_p {key} R² (du/dy)²", fontsize=9)
     axes[0].set_ylabel("f (thesis definition; open: listing FNU = f/π)")
     fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=3,

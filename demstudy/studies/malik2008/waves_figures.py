@@ -97,8 +97,10 @@ def _spectrum(ax, run: RunWaves, plane: str, letter: str) -> None:
     ax.tick_params(labelsize=6, pad=0)
     ax.set_xticks(range(na + 1))
     ax.set_yticks(range(nb + 1))
+    spread = ("±2σ whiskers" if run.stationary else
+              "±2σ whiskers (modes drift: a transient's spread)")
     ax.set_title(f"({letter}) power {plane}: P = 2|X|²/(N1N2)², ± modes summed,\nmean over "
-                 "the production, ±2σ whiskers; red: dominant", fontsize=7.5)
+                 f"the production, {spread}; red: dominant", fontsize=7.5)
 
 
 def _energy(ax, run: RunWaves) -> None:
