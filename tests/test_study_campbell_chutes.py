@@ -277,3 +277,19 @@ def test_local_bagnold_coefficients_of_a_uniform_shear(accelerating):
     assert out["f_N"] == pytest.approx(2 * out["f_s"])
     flat = {**prof, "u": np.ones(8)}
     assert local_bagnold(dataclasses.replace(run, profiles=flat, stress=stress))["nu"].size == 0
+
+
+def test_the_approach_quadrant_is_where_a_positive_shear_brings_discs_together():
+    """θ = atan2(n_y, n_x) mod π from the flow direction x (downslope; u grows with y): a
+    collision whose line of centres points up-and-back (n = (−1, 1)/√2, θ = 135°) is an
+    approach one, (1, 1)/√2 (θ = 45°) a recession one; wall collisions and the settling
+    before ``start`` do not count."""
+    from demstudy.studies.campbell1982.chute_measure import _approach_halves
+
+    r = 1 / math.sqrt(2)
+    log = {"time": np.array([0.5, 1.0, 2.0, 3.0, 4.0, 5.0]),
+           "kind": np.array([0, 0, 0, 1, 0, 0]),
+           "normal": np.array([[r, r], [-r, r], [-r, r], [-r, r], [r, r], [r, -r]])}
+    # from t = 1: first half (t ≤ 3) two pairs, both approach; second half (4, 5): (1,1) is 45°,
+    # (1,-1) is 135° mod π, approach
+    assert _approach_halves(log, 1.0) == (1.0, 0.5)

@@ -363,7 +363,7 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     low = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.01))
     assert low.verdict == REPRODUCED and "TC" not in low.reason
     high = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2))
-    assert high.verdict == PARTLY and "this box: 20.0 % (t_c = 1e-05 time units)" in high.reason
+    assert high.verdict == PARTLY and "this box: 20.0 % (t_c = 1e-05 √(d/g))" in high.reason
 
     # the box's own TC twin agreed (same class and KE at a small share): no cap, said so;
     # another box's twin agreeing is mentioned, the cap stays

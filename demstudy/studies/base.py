@@ -110,7 +110,8 @@ class Check:
 
 def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]],
                unchanged: Mapping[str, str] | None = None,
-               twins: Mapping[str, str] | None = None) -> None:
+               quoted: Mapping[str, str] | None = None,
+               unit: str | Mapping[str, str] = "time units") -> None:
     """The rule of :data:`VERDICT_LEGEND` for the event-driven engine's TC model (Luding &
     McNamara: a pair colliding again within t_c is elastic; no thesis has it): every row
     resting on a run (``Check.runs``) whose ``shares`` (case name → (share of pair collisions
@@ -118,20 +119,22 @@ def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]
     in its reason, unless the reason discusses the TC model already, and an agreement becomes
     *partly* (a weaker test); a disagreement stays, the TC model one possible cause. A run in
     ``unchanged`` (case name → the evidence: a twin at another t_c with a share below the
-    level agrees) keeps the row's verdict. ``twins`` (case name → what a twin at another t_c
+    level agrees) keeps the row's verdict. ``quoted`` (case name → what a twin at another t_c
     whose own share is large found, :func:`twin_comparison`) is quoted in the reason but
     exempts nothing: with both shares large there is no reference free of the model. Rows
     about the TC model itself, and comparisons with engines without it, are the caller's to
-    leave out (give them no ``runs``)."""
+    leave out (give them no ``runs``). ``unit``: the scenes' time unit, for t_c (or per run)."""
     from ..engines.edmd.tc_share import WARN_SHARE
 
-    unchanged, twins = unchanged or {}, twins or {}
+    unchanged, quoted = unchanged or {}, quoted or {}
     for c in checks:
         large = [(n, *shares[n]) for n in c.runs
                  if n in shares and math.isfinite(shares[n][0]) and shares[n][0] > WARN_SHARE]
         if c.verdict == NOT_RUN or not large:
             continue
-        text = ", ".join(f"{n}: {100 * s:.1f} % (t_c = {tc:g} time units)" for n, s, tc in large)
+        text = ", ".join(f"{n}: {100 * s:.1f} % (t_c = {tc:g} "
+                         f"{unit if isinstance(unit, str) else unit.get(n, 'time units')})"
+                         for n, s, tc in large)
         note = (f"The engine's TC model made more than {100 * WARN_SHARE:g} % of the pair "
                 f"collisions elastic ({text}; the thesis has no TC model)")
         shown = [unchanged[n] for n, _s, _tc in large if n in unchanged]
@@ -141,7 +144,7 @@ def tc_caveats(checks: Sequence[Check], shares: Mapping[str, tuple[float, float]
         else:
             note += (": the flow dissipates less than its restitution says, a weaker test "
                      "either way")
-            told = [twins[n] for n, _s, _tc in large if n in twins and n not in unchanged]
+            told = [quoted[n] for n, _s, _tc in large if n in quoted and n not in unchanged]
             if told:
                 note += " (" + "; ".join(dict.fromkeys(told)) + ")"
             if c.verdict == REPRODUCED:

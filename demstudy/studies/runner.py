@@ -289,8 +289,9 @@ def _tc(engine: str, options: Mapping[str, Any]) -> float | None:
 
 def calibration(scene, engine: str, finished: Sequence[Took],
                 options: Mapping[str, Any] | None = None) -> Took | None:
-    """The made run that says how far ``scene``'s lower bound falls short: the same engine
-    and engine options (t_c), the same drive (``forecast_events.drive``: walls with their
+    """The made run that says how far ``scene``'s lower bound falls short: the same engine,
+    at the same t_c when one is made (else at another: the forecast line says so), the same
+    drive (``forecast_events.drive``: walls with their
     kind and speed, gravity, shear), run unit and solid fraction (within ``FAMILY_PHI``;
     the wall gap may differ); the closest in N, run length, e and
     β (``forecast_events.family_distance``); None when there is none.

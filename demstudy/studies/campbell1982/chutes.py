@@ -193,7 +193,7 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     out.mkdir(parents=True, exist_ok=True)
     checks = all_checks(found, quick)
     shares = {n: (r.tc_share, math.nan if r.tc is None else r.tc) for n, r in found.items()}
-    tc_caveats(checks, shares, tc_unchanged(found))
+    tc_caveats(checks, shares, tc_unchanged(found), unit="√(d/g)")
     sections = [("Chutes: how they were measured, and which base", HOW)]
     if found:
         sections.append(("Chutes: every run", _table(found)))

@@ -41,8 +41,9 @@ LARGER = "couette-cause-20x8-nu75"
 CAUSE_FIXED = ["couette-cause-20x8-nu55", "couette-cause-20x8-nu75"]
 CAUSE_ROUGH = ["couette-cause-rough-nu55", "couette-cause-rough-nu75"]
 
-#: TC twins: a cell → the same cell at t_c = 1e-6 (the cause runs); the dense no-slip cells
-#: and the rough servo cell make 4-13 % of their pair collisions elastic at the default 1e-5
+#: TC twins: a cell → the same cell at t_c = 1e-6 (the cause runs): the ν = 0.65 cell (6.0 %
+#: of its pair collisions elastic at the default 1e-5) and the rough servo cell (13.0 %); the
+#: ν = 0.75 cell's 4.3 % is below the warning level, so its twin is only a cause run
 TC_TWINS = {"couette-fixed-nu65": "couette-cause-tc1e-06-nu65",
             "couette-fixed-nu75": "couette-cause-tc1e-06-nu75",
             K1[1]: "couette-cause-tc1e-06-rough-servo-s1"}
@@ -78,17 +79,23 @@ def reads(quick: bool) -> tuple[str, ...]:
     return CHUTE_F
 
 
-def _chute_strips(paths: Mapping[str, Path]) -> dict[str, dict]:
+def _chute_strips(paths: Mapping[str, Path]) -> tuple[dict[str, dict],
+                                                      dict[str, tuple[float, float]]]:
+    """The chutes' strip-by-strip f (:func:`.chute_measure.local_bagnold`) and their TC
+    shares (the row on them carries the TC rule too)."""
     from .chute_measure import local_bagnold
     from .chute_measure import summarise as chute_summary
 
-    out = {}
+    strips, shares = {}, {}
     for name, path in paths.items():
         try:
-            out[name] = local_bagnold(chute_summary(name, path))
+            run = chute_summary(name, path)
         except (OSError, KeyError, ValueError) as exc:  # a damaged file: the row says not run
             print(f"warning: {name}: {path} not read for f(ν) ({exc})")
-    return out
+            continue
+        strips[name] = local_bagnold(run)
+        shares[name] = (run.tc_share, math.nan if run.tc is None else run.tc)
+    return strips, shares
 
 
 def cases(quick: bool) -> list[Case]:
@@ -98,30 +105,18 @@ def cases(quick: bool) -> list[Case]:
 
 def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     out.mkdir(parents=True, exist_ok=True)
-    chute = _chute_strips({n: Path(runs[n]) for n in CHUTE_F if n in runs})
+    chute, chute_shares = _chute_strips({n: Path(runs[n]) for n in CHUTE_F if n in runs})
     summaries = {name: summarise(name, Path(path)) for name, path in sorted(runs.items())
                  if name not in CHUTE_F}
     ana = Analysis()
     ana.checks = checks(summaries, chute)
-    chute_shares = _chute_shares({n: Path(runs[n]) for n in chute})
     unchanged, told = tc_twins(summaries)
+    units = {**{n: "d/U_T" for n in summaries}, **{n: "√(d/g)" for n in chute_shares}}
     tc_caveats(ana.checks, {**{n: _tc_share(r) for n, r in summaries.items()},
-                            **chute_shares}, unchanged, told)
+                            **chute_shares}, unchanged, told, unit=units)
     ana.figures = figures(summaries, out, chute)
     ana.sections = sections(summaries, quick)
     return ana
-
-
-def _chute_shares(paths: Mapping[str, Path]) -> dict[str, tuple[float, float]]:
-    """The chute runs' TC shares (their rows carry the TC rule too)."""
-    import h5py
-
-    out = {}
-    for name, path in paths.items():
-        with h5py.File(path, "r") as f:
-            out[name] = (float(f.attrs.get("tc_elastic_fraction", math.nan)),
-                         float(f.attrs.get("tc", math.nan)))
-    return out
 
 
 def checks(s: dict[str, RunSummary], chute: Mapping[str, dict] | None = None) -> list:

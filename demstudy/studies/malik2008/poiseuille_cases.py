@@ -124,7 +124,7 @@ SOFT_SECTIONS = {"run": {"equilibration": 200.0, "production": 400.0, "sample_in
 QUICK = (Flow(0.01, 0.8, 0.99), Flow(0.01, 0.8, -0.99), Flow(0.5, *DENSE))
 #: TC twins (full study): the dense φ = 0.5 channel makes 16 % of its pair collisions
 #: elastic at the default t_c = 1e-5 √(d/g); the same flow at t_c = 1e-6 says whether its
-#: rows depend on the TC model (the "TC model" row, :func:`poiseuille_checks.tc_twin_row`)
+#: rows depend on the TC model (the "TC model" row, :func:`poiseuille_checks.tc_twin_rows`)
 TC_TWINS = (Flow(0.5, *DENSE, tc=1e-6),)
 #: the code validation of §3.5 (Fig 2.11): N = 1000 at φ = 0.01 in a cube (37.4 d), e = 0.8,
 #: β = 0.99 (the thesis's system for Ch. 3 is 2744 in 50³: REF in poiseuille_checks)

@@ -100,7 +100,7 @@ def _spectrum(ax, run: RunWaves, plane: str, letter: str) -> None:
     spread = ("±2σ whiskers" if run.stationary else
               "±2σ whiskers (modes drift: a transient's spread)")
     ax.set_title(f"({letter}) power {plane}: P = 2|X|²/(N1N2)², ± modes summed,\nmean over "
-                 f"the production, {spread}; red: dominant", fontsize=7.5)
+                 f"the production; red: dominant;\n{spread}", fontsize=7.5)
 
 
 def _energy(ax, run: RunWaves) -> None:

@@ -296,7 +296,7 @@ def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
     exempt, text = tc_evidence(own_twin, agreed, tag, disagreed)
     check.runs = (name,)
     rule([check], {name: (run.tc_fraction, DEFAULT_TC)}, {name: text} if exempt else {},
-         {name: text} if text and not exempt else {})
+         {name: text} if text and not exempt else {}, unit="√(d/g)")
     return check
 
 
