@@ -584,3 +584,28 @@ def test_twin_comparison_allows_two_sigma_and_the_tolerance():
         "gives the same values within 2σ + 10 %" == unchanged["r1"]
     assert "the twin's own share is large too" in told["r2"]
     assert told["r3"].endswith("gives other values (A +100 %)")
+
+
+def test_a_run_at_another_t_c_is_not_taken_for_the_case(tmp_path):
+    """A results file (or record) of the right scene but made at another t_c is not the
+    case's run: the runner makes it again and says why; files that predate the attribute,
+    and engines without a t_c, pass."""
+    from demstudy.accuracy.execute import is_done, option_mismatch
+    from demstudy.scene import load_scene, scene_to_toml
+    from demstudy.studies.records import why_not_current
+
+    assert option_mismatch({"tc": 1e-5}, "edmd", {}) is None  # the default
+    assert option_mismatch({"tc": 1e-5}, "edmd", {"tc": 1e-6}) == (
+        "made at t_c = 1e-05, the run asks for t_c = 1e-06")
+    assert option_mismatch({}, "edmd", {"tc": 1e-6}) is None
+    assert option_mismatch({"tc": 1e-5}, "lammps", {"tc": 1e-6}) is None
+    scene = load_scene("campbell1982/couette-rough", ["run.equilibration=0",
+                                                      "run.production=2"])
+    path = tmp_path / "cell.h5"
+    ds.run(scene, engine="edmd", out=path, progress=False)
+    toml = scene_to_toml(scene)
+    assert is_done(path, toml) and is_done(path, toml, "edmd", {})
+    assert not is_done(path, toml, "edmd", {"tc": 1e-6})
+    assert why_not_current(path, None, toml, "", "edmd", {"tc": 1e-6}) == (
+        "the record was made at t_c = 1e-05, the run asks for t_c = 1e-06")
+    assert why_not_current(path, None, toml, "", "edmd", {}) is None

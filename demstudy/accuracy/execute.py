@@ -10,9 +10,10 @@ Dimensionless particle units: d = 1, m = 1, g = 1 when gravity acts.
 
 from __future__ import annotations
 
+import math
 import multiprocessing
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,8 +38,27 @@ class Task:
         return scene_for(base, self.spec)
 
 
-def is_done(path: Path, expected_scene_toml: str) -> bool:
-    """Whether ``path`` holds the finished run of that scene (readable, same scene)."""
+def option_mismatch(attrs: Mapping[str, Any], engine: str,
+                    options: Mapping[str, Any] | None) -> str | None:
+    """Why a finished run (its results file's root ``attrs``) is not the run of ``engine``
+    with ``options``, for the engine options that change the physics (None: it is): the
+    event-driven engine's t_c (the option, else the engine's default). A file that does not
+    record it (older than the attribute) cannot tell, and passes."""
+    if engine != "edmd" or attrs.get("tc") is None:
+        return None
+    from ..engines.edmd.core import DEFAULT_TC
+
+    wanted = float((options or {}).get("tc", DEFAULT_TC))
+    made = float(attrs["tc"])
+    if math.isclose(made, wanted, rel_tol=1e-9):
+        return None
+    return f"made at t_c = {made:g}, the run asks for t_c = {wanted:g}"
+
+
+def is_done(path: Path, expected_scene_toml: str, engine: str = "",
+            options: Mapping[str, Any] | None = None) -> bool:
+    """Whether ``path`` holds the finished run of that scene (readable, same scene) and, when
+    ``engine`` is given, of its physics-changing ``options`` (:func:`option_mismatch`)."""
     from ..io.results import read_results
 
     if not path.is_file():
@@ -47,7 +67,8 @@ def is_done(path: Path, expected_scene_toml: str) -> bool:
         attrs = read_results(path, skip=("frames", "collisions")).attrs
     except Exception:  # noqa: BLE001 - any unreadable file (truncated, not HDF5) is redone
         return False
-    return attrs.get("scene_toml") == expected_scene_toml and "wall_seconds" in attrs
+    return (attrs.get("scene_toml") == expected_scene_toml and "wall_seconds" in attrs
+            and option_mismatch(attrs, engine, options) is None)
 
 
 def run_task(task: Task) -> dict[str, Any]:

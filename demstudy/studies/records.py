@@ -92,12 +92,15 @@ def same_scene(stored: Any, expected: str) -> bool:
         return False
 
 
-def why_not_current(record: Path, full: Path | None, scene_toml: str, version: str
+def why_not_current(record: Path, full: Path | None, scene_toml: str, version: str,
+                    engine: str = "", options: Mapping[str, Any] | None = None
                     ) -> str | None:
     """Why ``record`` cannot stand for the run of this scene (None: it can). It must be a
-    readable results file (read whole: ``read_results`` verifies it) of this scene; when the
-    run ``full`` exists it must also be of this ``version`` and not older than the run (else
-    it is remade from the run)."""
+    readable results file (read whole: ``read_results`` verifies it) of this scene and of
+    ``engine``'s physics-changing ``options`` (the t_c: ``accuracy.execute.option_mismatch``);
+    when the run ``full`` exists it must also be of this ``version`` and not older than the
+    run (else it is remade from the run)."""
+    from ..accuracy.execute import option_mismatch
     from ..io.results import read_results
 
     if not record.is_file():
@@ -108,6 +111,9 @@ def why_not_current(record: Path, full: Path | None, scene_toml: str, version: s
         return f"unreadable ({exc})"
     if not same_scene(attrs.get("scene_toml"), scene_toml) or "wall_seconds" not in attrs:
         return "the record is of another scene or an unfinished run"
+    other = option_mismatch(attrs, engine, options)
+    if other:
+        return f"the record was {other}"
     if full is not None and full.is_file():
         if attrs.get("record_version") != version:
             return f"record version {attrs.get('record_version')!r}, now {version!r}"
@@ -116,6 +122,7 @@ def why_not_current(record: Path, full: Path | None, scene_toml: str, version: s
     return None
 
 
-def current(record: Path, full: Path | None, scene_toml: str, version: str) -> bool:
+def current(record: Path, full: Path | None, scene_toml: str, version: str,
+            engine: str = "", options: Mapping[str, Any] | None = None) -> bool:
     """Whether ``record`` stands for the run of this scene (:func:`why_not_current`)."""
-    return why_not_current(record, full, scene_toml, version) is None
+    return why_not_current(record, full, scene_toml, version, engine, options) is None

@@ -401,19 +401,22 @@ def run_study(name: str, *, quick: bool = False, out: str | Path | None = None,
         if study.derive is not None else None
     todo, done = [], []
     for task in tasks:
-        if is_done(task.path, task.scene_toml):
+        # a run is made when its scene and its physics-changing engine options (t_c) match
+        same = {"engine": task.case.engine, "options": task.case.options}
+        if is_done(task.path, task.scene_toml, **same):
             done.append(task)
         elif record_dir is not None and current(record_dir / f"{task.case.name}.h5", None,
                                                 task.scene_toml,
                                                 record_version(study.name,
-                                                               study.derive_version)):
+                                                               study.derive_version),
+                                                **same):
             done.append(task)
             result.from_records.append(task.case.name)
         else:
             todo.append(task)
             if record_dir is not None and (record_dir / f"{task.case.name}.h5").is_file():
                 why = why_not_current(record_dir / f"{task.case.name}.h5", None,
-                                      task.scene_toml, "")
+                                      task.scene_toml, "", **same)
                 echo(f"warning: the record of {task.case.name} is not used ({why}): "
                      "the run is made again")
     result.reused = [t.case.name for t in done]
@@ -498,8 +501,9 @@ def keep_record(study: Study, task: StudyTask, record: Path, echo=print) -> bool
     from .records import current, record_version, write_record
 
     version = record_version(study.name, study.derive_version)
-    full = task.path if is_done(task.path, task.scene_toml) else None
-    if current(record, full, task.scene_toml, version):
+    same = {"engine": task.case.engine, "options": task.case.options}
+    full = task.path if is_done(task.path, task.scene_toml, **same) else None
+    if current(record, full, task.scene_toml, version, **same):
         return True
     if full is None:
         return False
