@@ -70,7 +70,9 @@ class TcShare:
         return (f"warning: the TC model made {100 * self.fraction:.3g} % of pair collisions "
                 f"elastic (more than {100 * WARN_SHARE:g} %): the results may depend on t_c = "
                 f"{self.tc:g}; rerun with a smaller --tc (e.g. --tc {self.tc / 10:g}) and "
-                "compare")
+                "compare the results, not only the share (in the studies' dense 3D flows "
+                "t_c = 1e-6 brought it to 2-6 % at ×1.0-2.1 the cost; in dense 2D flows it "
+                "did not fall: docs/edmd-engine.md)")
 
 
 def tc_share(elastic: int, collisions: int, tc: float) -> TcShare:

@@ -190,7 +190,7 @@ def snapshots(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:
     widths = [float(sz[0]) for sz in sizes]
     height = max(float(sz[1]) for sz in sizes)
     fig, axes = plt.subplots(1, len(runs), figsize=(1.5 + 0.42 * sum(widths),
-                                                    0.36 * height + 1.8),
+                                                    0.36 * height + 1.2),
                              gridspec_kw={"width_ratios": widths}, squeeze=False)
     for ax, (label, r) in zip(axes[0], runs, strict=True):
         (x0, y0), (x1, y1) = r.arrays["snapshot_box"]
@@ -209,7 +209,7 @@ def snapshots(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:
     axes[0][0].set_ylabel("y [d] (walls: thick lines)")
     fig.suptitle("Snapshots at the end of the run, Campbell Fig 2.3", fontsize=10)
     return _save(fig, out, "couette-snapshots.png", "Fig 2.3 form: the cells' discs in "
-                 "their last frame (the upper wall moves to the right)", bottom=0.1)
+                 "their last frame (the upper wall moves to the right)", bottom=0.04)
 
 
 #: how much of the settling the energy history shows before averaging starts (strain units)
