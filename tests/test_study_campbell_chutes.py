@@ -293,3 +293,18 @@ def test_the_approach_quadrant_is_where_a_positive_shear_brings_discs_together()
     # from t = 1: first half (t ≤ 3) two pairs, both approach; second half (4, 5): (1,1) is 45°,
     # (1,-1) is 135° mod π, approach
     assert _approach_halves(log, 1.0) == (1.0, 0.5)
+
+
+def test_campbells_2d_to_3d_conversion_keeps_the_mean_spacing(accelerating):
+    """ν_3D = (4/(3√π)) ν^{3/2} (equal mean spacing): the square packing π/4 maps onto the
+    cubic π/6 exactly; a bed below the 3D dense range is the thesis's "probably too small"."""
+    from demstudy.studies.campbell1982.chute_checks import c8_conversion, nu_3d
+
+    assert nu_3d(math.pi / 4) == pytest.approx(math.pi / 6)
+    run = summarise("chute-40-flat", accelerating)
+    bed = dataclasses.replace(run, profiles={**run.profiles, "nu": np.array([0.3, 0.68, 0.6])})
+    row = c8_conversion({"chute-30-bumpy": bed})
+    assert row.verdict == REPRODUCED and "ν = 0.680 → ν_3D = 0.422" in row.measured
+    dense = dataclasses.replace(run, profiles={**run.profiles, "nu": np.array([0.85])})
+    assert c8_conversion({"chute-30-bumpy": dense}).verdict == NOT_REPRODUCED
+    assert c8_conversion({}).verdict == NOT_RUN

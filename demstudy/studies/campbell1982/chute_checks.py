@@ -26,6 +26,8 @@ from ..base import (
 from .chute_measure import ChuteRun, basal_layer, centre_plug
 
 NU_SQUARE = math.pi / 4
+#: ν_m: the densest shearable packing, layers following contours (L1093)
+NU_SHEARABLE = math.pi / (math.sqrt(3) + 2 * math.pi / 3)
 #: "little effect", "insignificant changes": a difference within 2σ + 10 % (of the reference)
 #: how far two runs of the 40-disc flow may differ and count as the same flow (2σ + 10 %,
 #: the C6, width and t_c rows), the same as the studies' TC-twin tolerance
@@ -528,6 +530,44 @@ def c7_c8(runs: Mapping[str, ChuteRun], name: str, ref: str, statement: str) -> 
                                         "(row C3)"))
 
 
+#: 3D dense granular flows (inclined planes, GDR MiDi 2004, Eur. Phys. J. E 14, 341): solid
+#: fractions from ≈ 0.5 (the thinnest flows) to ≈ 0.6
+DENSE_3D = (0.5, 0.6)
+
+
+def nu_3d(nu: float) -> float:
+    """Campbell's 2-D → 3-D solid fraction at equal mean spacing (L990-999): C_2D = (π/ν)^½ R
+    and C_3D = ((4/3)π/ν_3D)^⅓ R give ν_3D = (4/(3√π)) ν^{3/2}."""
+    return 4.0 / (3.0 * math.sqrt(math.pi)) * nu**1.5
+
+
+def c8_conversion(runs: Mapping[str, ChuteRun]) -> Check:
+    """C8's 2-D → 3-D conversion (Fig 3.6, L990-999), which Campbell himself thought gives
+    "probably too small" solid fractions: the steady bed's densest strips converted, against
+    3D dense flows' ν."""
+    ref = "C8; Fig 3.6, L990-999"
+    statement = ("the equivalent 3-D solid fraction ν_3D = (4/(3√π)) ν^{3/2} (equal mean "
+                 "spacing) of a dense 2-D bed is probably too small")
+    thesis = "probably too small (no value)"
+    if "chute-30-bumpy" not in runs:
+        return not_run(ref, statement, thesis, ["chute-30-bumpy"])
+    r = runs["chute-30-bumpy"]
+    top = float(np.nanmax(r.profiles["nu"]))
+    limits = [("ν_s = π/4 (square, layers slide)", NU_SQUARE),
+              ("ν_m = 0.821 (densest shearable)", NU_SHEARABLE)]
+    parts = [f"the steady 30° bed's densest strip ν = {top:.3f} → ν_3D = {nu_3d(top):.3f}"]
+    parts += [f"{what} → {nu_3d(v):.3f}" for what, v in limits]
+    low = nu_3d(top) < DENSE_3D[0]
+    return Check(ref, statement, thesis, "; ".join(parts),
+                 REPRODUCED if low else NOT_REPRODUCED,
+                 f"3D dense granular flows run at ν ≈ {DENSE_3D[0]:g}-{DENSE_3D[1]:g} (inclined "
+                 "planes, GDR MiDi 2004): the converted bed "
+                 + ("falls below that" if low else "reaches it")
+                 + "; only beds at the 2-D packing limits (π/4, 0.821) would map into it; "
+                 "the conversion keeps the mean spacing, not the contact network that makes a "
+                 "3-D bed dense")
+
+
 def tc_independence(runs: Mapping[str, ChuteRun]) -> Check:
     ref = "TC model (demstudy; not in the thesis)"
     statement = ("the 30° bumpy chute does not depend on the event-driven engine's t_c, and "
@@ -608,6 +648,7 @@ def all_checks(runs: Mapping[str, ChuteRun], quick: bool) -> list[Check]:
         (c7_c8(runs, c8, "C8; Fig 3.6, L193, L1039",
                "the 4 × 4 bed at 40° with the variable ε gives a steady mass-flow profile "
                "(compared with Ridgway & Rupp)"), (c8,)),
+        (c8_conversion(runs), (bumpy30,)),
         (width_doubling(runs), (bumpy30, "chute-30-bumpy-10x8")),
         # the t_c row is about the TC model; the soft engines have none, so agreeing with
         # them is evidence on the TC model's effect, not a test it weakens
