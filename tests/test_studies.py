@@ -580,8 +580,9 @@ def test_twin_comparison_allows_two_sigma_and_the_tolerance():
     pairs = [("r1", base, base, 0.02, 1e-6), ("r2", base, base, 0.07, 1e-6),
              ("r3", base, {"a": (2.0, 0.01), "b": (2.0, 0.0)}, 0.02, 1e-6)]
     unchanged, told = twin_evidence(pairs, labels)
-    assert list(unchanged) == ["r1"] and "the twin of r1 at t_c = 1e-06 (2.0 % elastic) " \
-        "gives the same values within 2σ + 10 %" == unchanged["r1"]
+    assert list(unchanged) == ["r1"] and unchanged["r1"] == (
+        "the twin of r1 at t_c = 1e-06 time units (2.0 % elastic) gives the same values "
+        "within 2σ + 10 %")
     assert "the twin's own share is large too" in told["r2"]
     assert told["r3"].endswith("gives other values (A +100 %)")
 

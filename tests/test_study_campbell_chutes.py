@@ -232,7 +232,7 @@ def test_the_chutes_collision_angles_row_wants_the_approach_quadrant(acceleratin
     row = c9_angles({"chute-40-flat": _with_angles(run, 0.75)})
     assert row.verdict == REPRODUCED and "share in 90°-180° 0.750" in row.measured
     assert "logged over t = 50-99 of the production 50-400" in row.measured
-    assert "only of its logged start" in row.reason
+    assert "the log of chute-40-flat covers only the start of the production" in row.reason
     assert c9_angles({"chute-40-flat": _with_angles(run, 0.5)}).verdict == NOT_REPRODUCED
 
 
@@ -308,3 +308,20 @@ def test_campbells_2d_to_3d_conversion_keeps_the_mean_spacing(accelerating):
     dense = dataclasses.replace(run, profiles={**run.profiles, "nu": np.array([0.85])})
     assert c8_conversion({"chute-30-bumpy": dense}).verdict == NOT_REPRODUCED
     assert c8_conversion({}).verdict == NOT_RUN
+
+
+def test_the_reference_chutes_twins_are_quoted_when_their_shares_are_large(accelerating):
+    """tc_quoted: both t_c twins of the 30° bumpy chute with shares above 5 % give the same
+    flow: quoted in its rows, not an exemption; a small-share twin leaves it to tc_unchanged."""
+    from demstudy.studies.campbell1982.chute_checks import tc_quoted
+
+    run = dataclasses.replace(summarise("chute-40-flat", accelerating), name="chute-30-bumpy",
+                              tc=1e-5, tc_share=0.116)
+    runs = {"chute-30-bumpy": run,
+            "chute-30-bumpy-tc1e-4": dataclasses.replace(run, tc=1e-4, tc_share=0.079),
+            "chute-30-bumpy-tc1e-6": dataclasses.replace(run, tc=1e-6, tc_share=0.335)}
+    quoted = tc_quoted(runs)["chute-30-bumpy"]
+    assert quoted.startswith("its twins at t_c = 0.0001 (7.9 %) and 1e-06 (33.5 %) √(d/g) "
+                             "give the same u_max, KE/N and H within 2σ + 10 %")
+    runs["chute-30-bumpy-tc1e-6"] = dataclasses.replace(run, tc=1e-6, tc_share=0.02)
+    assert tc_quoted(runs) == {}

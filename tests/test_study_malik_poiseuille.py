@@ -972,7 +972,8 @@ def test_the_tc_twin_row_and_its_evidence():
     small = [run(twin_flow, 0.02, 1e-6)]
     unchanged, told = tc_twin_evidence(data, small)
     assert base_flow.name in unchanged and not told
-    assert "at t_c = 1e-06 (2.0 % elastic) gives the same values" in unchanged[base_flow.name]
+    assert ("at t_c = 1e-06 √(d/g) (2.0 % elastic) gives the same values"
+            in unchanged[base_flow.name])
     (row,) = tc_twin_rows(data, small, [twin_flow])
     assert row.verdict == REPRODUCED and row.own and "TC share 16.0 %" in row.measured
     # two transients that agree: a weaker test, as every row on unsteady runs
@@ -1010,8 +1011,8 @@ def test_the_validation_box_is_figure_2_11s_system(tiny_run):
     box = load_flow(VALIDATION, path, with_gr=False)  # the same file stands in for the box
     rows = validation_checks({REF: main}, box)
     assert len(rows) == 5 and all(r.runs == (VALIDATION.name,) for r in rows)
-    assert all(r.measured.startswith("N = 1000 in 37.4³ (Fig 2.11's system): ")
-               for r in rows)
+    assert all(r.measured.startswith("N = 1000 in 37.4³ (Fig 2.11's N; the cube's side from "
+                                     "φ = 0.01, not given in the thesis): ") for r in rows)
     assert all("; Ch. 3's N = 2744 in 50³: " in r.measured for r in rows)
     plain = validation_checks({REF: main})
     assert all(r.runs == (flow.name,) and "N = 1000" not in r.measured for r in plain)

@@ -388,7 +388,13 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
                      None, ["L42W30H30"], "L70W50H50",
                      {"L150W50H10": NOT_REPRODUCED, "L90W30H30": PARTLY})
     assert ("kept its class; the TC twin of L150W50H10 changed the class; the TC twin of "
-            "L90W30H30 kept the class but not the KE/N or a small share") in both.reason
+            "L90W30H30 kept the class but not the KE/N") in both.reason
+    # a "partly" twin whose own share is large: said so
+    shared = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
+                       None, [], "L70W50H50", {"L90W30H30": PARTLY},
+                       twin_shares={"L90W30H30": 0.056})
+    assert ("the TC twin of L90W30H30 kept the class and the KE/N, but its own share "
+            "(5.6 %) is above 5 %") in shared.reason
     only_bad = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
                          None, [], "L70W50H50", {"L150W50H10": NOT_REPRODUCED})
     assert "(the TC twin of L150W50H10 changed the class: rows" in only_bad.reason
@@ -406,7 +412,7 @@ def test_a_large_tc_share_caps_the_box_verdicts_and_says_so(tmp_path: Path) -> N
     # the box's own twin measured and disagreeing: said so, by its row's name, capped
 
     for verdict, said in ((NOT_REPRODUCED, "changes the class, so the structure depends"),
-                          (PARTLY, "keeps the class, but its KE or share differ")):
+                          (PARTLY, "kept the class but not the KE/N, so an effect")):
         own = Check("TC model, L90W30H30 (demstudy; not in the thesis)", "", "", "", verdict)
         capped = tc_caveat(class_check(box, run), dataclasses.replace(run, tc_fraction=0.2),
                            own, ["L42W30H30"], "L90W30H30")

@@ -174,7 +174,8 @@ def twin_comparison(base: Mapping[str, tuple[float, float]],
         if not all(map(math.isfinite, (x, y))):
             continue
         err = math.hypot(xe, ye) if math.isfinite(xe) and math.isfinite(ye) else 0.0
-        change = f" ({100 * (y - x) / x:+.1f} %)" if x else ""
+        # rounded, + 0.0: a change that rounds to zero prints "+0.0", not "-0.0"
+        change = f" ({round(100 * (y - x) / x, 1) + 0.0:+.1f} %)" if x else ""
         parts.append(f"{label} {pm(y, ye)}{change}")
         if not within(y, err, x, 2.0, TWIN_TOLERANCE * abs(x)):
             off.append(f"{label} {100 * (y - x) / x:+.0f} %" if x else label)
@@ -182,7 +183,8 @@ def twin_comparison(base: Mapping[str, tuple[float, float]],
 
 
 def twin_evidence(pairs: Sequence[tuple[str, Mapping, Mapping, float, float]],
-                  labels: Mapping[str, str]) -> tuple[dict[str, str], dict[str, str]]:
+                  labels: Mapping[str, str], unit: str = "time units"
+                  ) -> tuple[dict[str, str], dict[str, str]]:
     """What TC twins say, for :func:`tc_caveats`: ``pairs`` of (run name, its values, its
     twin's values, the twin's TC-elastic share and t_c) give (runs a twin with a share below
     the warning level reproduces → the evidence, runs whose twin differs or has a large share
@@ -192,7 +194,8 @@ def twin_evidence(pairs: Sequence[tuple[str, Mapping, Mapping, float, float]],
     unchanged, told = {}, {}
     for name, base, twin, share, tc in pairs:
         same, _text, off = twin_comparison(base, twin, labels)
-        found = (f"the twin of {name} at t_c = {tc:g} ({100 * share:.1f} % elastic) gives "
+        found = (f"the twin of {name} at t_c = {tc:g} {unit} ({100 * share:.1f} % elastic) "
+                 "gives "
                  + ("the same values within 2σ + 10 %" if same else
                     "other values (" + ", ".join(off) + ")"))
         if same and share < WARN_SHARE:

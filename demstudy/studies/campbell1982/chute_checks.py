@@ -342,6 +342,12 @@ def c3_basal_layer(runs: Mapping[str, ChuteRun]) -> Check:
                  "steady 30° bumpy bed for contrast): " + ", ".join(met))
 
 
+def _logged_share(window: tuple[float, float, float, float]) -> float:
+    from .couette_measure import logged_fraction
+
+    return logged_fraction(window)
+
+
 def c9_angles(runs: Mapping[str, ChuteRun]) -> Check:
     """C9: the 40° chute's collision-angle distribution (Fig 3.33), read as the Couette cells'
     (Fig 3.32): anisotropic, the approach quadrant preferred. The digest gives no values."""
@@ -367,11 +373,13 @@ def c9_angles(runs: Mapping[str, ChuteRun]) -> Check:
         if name.startswith("chute-40"):
             ok.append(share - 0.5 > 2 * err)
     verdict = REPRODUCED if all(ok) else PARTLY if any(ok) else NOT_REPRODUCED
+    short = [n for n in have if _logged_share(runs[n].angles["window"]) < 0.99]
     reason = ("criterion: share − ½ beyond 2σ (isotropic collisions give ½); the 40° beds "
               "accelerate (row C3), so this is the distribution of a transient, as the "
-              "thesis's own 40° bed was, and only of its logged start (the engine keeps the "
-              "production's first 2·10⁵ collisions, the base's included); the steady 30° "
-              "bumpy bed beside it")
+              "thesis's own 40° bed was; the steady 30° bumpy bed beside it"
+              + ("" if not short else "; the log of " + ", ".join(short) + " covers only the "
+                 "start of the production (the engine keeps its first 2·10⁵ collisions, the "
+                 "base's included)"))
     return Check(ref, statement, thesis, "; ".join(parts), verdict, reason)
 
 
@@ -658,6 +666,26 @@ def all_checks(runs: Mapping[str, ChuteRun], quick: bool) -> list[Check]:
     for check, names in rest_on:
         check.runs = tuple(n for n in names if n in runs)
     return [check for check, _names in rest_on]
+
+
+def tc_quoted(runs: Mapping[str, ChuteRun]) -> dict[str, str]:
+    """What the 30° bumpy chute's t_c twins found when none of them exempts it (their own
+    shares are large): quoted in the rows resting on it (``base.tc_caveats``)."""
+    from ...engines.edmd.tc_share import WARN_SHARE
+
+    names = ["chute-30-bumpy-tc1e-4", "chute-30-bumpy-tc1e-6"]
+    if "chute-30-bumpy" not in runs or any(n not in runs for n in names):
+        return {}
+    a, spread = runs["chute-30-bumpy"], seed_spread(runs)
+    twins = [runs[n] for n in names]
+    if any(r.tc_share < WARN_SHARE for r in twins):
+        return {}  # a small-share twin decides (tc_unchanged), or its row says it differs
+    same = all(_same(a, r, spread)[0] == 2 for r in twins)
+    listed = " and ".join(f"{r.tc:g} ({100 * r.tc_share:.1f} %)" for r in twins)
+    return {"chute-30-bumpy": f"its twins at t_c = {listed} √(d/g) give "
+                              + ("the same u_max, KE/N and H within 2σ + 10 %"
+                                 if same else "other u_max, KE/N or H")
+                              + ", but neither has a share below 5 % (row 'TC model')"}
 
 
 def tc_unchanged(runs: Mapping[str, ChuteRun]) -> dict[str, str]:

@@ -21,7 +21,7 @@ import numpy as np
 from ..base import Analysis, Case, Figure, pm, tc_caveats
 from . import chute_figures as figs
 from .chute_cases import cases as _cases
-from .chute_checks import all_checks, tc_unchanged
+from .chute_checks import all_checks, tc_quoted, tc_unchanged
 from .chute_measure import ChuteRun, summarise_all
 
 __all__ = ["analyse", "cases"]
@@ -193,7 +193,7 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     out.mkdir(parents=True, exist_ok=True)
     checks = all_checks(found, quick)
     shares = {n: (r.tc_share, math.nan if r.tc is None else r.tc) for n, r in found.items()}
-    tc_caveats(checks, shares, tc_unchanged(found), unit="√(d/g)")
+    tc_caveats(checks, shares, tc_unchanged(found), tc_quoted(found), unit="√(d/g)")
     sections = [("Chutes: how they were measured, and which base", HOW)]
     if found:
         sections.append(("Chutes: every run", _table(found)))

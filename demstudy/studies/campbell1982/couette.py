@@ -67,7 +67,7 @@ def tc_twins(s: Mapping[str, RunSummary]) -> tuple[dict[str, str], dict[str, str
     can show the results converged in t_c without being a reference free of the model."""
     return twin_evidence([(base, s[base].values, s[twin].values, *_tc_share(s[twin]))
                           for base, twin in TC_TWINS.items() if base in s and twin in s],
-                         TWIN_VALUES)
+                         TWIN_VALUES, unit="d/U_T")
 
 
 #: the chute runs this part reads: Figs 3.21-3.24 put the steady chute's strips on f(ν)

@@ -151,7 +151,7 @@ def servo_density(runs: Runs, key: str, names: Sequence[str], factors: Sequence[
             verdict = PARTLY if verdict == REPRODUCED else verdict
         return Check(f"{figure} ({key}, L1117-1123)", statement,
                      "ν an output (L855-857); values not in the digest",
-                     "ν = " + fmt(pts, [f"σ_n×{f:g}" for f in factors]), verdict, why)
+                     "ν at " + fmt(pts, [f"σ_n×{f:g}" for f in factors]), verdict, why)
     return guarded(f"{figure} ({key})", statement, "ν an output", runs, names, body)
 
 
@@ -352,10 +352,14 @@ def chute_on_curve(runs: Runs, names: Sequence[str], chute: Mapping[str, Mapping
                 mean, mean_err = float(np.sum(w * ratio) / w.sum()), float(w.sum() ** -0.5)
                 means.append((key, mean, mean_err))
                 off += int(np.sum(np.abs(ratio - 1) > 2 * ratio_err + CURVE_TOLERANCE))
+                heaviest = float(w.max() / w.sum())
+                above = int(np.sum(ratio > 1))
                 parts.append(f"{name} {key}: " + ", ".join(
                     f"ν {n:.2f}: {pm(v, e)} (curve {c:.3g}, ×{v / c:.2f})"
                     for n, v, e, c in zip(strips["nu"][on], f, fe, curve[on], strict=True))
-                    + f"; weighted mean ratio ×{pm(mean, mean_err)}")
+                    + f"; weighted mean ratio ×{pm(mean, mean_err)} (its most precise strip "
+                    f"carries {100 * heaviest:.0f} % of the weight; {above} of {on.sum()} "
+                    "strips above the curve)")
         if not means:
             return Check(ref, statement, thesis, "; ".join(parts), NOT_RUN,
                          "no chute strip inside the cells' range of ν "
@@ -572,8 +576,10 @@ def lammps_cross_check(runs: Runs, edmd: str, lammps: str) -> Check:
                      "; ".join(rows), REPRODUCED if ok else PARTLY, own=True, reason=
                      "" if ok else "beyond 2σ + 5 %. Candidate causes: width/gap is "
                      f"{ratios[0]:.2f} in edmd (its width cannot shrink past touching discs) "
-                     f"against {ratios[1]:.2f} in LAMMPS (Campbell: 0.40); edmd's T depends "
-                     "on t_c here (13 % of collisions elastic; causes section); soft contacts "
+                     f"against {ratios[1]:.2f} in LAMMPS (Campbell: 0.40); edmd's T scatters "
+                     "between its runs at t_c = 1e-4, 1e-5 and 1e-6 with no order in t_c "
+                     "(13-14 % of collisions elastic at each: the causes section's table); "
+                     "soft contacts "
                      "(k_n, Coulomb-capped tangential spring) and the servo's time interval")
     check = guarded(ref, statement, "", runs, [edmd, lammps], body, own=True)
     check.runs = ()  # LAMMPS has no TC model: the comparison is evidence on it, not weakened

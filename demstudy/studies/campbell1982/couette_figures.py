@@ -105,6 +105,11 @@ def bagnold(points: dict[str, list[RunSummary]], out: Path,
     ``compared_up_to`` (the cells' ν range the row compares them in)."""
     fig, axes = plt.subplots(1, 2, figsize=(9, 5.6), sharey=True)
     for ax, key in zip(axes, ("f_s", "f_N"), strict=False):
+        cells = sorted((r for r in points.get("fixed gap, no-slip", [])
+                        if r.v("nu") <= compared_up_to), key=lambda r: r.v("nu"))
+        if chute and len(cells) > 1:  # the curve the chute strips are compared with
+            ax.plot([r.v("nu") for r in cells], [r.v(key) for r in cells], "--", color="0.5",
+                    lw=1, zorder=0, label="the cells' curve the strips are compared with")
         for name, strips in (chute or {}).items():
             if len(strips.get("nu", ())):
                 val, err = strips[key], 2 * strips[f"{key}_err"]
@@ -132,7 +137,8 @@ def bagnold(points: dict[str, list[RunSummary]], out: Path,
     fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=3,
                fontsize=7, bbox_to_anchor=(0.5, 0.05))
     fig.suptitle("Bagnold coefficients f_s(ν), f_N(ν), Campbell Figs 3.21-3.24 (±2σ; lower "
-                 "bars stop at 5 % of the value)", fontsize=10)
+                 "bars stop at 5 % of the value)\ntriangles: the 30° chute's strips (τ from its "
+                 "momentum balance; f is dimensionless in either flow's units)", fontsize=9.5)
     return _save(fig, out, "couette-f-nu.png", "f_s(ν) and f_N(ν) on a log axis, with and "
                  "without the π factor (cubic-spline du/dy; fixed gap: the engine's "
                  "collisional + kinetic strip stress; servo: the walls' stress)", bottom=0.22)
@@ -221,8 +227,9 @@ def energy_history(groups: Sequence[tuple[str, Sequence[tuple[str, RunSummary]]]
     """Fig 2.4: kinetic energy per disc over its production mean against the strain from the
     start of averaging (the last 100 strain units of the settling before it: the cells settle
     for different lengths), one panel per group, with Campbell's ±20 % band."""
-    fig, axes = plt.subplots(1, len(groups), figsize=(4.6 * len(groups), 4.4), sharey=True,
+    fig, axes = plt.subplots(1, len(groups), figsize=(4.6 * len(groups), 5.2), sharey=True,
                              squeeze=False)
+    tops = []
     for ax, (title, runs) in zip(axes[0], groups, strict=True):
         ax.axhspan(0.8, 1.2, color="0.92", zorder=0)
         longest = 0.0
@@ -234,16 +241,21 @@ def energy_history(groups: Sequence[tuple[str, Sequence[tuple[str, RunSummary]]]
                     label=f"{label} ({100 * r.v('ke_within'):.0f} % in band)")
             longest = max(longest, float(strain[-1]))
         ax.axvline(0.0, color="k", ls="--", lw=0.8)
+        tops += [float(np.nanmax(r.arrays["ke"][r.arrays["ke_strain"] - float(
+            r.arrays["ke_start"]) >= -SETTLING_SHOWN] / r.v("ke_mean"))) for _l, r in runs]
         ax.set(xlabel="strain γ̇(t − t_avg) from the start of averaging", title=title,
-               ylim=(0, 3.0), xlim=(-SETTLING_SHOWN, longest))
+               xlim=(-SETTLING_SHOWN, longest))
         ax.title.set_fontsize(9)
-        ax.legend(fontsize=7, loc="upper right", ncol=2 if len(runs) > 3 else 1)
+        # below the axes: the rough cells' energy swings through the whole panel
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2),
+                  ncol=2 if len(runs) > 3 else 1)
     axes[0][0].set_ylabel("kinetic energy per disc / production mean")
+    axes[0][0].set_ylim(0, max(2.0, 1.05 * max(tops, default=2.0)))  # shared: no spike cut
     fig.suptitle("Kinetic-energy history, Campbell Fig 2.4 (band: ±20 %; dashed: averaging "
                  "starts, t_avg)", fontsize=10)
     return _save(fig, out, "couette-energy.png", "Fig 2.4 form: total kinetic energy per "
                  "disc (translation + rotation, mean flow included) over its production mean "
-                 "against the strain, with Campbell's ±20 % band", bottom=0.07)
+                 "against the strain, with Campbell's ±20 % band", bottom=0.05)
 
 
 def angles(runs: Sequence[tuple[str, RunSummary]], out: Path) -> Figure:

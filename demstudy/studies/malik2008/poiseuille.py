@@ -10,6 +10,7 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts): speeds in √(
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
@@ -161,17 +162,20 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     for c in checks:  # a statement without runs says so, never crashes
         if c.verdict == NOT_RUN and not c.reason:
             c.reason = "its runs are not in this run of the study"
+        # the unsteady-run note (pc._steady_note) starts a sentence: end the one before it
+        c.reason = re.sub(r"([^.\s;:]) (The runs? β)", r"\1. \2", c.reason)
     figures = make_figures(data, Path(out), quick)
     if box is not None:
         shown = [box, *([data[pc.REF]] if pc.REF in data else [])]
-        path = profiles_figure(shown, ["N = 1000 in 37.4³ (Fig 2.11's system)",
-                                       "N = 2744 in 50³ (Ch. 3)"][: len(shown)],
-                               "Malik Fig 2.11: the validation flow, φ = 0.01, β = 0.99, "
-                               "e = 0.8", Path(out) / "poiseuille-validation.png",
+        path = profiles_figure(shown, ["N = 1000 in 37.4³, φ = 0.0100 (Fig 2.11's N)",
+                                       "N = 2744 in 50³, φ = 0.0115 (Ch. 3)"][: len(shown)],
+                               "Malik Fig 2.11: the validation flow, nominal φ = 0.01, "
+                               "β = 0.99, e = 0.8", Path(out) / "poiseuille-validation.png",
                                across=True)
         figures.insert(0, Figure(path, "Fig 2.11's form: U_x*, ω_z*, φ, T*, θ* and Kn "
-                                       "against y/W for the validation box (N = 1000) beside "
-                                       "Ch. 3's N = 2744 flow at the same φ, β, e."))
+                                       "against y/W for the validation box (N = 1000, φ = "
+                                       "0.0100) beside Ch. 3's N = 2744 flow (φ = 0.0115) at "
+                                       "the same β, e."))
     return Analysis(checks, figures, sections(data, runs, quick,
                                               [*twins, *([box] if box else [])]))
 
@@ -310,7 +314,9 @@ def sections(data: Runs, runs: Mapping[str, Path], quick: bool,
     lines = [UNITS_NOTE, "",
              "Event-driven hard spheres (the reference engine), the thesis's N and boxes "
              "(2744 in 50³, 24400 in 50³, 19600 in 20 × 50 × 20), 25 bins of 2 d across W = "
-             "50, K = 2/5, e_w = β_w = 1, g along +x. Collisions per particle = 2 N_pp/N "
+             "50; beside them Fig 2.11's validation box (N = 1000 in a 37.4 d cube at φ = "
+             "0.01, 25 bins of W/25) and the φ = 0.5 flow's TC twin at t_c = 10⁻⁶; K = 2/5, "
+             "e_w = β_w = 1, g along +x. Collisions per particle = 2 N_pp/N "
              "(wall collisions not counted). Fluctuations (T, θ, VDFs, Λ, C_aa) are taken "
              "relative to the run mean of each 2 d bin (Malik's number of z cells is not "
              "stated; the flows are homogeneous in z). Kn uses the free paths of the first "

@@ -161,7 +161,7 @@ def tc_twin_evidence(data: Runs, twins: Sequence[FlowData]
             info = twin.run_info()
             pairs.append((base.flow.name, twin_values(base), twin_values(twin),
                           info["tc_fraction"], info["tc"]))
-    return twin_evidence(pairs, TWIN_VALUES)
+    return twin_evidence(pairs, TWIN_VALUES, unit="√(d/g)")
 
 
 def tc_twin_rows(data: Runs, twins: Sequence[FlowData], wanted: Sequence) -> list[Check]:
@@ -202,6 +202,10 @@ def tc_twin_rows(data: Runs, twins: Sequence[FlowData], wanted: Sequence) -> lis
             reason += ("; the smaller t_c does not bring the share below 5 %: the elastic "
                        "collisions are plausibly the dense core's rapid re-collisions, which a "
                        "smaller t_c brings closer in time rather than removes (not measured)")
+        reason += ("; both runs start from the same state (the scene's seed), so the "
+                   "comparison isolates t_c; it covers only what the rows use: profiles, the "
+                   "centre's kurtosis, Λ and g at contact, not the correlations or the VDF "
+                   "tails")
         reason = (reason + "." + _steady_note([base, twin])).strip()
         out.append(Check(ref, statement, thesis, measured, verdict, reason, own=True))
     return out
@@ -256,7 +260,8 @@ def validation_checks(data: Runs, box: FlowData | None = None) -> list[Check]:
             continue
         measured, verdict, reason = fn(d)
         if box is not None:
-            measured = f"N = 1000 in {box.flow.side:.1f}³ (Fig 2.11's system): " + measured
+            measured = (f"N = 1000 in {box.flow.side:.1f}³ (Fig 2.11's N; the cube's side "
+                        "from φ = 0.01, not given in the thesis): " + measured)
         others = [x for (p, _b, _e), x in data.items() if p == 0.01 and x is not d]
         if others:
             holds = sum(fn(x)[1] == REPRODUCED for x in others)

@@ -248,7 +248,8 @@ def tc_row(tag: str) -> str:
 
 
 def tc_evidence(own_twin: Check | None = None, agreed: Sequence[str] = (), tag: str = "",
-                disagreed: Mapping[str, str] | None = None) -> tuple[bool, str]:
+                disagreed: Mapping[str, str] | None = None,
+                twin_shares: Mapping[str, float] | None = None) -> tuple[bool, str]:
     """What the TC twins say about a box, for the studies' one TC rule
     (:func:`..base.tc_caveats`): (whether its own twin exempts it, the evidence in words).
     ``own_twin``: the TC row of this box's own twin at a smaller t_c; "reproduced" (same
@@ -256,44 +257,54 @@ def tc_evidence(own_twin: Check | None = None, agreed: Sequence[str] = (), tag: 
     named. ``agreed`` and ``disagreed``: the tags of other boxes whose twins agreed, and
     those whose did not (tag → the twin row's verdict), named when the box has no twin of
     its own (none decides for this box). ``tag``: this box's tag, naming its twin's row;
-    without it the row is read off the twin's reference."""
+    without it the row is read off the twin's reference. ``twin_shares``: tag → the twin's
+    own TC share, which says why a "partly" twin row is one (its share, or its KE/N)."""
     if not tag and own_twin is not None:
         tag = own_twin.ref.split(" (")[0].removeprefix(tc_row(""))
     row = f"row \"{tc_row(tag)}\""
+    shares = twin_shares or {}
+
+    def kept(t: str) -> str:
+        share = shares.get(t, math.nan)
+        return (f"kept the class and the KE/N, but its own share ({100 * share:.1f} %) is above "
+                f"{100 * WARN_SHARE:g} %" if share > WARN_SHARE else
+                "kept the class but not the KE/N")
     if own_twin is not None and own_twin.verdict == REPRODUCED:
-        return True, (f"its twin at t_c = {TC_TWIN_TC:g} gives the same class and KE/N "
+        return True, (f"its twin at t_c = {TC_TWIN_TC:g} √(d/g) gives the same class and KE/N "
                       f"within 2σ + 5 % ({row}): the share does not change the structure "
                       "here")
     if own_twin is not None and own_twin.verdict in (PARTLY, NOT_REPRODUCED):
         found = ("changes the class, so the structure depends on the engine's TC model"
-                 if own_twin.verdict == NOT_REPRODUCED else "keeps the class, but its KE or "
-                 "share differ, so an effect of the TC model is not ruled out")
-        return False, f"its twin at t_c = {TC_TWIN_TC:g} {found} ({row})"
+                 if own_twin.verdict == NOT_REPRODUCED else
+                 kept(tag) + ", so an effect of the TC model is not ruled out")
+        return False, f"its twin at t_c = {TC_TWIN_TC:g} √(d/g) {found} ({row})"
     said = []
     if agreed:
         said.append(f"the TC twin{'s' * (len(agreed) > 1)} of {', '.join(agreed)} at "
                     f"t_c = {TC_TWIN_TC:g} kept {'their' if len(agreed) > 1 else 'its'} "
                     "class")
-    for verdict, what in ((NOT_REPRODUCED, "changed the class"),
-                          (PARTLY, "kept the class but not the KE/N or a small share")):
-        tags = [t for t, v in (disagreed or {}).items() if v == verdict]
-        if tags:
-            said.append(f"the TC twin{'s' * (len(tags) > 1)} of {', '.join(tags)} {what}")
+    changed = [t for t, v in (disagreed or {}).items() if v == NOT_REPRODUCED]
+    if changed:
+        said.append(f"the TC twin{'s' * (len(changed) > 1)} of {', '.join(changed)} changed "
+                    "the class")
+    said += [f"the TC twin of {t} {kept(t)}" for t, v in (disagreed or {}).items()
+             if v == PARTLY]
     return False, ("" if not said else
                    f"{'; '.join(said)}: rows \"TC model\"; this box's share is not tested")
 
 
 def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
               agreed: Sequence[str] = (), tag: str = "",
-              disagreed: Mapping[str, str] | None = None) -> Check:
+              disagreed: Mapping[str, str] | None = None, label: str = "",
+              twin_shares: Mapping[str, float] | None = None) -> Check:
     """``check`` of a box run under the studies' one TC rule (:func:`..base.tc_caveats`):
     above WARN_SHARE the share in the reason and an agreement "partly" (a mismatch stays,
     the TC model one possible cause) unless the box's own twin exempts it; the twins'
     evidence (:func:`tc_evidence`) quoted."""
     from ..base import tc_caveats as rule
 
-    name = tag or "this box"
-    exempt, text = tc_evidence(own_twin, agreed, tag, disagreed)
+    name = label or tag or "this box"  # label: the box with its e where it is not 0.7
+    exempt, text = tc_evidence(own_twin, agreed, tag, disagreed, twin_shares)
     check.runs = (name,)
     rule([check], {name: (run.tc_fraction, DEFAULT_TC)}, {name: text} if exempt else {},
          {name: text} if text and not exempt else {}, unit="√(d/g)")
@@ -526,7 +537,7 @@ def peak_check(measured: Mapping[str, RunWaves]) -> Check:
 def _run_table(measured: Mapping[str, RunWaves]) -> str:
     head = ("| case | N | c/p analysed | c/p per √(d/g) | class | dominant xy | stationary | "
             "max drift | dissipation/input | peak φ (2 d / 5 d cells) | close-packed | "
-            "TC elastic fraction | engine wall time (s) |\n"
+            "TC-elastic share | engine wall time (s) |\n"
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     rows = []
     for name, run in measured.items():
@@ -537,7 +548,7 @@ def _run_table(measured: Mapping[str, RunWaves]) -> str:
             f"{run.modes.pattern} | {', '.join(str(k) for k in run.modes.dominant('xy'))} | "
             f"{'yes' if run.stationary else 'no'} | {drift} | {pm(*run.balance)} | "
             f"{pm(*run.peak)} / {pm(*run.peak_coarse)} | {100 * run.close_packed:.1f} % | "
-            f"{run.tc_fraction:.1e} | {run.wall_seconds:.0f} |")
+            f"{_share(run)} | {run.wall_seconds:.0f} |")
     return head + "\n".join(rows)
 
 
@@ -637,6 +648,8 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
                                           or failed.get(box.name, ""))
         if twin is not None:
             table[twin_name(box)] = twin
+    twin_shares = {b.tag: table[twin_name(b)].tc_fraction for b in twin_boxes()
+                   if twin_name(b) in table}
     agreed = [b.tag for b in twin_boxes()
               if b.name in tc_rows and tc_rows[b.name].verdict == REPRODUCED]
     disagreed = {b.tag: tc_rows[b.name].verdict for b in twin_boxes() if b.name in tc_rows
@@ -647,11 +660,23 @@ def analyse_waves(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
             ana.checks.append(class_check(box, None, failed.get(box.name) or
                                           "run missing; " + _forecast(box, quick, costs)))
             continue
-        for check in (class_check(box, run), steady_check(box, run)):
+        label = box.tag + ("" if box.restitution == RESTITUTION
+                           else f", e = {box.restitution:g}")
+        shape = class_check(box, run)
+        twin = table.get(twin_name(box)) if box.name in tc_rows else None
+        thesis = THESIS.get(box.fig)
+        if twin is not None and thesis is not None and thesis.time is not None:
+            # the twin with the smaller share: when its structure forms, by the same readings
+            seen = first_seen_text(twin, thesis.cls, thesis.time).strip(" ()")
+            if seen:
+                shape.reason = (shape.reason.rstrip(".") + f". Its TC twin at t_c = "
+                                f"{TC_TWIN_TC:g} √(d/g) ({100 * twin.tc_fraction:.1f} % "
+                                f"elastic): {seen}")
+        for check in (shape, steady_check(box, run)):
             ana.checks.append(tc_caveat(check, run, tc_rows.get(box.name),
                                         [t for t in agreed if t != box.tag], box.tag,
                                         {t: v for t, v in disagreed.items()
-                                         if t != box.tag}))
+                                         if t != box.tag}, label, twin_shares))
         path = run_figure(run, box, out / f"{box.name.removesuffix('-edmd')}.png")
         ana.figures.append(Figure(path, f"Fig {box.fig}'s form: N = {box.n} in {box.tag}, "
                                         f"e = {box.restitution:g}: positions, density "
