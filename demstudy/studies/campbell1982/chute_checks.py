@@ -24,6 +24,7 @@ from ..base import (
     within,
 )
 from .chute_measure import ChuteRun, basal_layer, centre_plug
+from .couette_measure import logged_fraction
 
 NU_SQUARE = math.pi / 4
 #: ν_m: the densest shearable packing, layers following contours (L1093)
@@ -342,12 +343,6 @@ def c3_basal_layer(runs: Mapping[str, ChuteRun]) -> Check:
                  "steady 30° bumpy bed for contrast): " + ", ".join(met))
 
 
-def _logged_share(window: tuple[float, float, float, float]) -> float:
-    from .couette_measure import logged_fraction
-
-    return logged_fraction(window)
-
-
 def c9_angles(runs: Mapping[str, ChuteRun]) -> Check:
     """C9: the 40° chute's collision-angle distribution (Fig 3.33), read as the Couette cells'
     (Fig 3.32): anisotropic, the approach quadrant preferred. The digest gives no values."""
@@ -373,7 +368,7 @@ def c9_angles(runs: Mapping[str, ChuteRun]) -> Check:
         if name.startswith("chute-40"):
             ok.append(share - 0.5 > 2 * err)
     verdict = REPRODUCED if all(ok) else PARTLY if any(ok) else NOT_REPRODUCED
-    short = [n for n in have if _logged_share(runs[n].angles["window"]) < 0.99]
+    short = [n for n in have if logged_fraction(runs[n].angles["window"]) < 0.99]
     reason = ("criterion: share − ½ beyond 2σ (isotropic collisions give ½); the 40° beds "
               "accelerate (row C3), so this is the distribution of a transient, as the "
               "thesis's own 40° bed was; the steady 30° bumpy bed beside it"

@@ -60,7 +60,7 @@ def _mean(v: np.ndarray, e: np.ndarray) -> tuple[float, float]:
 
 
 def _tag(d: FlowData) -> str:
-    twin = "" if getattr(d.flow, "tc", None) is None else f", t_c = {d.flow.tc:g}"
+    twin = "" if d.flow.tc is None else f", t_c = {d.flow.tc:g}"
     return f"β = {d.flow.beta:g}, e = {d.flow.e:g}{twin}"
 
 
