@@ -321,7 +321,7 @@ def test_the_reference_chutes_twins_are_quoted_when_their_shares_are_large(accel
             "chute-30-bumpy-tc1e-4": dataclasses.replace(run, tc=1e-4, tc_share=0.079),
             "chute-30-bumpy-tc1e-6": dataclasses.replace(run, tc=1e-6, tc_share=0.335)}
     quoted = tc_quoted(runs)["chute-30-bumpy"]
-    assert quoted.startswith("its twins at t_c = 0.0001 (7.9 %) and 1e-06 (33.5 %) √(d/g) "
-                             "give the same u_max, KE/N and H within 2σ + 10 %")
+    assert quoted.startswith("the twins of chute-30-bumpy at t_c = 0.0001 (7.9 %) and 1e-06 "
+                             "(33.5 %) √(d/g) give the same u_max, KE/N and H within 2σ + 10 %")
     runs["chute-30-bumpy-tc1e-6"] = dataclasses.replace(run, tc=1e-6, tc_share=0.02)
     assert tc_quoted(runs) == {}

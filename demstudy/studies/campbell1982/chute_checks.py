@@ -677,7 +677,7 @@ def tc_quoted(runs: Mapping[str, ChuteRun]) -> dict[str, str]:
         return {}  # a small-share twin decides (tc_unchanged), or its row says it differs
     same = all(_same(a, r, spread)[0] == 2 for r in twins)
     listed = " and ".join(f"{r.tc:g} ({100 * r.tc_share:.1f} %)" for r in twins)
-    return {"chute-30-bumpy": f"its twins at t_c = {listed} √(d/g) give "
+    return {"chute-30-bumpy": f"the twins of chute-30-bumpy at t_c = {listed} √(d/g) give "
                               + ("the same u_max, KE/N and H within 2σ + 10 %"
                                  if same else "other u_max, KE/N or H")
                               + ", but neither has a share below 5 % (row 'TC model')"}
