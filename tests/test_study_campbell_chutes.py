@@ -212,7 +212,7 @@ def _with_angles(run, approach: float):
     theta = (np.arange(50) + 0.5) * math.pi / 50
     p = np.where(theta > math.pi / 2, 2 * approach, 2 * (1 - approach)) / math.pi
     err = np.full(50, 0.01)
-    from demstudy.studies.campbell1982.couette_measure import approach_share
+    from demstudy.studies.campbell1982.collision_log import approach_share
 
     return dataclasses.replace(run, angles={"theta": theta, "p": p, "p_err": err,
                                             "collisions": 1e4,

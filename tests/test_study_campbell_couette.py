@@ -304,7 +304,7 @@ def test_chute_strips_are_compared_with_the_cells_f_curve() -> None:
 
 
 def test_the_angle_rows_say_how_much_of_the_production_the_log_spans() -> None:
-    from demstudy.studies.campbell1982.couette_measure import logged_fraction
+    from demstudy.studies.campbell1982.collision_log import logged_fraction
 
     assert logged_fraction((50.0, 99.0, 50.0, 400.0)) == pytest.approx(49 / 350)
     runs = {n: RunSummary(n, values={"approach_share": (0.8, 0.01)},

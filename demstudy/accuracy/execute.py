@@ -38,17 +38,25 @@ class Task:
         return scene_for(base, self.spec)
 
 
+def wanted_tc(engine: str, options: Mapping[str, Any] | None) -> float | None:
+    """The TC time a run of ``engine`` with ``options`` is made at: the ``tc`` option, else
+    the event-driven engine's default; None for engines without a TC model."""
+    if engine != "edmd":
+        return None
+    from ..engines.edmd.core import DEFAULT_TC
+
+    return float((options or {}).get("tc", DEFAULT_TC))
+
+
 def option_mismatch(attrs: Mapping[str, Any], engine: str,
                     options: Mapping[str, Any] | None) -> str | None:
     """Why a finished run (its results file's root ``attrs``) is not the run of ``engine``
     with ``options``, for the engine options that change the physics (None: it is): the
     event-driven engine's t_c (the option, else the engine's default). A file that does not
     record it (older than the attribute) cannot tell, and passes."""
-    if engine != "edmd" or attrs.get("tc") is None:
+    wanted = wanted_tc(engine, options)
+    if wanted is None or attrs.get("tc") is None:
         return None
-    from ..engines.edmd.core import DEFAULT_TC
-
-    wanted = float((options or {}).get("tc", DEFAULT_TC))
     made = float(attrs["tc"])
     if math.isclose(made, wanted, rel_tol=1e-9):
         return None

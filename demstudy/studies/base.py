@@ -196,7 +196,7 @@ def twin_evidence(pairs: Sequence[tuple[str, Mapping, Mapping, float, float]],
         same, _text, off = twin_comparison(base, twin, labels)
         found = (f"the twin of {name} at t_c = {tc:g} {unit} ({100 * share:.1f} % elastic) "
                  "gives "
-                 + ("the same values within 2σ + 10 %" if same else
+                 + (f"the same values within 2σ + {100 * TWIN_TOLERANCE:.0f} %" if same else
                     "other values (" + ", ".join(off) + ")"))
         if same and share < WARN_SHARE:
             unchanged[name] = found

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ..accuracy.execute import wanted_tc
 from ..errors import BadOption, EngineError
 from .base import Analysis, Case, Study
 
@@ -219,7 +220,7 @@ class _Forecasts:
             self.again[like.name] = _bound_now(like, task.path.parent)
         ratio = like.wall / self.again[like.name]
         self.seconds[task.case.name] = float(s) * ratio
-        tc = _tc(task.case.engine, task.case.options)
+        tc = wanted_tc(task.case.engine, task.case.options)
         other = like.tc is not None and tc is not None and not math.isclose(like.tc, tc)
         self.other_tc = self.other_tc or other
         self.lines.append(
@@ -279,14 +280,6 @@ def finished_runs(paths: Mapping[str, Path]) -> list[Took]:
     return took
 
 
-def _tc(engine: str, options: Mapping[str, Any]) -> float | None:
-    if engine != "edmd":
-        return None
-    from ..engines.edmd import DEFAULT_TC
-
-    return float(options.get("tc", DEFAULT_TC))
-
-
 def calibration(scene, engine: str, finished: Sequence[Took],
                 options: Mapping[str, Any] | None = None) -> Took | None:
     """The made run that says how far ``scene``'s lower bound falls short: the same engine,
@@ -303,7 +296,7 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     study's lower-bound runs the shortfall spans ×1.0–68 (docs/forecast.md)."""
     from ..simulation.forecast_events import drive, family_distance, similar_fraction
 
-    tc = _tc(engine, options or {})
+    tc = wanted_tc(engine, options or {})
     if not scene.solid_fraction > 0:
         return None
     like = [t for t in finished if t.engine == engine and drive(t.scene) == drive(scene)

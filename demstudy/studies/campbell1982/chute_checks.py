@@ -24,7 +24,7 @@ from ..base import (
     within,
 )
 from .chute_measure import ChuteRun, basal_layer, centre_plug
-from .couette_measure import logged_fraction
+from .collision_log import logged_fraction
 
 NU_SQUARE = math.pi / 4
 #: ν_m: the densest shearable packing, layers following contours (L1093)

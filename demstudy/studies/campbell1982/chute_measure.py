@@ -211,7 +211,7 @@ def collision_angles(res: Any) -> dict[str, Any]:
     the log holds the production's first 2·10⁵ collisions, walls included) and the share in
     its two ``halves``. Empty when the run kept no collision log (``measure.statistics``
     without ``angles``)."""
-    from .couette_measure import approach_share, log_window
+    from .collision_log import approach_share, log_window
 
     ang = res.groups.get("statistics/angles")
     if ang is None or "p_text" not in ang:

@@ -17,7 +17,8 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from ..base import NOT_REPRODUCED, NOT_RUN, PARTLY, REPRODUCED, Check, not_run, pm
-from .couette_measure import RunSummary, logged_fraction
+from .collision_log import logged_fraction
+from .couette_measure import RunSummary
 
 Runs = dict[str, RunSummary]
 

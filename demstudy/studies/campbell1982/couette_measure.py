@@ -37,6 +37,7 @@ from ...analysis.blocking import split_mean
 from ...analysis.profiles import ProfileAnalysis
 from ...analysis.steady import energy_trend
 from ...io.results import read_results
+from .collision_log import approach_share, log_window_of
 
 #: bins closer than this (d) to a wall are left out of the centre averages
 WALL_SKIP = 2.0
@@ -152,7 +153,7 @@ def summarise(name: str, path: Path) -> RunSummary:
     _distributions(out, res, (float(edges[0]), float(edges[-1])) if not servo else
                    (float(res.profiles["edges"][0]), float(res.profiles["edges"][-1])))
     _energy_history(out, ts, keep, n, u_t)
-    out.attrs["log_window"] = _log_window_of(path, res)
+    out.attrs["log_window"] = log_window_of(path, res)
     if res.frames and "position" in res.frames:  # the last frame: Fig 2.3's snapshot
         out.arrays.update(snapshot=np.asarray(res.frames["position"][-1], float),
                           snapshot_radius=np.asarray(res.frames["radius"][-1], float),
@@ -190,9 +191,8 @@ def _energy_history(out: RunSummary, ts: dict, keep: np.ndarray, n: int, u_t: fl
     if "dissipated_energy" in ts:
         # a thermal indicator: the mean flow carries ≈ 98 % of a no-slip cell's energy, the
         # dissipation rate (collisions × their energy loss) only the fluctuations'
-        rate_t, rate = _block_rates(prod_t, np.asarray(ts["dissipated_energy"], float)[keep])
-        out.values["dissipation_trend"] = (energy_trend(rate_t, rate),
-                                           trend_error(rate_t, rate))
+        mid_t, loss = _block_rates(prod_t, np.asarray(ts["dissipated_energy"], float)[keep])
+        out.values["dissipation_trend"] = (energy_trend(mid_t, loss), trend_error(mid_t, loss))
     out.values["ke_within"] = (float(np.mean(np.abs(prod_e / prod_e.mean() - 1.0) <= BAND)),
                                0.0)
     out.values["ke_mean"] = split_mean(prod_e)
@@ -344,41 +344,6 @@ def _block_rates(t: np.ndarray, cumulative: np.ndarray) -> tuple[np.ndarray, np.
     rates)."""
     idx = np.linspace(0, t.size - 1, min(RATE_BLOCKS, t.size - 1) + 1).astype(int)
     return 0.5 * (t[idx][1:] + t[idx][:-1]), np.diff(cumulative[idx]) / np.diff(t[idx])
-
-
-def _log_window_of(path: Path, res: Any) -> tuple[float, float, float, float]:
-    """:func:`log_window` of a file read without its log (its times alone, from the file)."""
-    import h5py
-
-    with h5py.File(path, "r") as f:
-        times = f["collisions/time"][...] if "collisions/time" in f else np.zeros(0)
-    return log_window(times, res)
-
-
-def log_window(times: np.ndarray, res: Any) -> tuple[float, float, float, float]:
-    """(first, last logged collision time, start, end of the production) of a run whose log
-    holds ``times``: the engine keeps the production's first 2·10⁵ collisions
-    (demstudy.engines.backend.LOG_CAPACITY, wall collisions included), so a long run's
-    collision statistics cover only its start. NaN for the window without a log."""
-    t = np.asarray(times, float)
-    end = float(np.asarray(res.timeseries["time"], float)[-1]) if res.timeseries else math.nan
-    start = float(res.attrs.get("equilibration_end", 0.0))
-    if t.size == 0:
-        return math.nan, math.nan, start, end
-    return float(t.min()), float(t.max()), start, end
-
-
-def logged_fraction(window: tuple[float, float, float, float]) -> float:
-    """The share of the production its collision log spans."""
-    _t0, t1, start, end = window
-    return (t1 - start) / (end - start) if end > start else math.nan
-
-
-def approach_share(p: np.ndarray, err: np.ndarray, theta: np.ndarray) -> tuple[float, float]:
-    """Share of collisions with θ (text convention) in the approach quadrant 90°-180°."""
-    width = math.pi / theta.size
-    sel = theta > math.pi / 2
-    return float(np.sum(p[sel]) * width), float(np.sqrt(np.sum(err[sel] ** 2)) * width)
 
 
 def _layering(r: np.ndarray, normal: np.ndarray, err: np.ndarray) -> tuple[float, float]:
