@@ -36,7 +36,7 @@ import numpy as np
 
 import demstudy as ds
 from demstudy.analysis.steady import energy_trend, is_steady
-from demstudy.engines.edmd import DEFAULT_TC
+from demstudy.engines.edmd import DEFAULT_TC_2D
 from demstudy.io.results import write_atomically
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -343,7 +343,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="4 short runs (about 1 minute)")
     parser.add_argument("--redraw", action="store_true", help="only the figure, from docs/data")
-    parser.add_argument("--tc", type=float, default=DEFAULT_TC,
+    parser.add_argument("--tc", type=float, default=DEFAULT_TC_2D,
                         help="TC-model time of the event-driven engine (default %(default)g); "
                              "another value is a sensitivity check, written to "
                              "results/chute-angles-tc<tc>/ only")
@@ -366,9 +366,9 @@ def main(argv: list[str] | None = None) -> int:
         selected = [Case(c.angle, c.base, args.duration or c.duration, args.seed)
                     for c in selected]
     partial = (args.quick or args.angles or args.duration or args.seed is not None
-               or args.tc != DEFAULT_TC)
+               or args.tc != DEFAULT_TC_2D)
     name = "chute-angles" + ("-quick" if args.quick else "") + (
-        f"-tc{args.tc:g}" if args.tc != DEFAULT_TC else "") + (
+        f"-tc{args.tc:g}" if args.tc != DEFAULT_TC_2D else "") + (
         "-some" if args.angles or args.duration else "") + (
         f"-seed{args.seed}" if args.seed is not None else "")
     out = ROOT / "results" / name

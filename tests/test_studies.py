@@ -595,11 +595,18 @@ def test_a_run_at_another_t_c_is_not_taken_for_the_case(tmp_path):
     from demstudy.scene import load_scene, scene_to_toml
     from demstudy.studies.records import why_not_current
 
-    assert option_mismatch({"tc": 1e-5}, "edmd", {}) is None  # the default
-    assert option_mismatch({"tc": 1e-5}, "edmd", {"tc": 1e-6}) == (
+    discs, spheres = {"scene_toml": "dimension = 2\n"}, {"scene_toml": "dimension = 3\n"}
+    assert option_mismatch({"tc": 1e-5, **discs}, "edmd", {}) is None  # the 2D default
+    assert option_mismatch({"tc": 1e-6, **spheres}, "edmd", {}) is None  # the 3D default
+    # a 3D run made before the default for spheres became 1e-6 is not today's default run
+    assert option_mismatch({"tc": 1e-5, **spheres}, "edmd", {}) == (
         "made at t_c = 1e-05, the run asks for t_c = 1e-06")
-    assert option_mismatch({}, "edmd", {"tc": 1e-6}) is None
-    assert option_mismatch({"tc": 1e-5}, "lammps", {"tc": 1e-6}) is None
+    assert option_mismatch({"tc": 1e-5, **spheres}, "edmd", {"tc": 1e-5}) is None
+    assert option_mismatch({"tc": 1e-5, **discs}, "edmd", {"tc": 1e-6}) == (
+        "made at t_c = 1e-05, the run asks for t_c = 1e-06")
+    assert option_mismatch(discs, "edmd", {"tc": 1e-6}) is None  # older than the attribute
+    assert option_mismatch({"tc": 1e-5}, "edmd", {"tc": 1e-6}) is None  # no scene: can't tell
+    assert option_mismatch({"tc": 1e-5, **discs}, "lammps", {"tc": 1e-6}) is None
     scene = load_scene("campbell1982/couette-rough", ["run.equilibration=0",
                                                       "run.production=2"])
     path = tmp_path / "cell.h5"

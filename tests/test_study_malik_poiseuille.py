@@ -147,7 +147,8 @@ def tiny_run(tmp_path_factory):
                               "sample_interval": 2.0}})
     out = tmp_path_factory.mktemp("poiseuille")
     path = out / "runs" / f"{flow.name}.h5"
-    run(load_scene(case.scene, **sections), engine="edmd", out=path, progress=False)
+    run(load_scene(case.scene, **sections), engine="edmd", out=path, progress=False,
+        **case.options)  # the study's t_c, 1e-5 (its records'), not the 3D default
     return flow, path, out
 
 

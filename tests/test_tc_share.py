@@ -68,3 +68,28 @@ def test_tc_off_and_no_collisions():
     assert math.isnan(empty.fraction) and empty.warning() is None
     assert "no pair collisions" in empty.line()
     assert TcShare(6, 100, 1e-4).warning() and TcShare(5, 100, 1e-4).warning() is None
+
+
+# the dense sheared spheres of the accuracy study (φ = 0.55, e = 0.9, β = 0.5, N = 1050),
+# shortened: 3 + 5 strain units
+DENSE_SHEAR = ["run", "inputs/accuracy-cost/lees-edwards-3d-phi0.55.toml", "--engine", "edmd",
+               "-q", "--set", "run.equilibration=3", "--set", "run.production=5"]
+
+
+def test_default_tc_is_1e6_for_spheres_and_1e5_for_discs(tmp_path, capfd):
+    """Without --tc a 3D run is made at t_c = 1e-6 and a 2D one at 1e-5 (the results say so);
+    --tc overrides either. In dense sheared spheres the 3D default is what keeps the elastic
+    share small: 1e-5 makes several times more collisions elastic (≈ 2 % against ≈ 0.3 %
+    over a long run; benchmarks/bench_tc_choice.py, docs/edmd-engine.md)."""
+    from demstudy.engines.edmd import default_tc
+
+    assert (default_tc(3), default_tc(2)) == (1e-6, 1e-5)
+    spheres, err = run(DENSE_SHEAR, tmp_path, capfd)
+    assert spheres.attrs["tc"] == 1e-6 and "t_c = 1e-06" in err
+    small = spheres.attrs["tc_elastic_fraction"]
+    discs, _ = run(DENSE, tmp_path, capfd)
+    assert discs.attrs["tc"] == 1e-5
+    older, _ = run([*DENSE_SHEAR, "--tc", "1e-5"], tmp_path, capfd)
+    assert older.attrs["tc"] == 1e-5
+    larger = older.attrs["tc_elastic_fraction"]
+    assert 0.0 < small < 0.01 and 3 * small < larger < 0.2, (small, larger)

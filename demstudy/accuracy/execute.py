@@ -38,23 +38,36 @@ class Task:
         return scene_for(base, self.spec)
 
 
-def wanted_tc(engine: str, options: Mapping[str, Any] | None) -> float | None:
-    """The TC time a run of ``engine`` with ``options`` is made at: the ``tc`` option, else
-    the event-driven engine's default; None for engines without a TC model."""
+def wanted_tc(engine: str, options: Mapping[str, Any] | None, dimension: int) -> float | None:
+    """The TC time a run of ``engine`` with ``options`` in a ``dimension``-D scene is made at:
+    the ``tc`` option, else the event-driven engine's default for that dimension
+    (``engines.edmd.core.default_tc``); None for engines without a TC model."""
     if engine != "edmd":
         return None
-    from ..engines.edmd.core import DEFAULT_TC
+    from ..engines.edmd.core import default_tc
 
-    return float((options or {}).get("tc", DEFAULT_TC))
+    return float((options or {}).get("tc", default_tc(dimension)))
+
+
+def _dimension(attrs: Mapping[str, Any]) -> int | None:
+    """The dimension of the scene a results file's root ``attrs`` hold (None: unreadable)."""
+    import tomllib
+
+    try:
+        return int(tomllib.loads(str(attrs["scene_toml"]))["dimension"])
+    except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
+        return None
 
 
 def option_mismatch(attrs: Mapping[str, Any], engine: str,
                     options: Mapping[str, Any] | None) -> str | None:
     """Why a finished run (its results file's root ``attrs``) is not the run of ``engine``
     with ``options``, for the engine options that change the physics (None: it is): the
-    event-driven engine's t_c (the option, else the engine's default). A file that does not
-    record it (older than the attribute) cannot tell, and passes."""
-    wanted = wanted_tc(engine, options)
+    event-driven engine's t_c (the option, else the engine's default for the scene's
+    dimension). A file that does not record it (older than the attribute) or its scene cannot
+    tell, and passes."""
+    dimension = _dimension(attrs)
+    wanted = None if dimension is None else wanted_tc(engine, options, dimension)
     if wanted is None or attrs.get("tc") is None:
         return None
     made = float(attrs["tc"])

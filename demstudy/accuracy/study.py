@@ -227,7 +227,7 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
     study = CostStudy(folder, scale.definition, [], {}, tolerance, None, "",
                       scale_label=scale.label)
 
-    from ..engines.edmd.core import DEFAULT_TC
+    from ..engines.edmd.core import default_tc
 
     if max(replicas, reference_replicas) > 1:
         top = scene.run.seed + max(replicas, reference_replicas) - 1
@@ -237,7 +237,8 @@ def cost(scene: Scene | str | os.PathLike, *, kstars: Sequence[float] | None = N
         study.notes.append(f"replicas: {reference_replicas} per reference, {replicas} per soft "
                            f"run (seeds {scene.run.seed}, {scene.run.seed + 1}, …); errors "
                            "from their scatter, cost = the SUM of their wall times")
-    refs = [replicate([r], reference_replicas) for r in reference_ladder(DEFAULT_TC)]
+    refs = [replicate([r], reference_replicas)
+            for r in reference_ladder(default_tc(scene.dimension))]
     softs = [replicate([s], replicas) for s in soft_ladder(kstars, steps, models, engines)
              if (s.engine, s.model) not in left_out]
     for (engine, model), why in left_out.items():

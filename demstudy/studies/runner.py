@@ -220,7 +220,7 @@ class _Forecasts:
             self.again[like.name] = _bound_now(like, task.path.parent)
         ratio = like.wall / self.again[like.name]
         self.seconds[task.case.name] = float(s) * ratio
-        tc = wanted_tc(task.case.engine, task.case.options)
+        tc = wanted_tc(task.case.engine, task.case.options, task.scene().dimension)
         other = like.tc is not None and tc is not None and not math.isclose(like.tc, tc)
         self.other_tc = self.other_tc or other
         self.lines.append(
@@ -296,7 +296,7 @@ def calibration(scene, engine: str, finished: Sequence[Took],
     study's lower-bound runs the shortfall spans ×1.0–68 (docs/forecast.md)."""
     from ..simulation.forecast_events import drive, family_distance, similar_fraction
 
-    tc = wanted_tc(engine, options or {})
+    tc = wanted_tc(engine, options or {}, scene.dimension)
     if not scene.solid_fraction > 0:
         return None
     like = [t for t in finished if t.engine == engine and drive(t.scene) == drive(scene)

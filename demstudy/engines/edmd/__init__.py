@@ -8,8 +8,15 @@ backend. See docs/edmd-engine.md.
 """
 
 from .backend import EdmdBackend, with_bumps, y_range
-from .core import DEFAULT_TC, EventDriven, collide_pair, from_initial_state
+from .core import (
+    DEFAULT_TC_2D,
+    DEFAULT_TC_3D,
+    EventDriven,
+    collide_pair,
+    default_tc,
+    from_initial_state,
+)
 from .effects import core_options
 
-__all__ = ["DEFAULT_TC", "EdmdBackend", "EventDriven", "collide_pair", "core_options",
-           "from_initial_state", "with_bumps", "y_range"]
+__all__ = ["DEFAULT_TC_2D", "DEFAULT_TC_3D", "EdmdBackend", "EventDriven", "collide_pair",
+           "core_options", "default_tc", "from_initial_state", "with_bumps", "y_range"]

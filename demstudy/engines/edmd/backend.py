@@ -27,7 +27,7 @@ from ...scene import Scene
 from ...scene.initial import InitialState, build_initial_state
 from ..backend import BackendBase, Capabilities, EngineOption, Needs
 from ..peculiar import peculiar_observables
-from .core import DEFAULT_TC, EventDriven, advance_watched, from_initial_state
+from .core import EventDriven, advance_watched, default_tc, from_initial_state
 from .effects import TRANSLATIONS, core_options
 from .tc_share import TcShare, tc_share
 
@@ -90,10 +90,11 @@ class EdmdBackend(BackendBase):
     capabilities = Capabilities(collision_count=True, collision_log=True, stress="collisional")
     translations = TRANSLATIONS
     options = {
-        "tc": EngineOption("tc", float, "TC-model time t_c (default 1e-5; 0 = off). A collision "
-                           "within t_c of a partner's previous one is elastic, and a particle "
-                           "resting on a wall hops with period t_c: a resting bed costs ~1/t_c "
-                           "events per particle and time unit (docs/edmd-engine.md)",
+        "tc": EngineOption("tc", float, "TC-model time t_c (default 1e-6 for spheres, 1e-5 "
+                           "for discs; 0 = off). A collision within t_c of a partner's previous "
+                           "one is elastic, and a particle resting on a wall hops with period "
+                           "t_c: a resting bed costs ~1/t_c events per particle and time unit "
+                           "(docs/edmd-engine.md)",
                            _tc_problem, "TIME"),
         "log_every": EngineOption("log_every", int, "log every k-th collision in /collisions "
                                   "(default: 1 when a statistic needs the log, else none)",
@@ -117,7 +118,7 @@ class EdmdBackend(BackendBase):
 
     def __init__(self, scene: Scene, options, workdir):
         super().__init__(scene, options, workdir)
-        self.tc = float(options.extra.get("tc", DEFAULT_TC))
+        self.tc = float(options.extra.get("tc", default_tc(scene.dimension)))
         # whether a collision can lose energy: with t_c = 0 a stall is then inelastic collapse
         self.dissipative = (scene.contact.restitution < 1.0
                             or scene.contact.law.model != "constant"

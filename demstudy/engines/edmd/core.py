@@ -26,7 +26,9 @@ I = K m r². So g_n' = −e g_n, g_t' = −β g_t, and for equal masses
 
 Inelastic collapse: the TC model (Luding & McNamara 1998). A collision in which either
 partner had its previous collision less than ``tc`` earlier is elastic (e = 1, no tangential
-impulse). ``DEFAULT_TC`` = 1e-5 time units (the engine's default; 0 disables the model).
+impulse). The default t_c depends on the dimension (:func:`default_tc`): 1e-6 time units for
+spheres (``DEFAULT_TC_3D``), 1e-5 for discs (``DEFAULT_TC_2D``); 0 disables the model. Why
+these, measured: docs/edmd-engine.md ("Why these t_c") and benchmarks/bench_tc_choice.py.
 """
 
 from __future__ import annotations
@@ -40,14 +42,26 @@ from ..._native import EventDriven, edmd_collide_pair
 from ...errors import EngineError
 from ...scene.initial import InitialState
 
-DEFAULT_TC = 1e-5
+#: the TC time of 3D runs: dense sheared spheres keep the elastic share below 1-6 % and their
+#: pressure converged (φ = 0.55 shear: P 42.0 ± 0.9 at 1e-5, 47.1 ± 1.3 at 1e-6, 46.1 ± 1.7
+#: at 1e-7) at ×1.0-2.1 the cost of 1e-5; a bed at rest costs ~1/t_c events per particle
+DEFAULT_TC_3D = 1e-6
+#: the TC time of 2D runs: in dense 2D flows a smaller t_c raised the share instead (the
+#: elastic collisions are a cluster's re-collisions) and cost ×7 (Campbell's chute)
+DEFAULT_TC_2D = 1e-5
 # events between two synchronisations and checks for a stop request; the simulated time's
 # progress is checked over windows of at least STALL_CHUNK and STALL_CHUNK_PER_PARTICLE × N
 STALL_CHUNK = 10_000_000
 STALL_CHUNK_PER_PARTICLE = 1000
 
-__all__ = ["DEFAULT_TC", "STALL_CHUNK", "EventDriven", "advance_watched", "collide_pair",
-           "from_initial_state", "stall_message"]
+__all__ = ["DEFAULT_TC_2D", "DEFAULT_TC_3D", "STALL_CHUNK", "EventDriven", "advance_watched",
+           "collide_pair", "default_tc", "from_initial_state", "stall_message"]
+
+
+def default_tc(dimension: int) -> float:
+    """The TC time t_c of a run without the ``tc`` option: ``DEFAULT_TC_3D`` (1e-6) for
+    spheres, ``DEFAULT_TC_2D`` (1e-5) for discs, in the scene's time unit."""
+    return DEFAULT_TC_3D if dimension == 3 else DEFAULT_TC_2D
 
 
 def collide_pair(n, ri, rj, mi, mj, inertia_k, e, beta, vi, vj, wi, wj):
@@ -155,9 +169,10 @@ def stall_message(core: EventDriven, window: _Window, tc: float, dissipative: bo
         return head + (f"This is inelastic collapse: with the TC model switched off (--tc 0) "
                        f"and a restitution below 1, a cluster of {partners} collides ever "
                        "faster while their relative velocities go to zero, infinitely often "
-                       f"before a finite time. Rerun with --tc {_short(DEFAULT_TC)}, the default "
-                       "(a collision within t_c of a partner's previous one is elastic), or "
-                       "use the LAMMPS engine")
+                       "before a finite time. Rerun without --tc (the default t_c, "
+                       f"{_short(DEFAULT_TC_2D)} for discs and {_short(DEFAULT_TC_3D)} for "
+                       "spheres: a collision within t_c of a partner's previous one is "
+                       "elastic), or use the LAMMPS engine")
     return head + ("Most likely a cluster of exactly touching particles is colliding in a "
                    "loop that takes no time, for example a particle caged at zero gaps "
                    "between fixed bumps or in a crystalline row. Perturb the start (another "

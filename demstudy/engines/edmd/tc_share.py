@@ -70,9 +70,10 @@ class TcShare:
         return (f"warning: the TC model made {100 * self.fraction:.3g} % of pair collisions "
                 f"elastic (more than {100 * WARN_SHARE:g} %): the results may depend on t_c = "
                 f"{self.tc:g}; rerun with a smaller --tc (e.g. --tc {self.tc / 10:g}) and "
-                "compare the results, not only the share (in the studies' dense 3D flows "
-                "t_c = 1e-6 brought it to 2-6 % at ×1.0-2.1 the cost; in dense 2D flows it "
-                "did not fall: docs/edmd-engine.md)")
+                "compare the results, not only the share (in dense sheared 3D flows a smaller "
+                "t_c lowered the share at ×1.0-2.1 the cost; in beds at rest and dense 2D "
+                "flows it did not fall, the elastic collisions being a cluster's "
+                "re-collisions, and cost ×5-8: docs/edmd-engine.md)")
 
 
 def tc_share(elastic: int, collisions: int, tc: float) -> TcShare:

@@ -53,7 +53,8 @@ REST_RUN_BUMPY = {"equilibration": 30.0, "production": 60.0}
 QUICK_RUN = {20: {"equilibration": 20.0, "production": 40.0},
              30: {"equilibration": 50.0, "production": 150.0},
              40: {"equilibration": 20.0, "production": 100.0}}
-#: the TC-model times compared (1e-5 is the engine's default, DEFAULT_TC: chute-30-bumpy)
+#: the TC-model times compared (1e-5 is the engine's default for discs, DEFAULT_TC_2D:
+#: chute-30-bumpy)
 TC_VALUES = {"tc1e-4": 1e-4, "tc1e-6": 1e-6}
 SEEDS = (2, 3)  # besides the scenes' 12345
 VARIABLE = {"law": {"model": "campbell-exp"}}  # e(v) = ½[1 + exp(−3v/√(gR))], pairs only

@@ -10,7 +10,6 @@ Dimensionless particle units: d = 1, m = 1, g = 1 (gravity acts): speeds in √(
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
@@ -89,7 +88,7 @@ def _known_flows(quick: bool) -> dict[str, Flow]:
 
 def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
     """The part's runs present in ``runs``, read (in-bin g(r) computed from their frames);
-    the TC twins apart (:func:`load_twins`)."""
+    the TC twins apart (:func:`load_extra`)."""
     known = _known_flows(quick)
     out: Runs = {}
     for name, path in runs.items():
@@ -100,10 +99,9 @@ def load_runs(runs: Mapping[str, Path], quick: bool) -> Runs:
     return out
 
 
-def load_twins(runs: Mapping[str, Path], quick: bool,
-               which: tuple[Flow, ...] = TC_TWINS) -> list[FlowData]:
-    """The runs of ``which`` (the TC twins, or the validation box) present in ``runs`` (full
-    study), read."""
+def load_extra(runs: Mapping[str, Path], quick: bool, which: tuple[Flow, ...]) -> list[FlowData]:
+    """The runs of ``which`` (flows outside the thesis's (φ, β, e) grid: the TC twins, the
+    validation box) present in ``runs`` (full study), read."""
     if quick:
         return []
     return [load_flow(f, Path(runs[f.name])) for f in which
@@ -150,8 +148,8 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     """Checks, figures and report sections of the Poiseuille part (cases missing from
     ``runs`` give "not run" checks)."""
     data = load_runs(runs, quick)
-    twins = load_twins(runs, quick)
-    box = next(iter(load_twins(runs, quick, (VALIDATION,))), None)
+    twins = load_extra(runs, quick, TC_TWINS)
+    box = next(iter(load_extra(runs, quick, (VALIDATION,))), None)
     checks = [c for check in CHECKS for c in
               (check(data, box) if check is pc.validation_checks else check(data))]
     pc.tc_caveats(checks, data, pc.tc_twin_evidence(data, twins))
@@ -162,8 +160,6 @@ def analyse(runs: Mapping[str, Path], out: Path, quick: bool) -> Analysis:
     for c in checks:  # a statement without runs says so, never crashes
         if c.verdict == NOT_RUN and not c.reason:
             c.reason = "its runs are not in this run of the study"
-        # the unsteady-run note (pc._steady_note) starts a sentence: end the one before it
-        c.reason = re.sub(r"([^.\s;:]) (The runs? β)", r"\1. \2", c.reason)
     figures = make_figures(data, Path(out), quick)
     if box is not None:
         shown = [box, *([data[pc.REF]] if pc.REF in data else [])]

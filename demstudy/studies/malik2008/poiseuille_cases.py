@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..base import Case, merge
+from .tc import STUDY_TC
 
 SCENES = {0.01: "malik2008/poiseuille-phi0.01",
           0.1: "malik2008/poiseuille-phi0.1",
@@ -57,7 +58,8 @@ class Flow:
     e: float
     beta: float
     engine: str = "edmd"
-    #: the event-driven engine's TC time when not the default (a TC twin, :data:`TC_TWINS`)
+    #: the event-driven engine's TC time when not the study's ``tc.STUDY_TC`` (a TC twin,
+    #: :data:`TC_TWINS`)
     tc: float | None = None
     #: N in a cube of solid fraction φ when not the thesis's system (:data:`VALIDATION`)
     n: int | None = None
@@ -93,7 +95,10 @@ def case_of(flow: Flow, quick: bool = False) -> Case:
         sections["particles"] = {"count": flow.n}
         sections["measure"]["bin_width"] = flow.side / 25
     quick_sections = {"run": QUICK_RUN[flow.phi]} if quick else {}
-    options = {} if flow.tc is None else {"tc": flow.tc}
+    # the event-driven runs at the study's t_c, given explicitly (tc.STUDY_TC: not the
+    # engine's default for spheres, 1e-6, which the twins use)
+    options = {} if flow.engine != "edmd" else {
+        "tc": STUDY_TC if flow.tc is None else flow.tc}
     return Case(flow.name, SCENES[flow.phi], engine=flow.engine, sections=sections,
                 quick=quick, quick_sections=quick_sections, group=f"phi{flow.phi:g}",
                 options=options)
@@ -123,7 +128,7 @@ SOFT_SECTIONS = {"run": {"equilibration": 200.0, "production": 400.0, "sample_in
                  "soft": {"steps_per_contact": 10}}
 QUICK = (Flow(0.01, 0.8, 0.99), Flow(0.01, 0.8, -0.99), Flow(0.5, *DENSE))
 #: TC twins (full study): the dense φ = 0.5 channel makes 16 % of its pair collisions
-#: elastic at the default t_c = 1e-5 √(d/g); the same flow at t_c = 1e-6 says whether its
+#: elastic at the study's t_c = 1e-5 √(d/g); the same flow at t_c = 1e-6 says whether its
 #: rows depend on the TC model (the "TC model" row, :func:`poiseuille_checks.tc_twin_rows`)
 TC_TWINS = (Flow(0.5, *DENSE, tc=1e-6),)
 #: the code validation of §3.5 (Fig 2.11): N = 1000 at φ = 0.01 in a cube (37.4 d), e = 0.8,

@@ -19,7 +19,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...engines.edmd.core import DEFAULT_TC
 from ...engines.edmd.tc_share import WARN_SHARE
 from ..base import (
     NO_THESIS_VALUE,
@@ -44,6 +43,7 @@ from .poiseuille_data import (
     wall_distance,
     wall_gradient,
 )
+from .tc import STUDY_TC
 
 Runs = dict[tuple[float, float, float], FlowData]
 REF = (0.01, 0.99, 0.8)  # Fig 2.11's parameters (φ, β, e), rerun with Ch. 3's N = 2744
@@ -82,6 +82,15 @@ def _steady_note(ds: FlowData | Sequence[FlowData]) -> str:
     return (f" The run{'s' * (len(bad) > 1)} {runs} {'are' if len(bad) > 1 else 'is'} not "
             f"in steady state: a transient's values ({their} fluctuations, taken about each "
             "bin's run mean, include the mean flow's drift), a weaker test either way.")
+
+
+def _with_steady_note(reason: str, ds: FlowData | Sequence[FlowData]) -> str:
+    """``reason`` as a finished sentence followed by :func:`_steady_note`'s (when a run of
+    ``ds`` is unsteady), so that no caller has to end its sentence for it."""
+    note, reason = _steady_note(ds).strip(), reason.strip()
+    if not note or not reason:
+        return reason or note
+    return f"{reason.rstrip(';:,')}{'' if reason.endswith('.') else '.'} {note}"
 
 
 def _cap(verdict: str, ds: FlowData | Sequence[FlowData]) -> str:
@@ -166,14 +175,14 @@ def tc_twin_evidence(data: Runs, twins: Sequence[FlowData]
 
 def tc_twin_rows(data: Runs, twins: Sequence[FlowData], wanted: Sequence) -> list[Check]:
     """demstudy's own rows: each flow of ``wanted`` (Flows with a t_c) against its run at the
-    default t_c. Reproduced: the same values within 2σ + 10 % and a small share at the
-    smaller t_c; partly: the same values, but the twin's share is large too (no run free of
-    the model); not reproduced: the values depend on t_c."""
+    study's t_c (``tc.STUDY_TC``). Reproduced: the same values within 2σ + 10 % and a small
+    share at the smaller t_c; partly: the same values, but the twin's share is large too (no
+    run free of the model); not reproduced: the values depend on t_c."""
     out = []
     for flow in wanted:
         ref = f"TC model, φ = {flow.phi:g} (demstudy; not in the thesis)"
         statement = (f"the φ = {flow.phi:g} flow (β = {flow.beta:g}, e = {flow.e:g}) does not "
-                     f"depend on the event-driven engine's t_c ({DEFAULT_TC:g} against "
+                     f"depend on the event-driven engine's t_c ({STUDY_TC:g} against "
                      f"{flow.tc:g} √(d/g)), and the TC-elastic share is small at the smaller "
                      "t_c")
         thesis = "— (the thesis's collisions all dissipate: no TC model)"
@@ -206,13 +215,13 @@ def tc_twin_rows(data: Runs, twins: Sequence[FlowData], wanted: Sequence) -> lis
                    "comparison isolates t_c; it covers only what the rows use: profiles, the "
                    "centre's kurtosis, Λ and g at contact, not the correlations or the VDF "
                    "tails")
-        reason = (reason + "." + _steady_note([base, twin])).strip()
+        reason = _with_steady_note(reason + ".", [base, twin])
         out.append(Check(ref, statement, thesis, measured, verdict, reason, own=True))
     return out
 
 
 def base_flow(flow: Flow) -> Flow:
-    """The flow at the default t_c of TC twin ``flow``."""
+    """The flow at the study's t_c (``tc.STUDY_TC``) of TC twin ``flow``."""
     return dataclasses.replace(flow, tc=None)
 
 
@@ -270,7 +279,7 @@ def validation_checks(data: Runs, box: FlowData | None = None) -> list[Check]:
             measured += (f"{ch3}; holds in {holds} of {len(others)} "
                          f"{'' if box is not None else 'other '}φ = 0.01 runs of Ch. 3")
         out.append(Check(ref, full, statement, measured, _cap(verdict, d),
-                         reason + _steady_note(d), runs=(d.flow.name,)))
+                         _with_steady_note(reason, d), runs=(d.flow.name,)))
     return out
 
 
@@ -377,10 +386,10 @@ def dissipation_checks(data: Runs) -> list[Check]:
                          f"mass-weighted mean T* (the system's temperature): "
                          f"{'; '.join(rows)}; holds at {held} of {tested} e",
                          _cap(verdict, used),
-                         (("" if held == tested else "β = 0 is not the coldest beyond 2σ at "
-                                                     "every e tested")
-                          + missing + _steady_note(used)
-                          ).strip().removeprefix("; ")))
+                         _with_steady_note(
+                             (("" if held == tested else "β = 0 is not the coldest beyond 2σ "
+                                                         "at every e tested")
+                              + missing).strip().removeprefix("; "), used)))
     return out
 
 
@@ -452,7 +461,7 @@ def _plug_knudsen(data: Runs) -> Check:
                                            "either reading of the free path")
     used = list(runs.values())  # every β run enters (the lowest Kn among them)
     return Check(ref, statement, "Kn extremely low", measured, _cap(verdict, used),
-                 reason + _steady_note(used))
+                 _with_steady_note(reason, used))
 
 
 # ------------------------------------------------------------------ VDFs
@@ -692,7 +701,7 @@ def vdf_checks(data: Runs) -> list[Check]:
             + ("Kurtosis consistent with 3 (Gaussian tails). " if not tails else ""))
         reason = reason.strip()
         verdict = _cap(verdict, ds)
-        reason += _steady_note(ds)
+        reason = _with_steady_note(reason, ds)
         out.append(Check(ref, statement, "Gaussian core; tails deviate",
                          "; ".join(rows) + " (per C_x/C_y/C_z: core dev = the largest "
                          "relative departure of P(C/σ) from exp(-x²/2) over |x| ≤ 1 beyond "
@@ -740,7 +749,7 @@ def vdf_elastic_limit_checks(data: Runs) -> list[Check]:
         reason = "" if held == tested else (
             f"|κ - 3| does not fall beyond 2σ at {tested - held} of {tested} β")
         verdict = _cap(verdict, used)
-        reason += _steady_note(used)
+        reason = _with_steady_note(reason, used)
         out.append(Check(ref, statement, "VDF → Gaussian as e → 1",
                          "mean |κ - 3| of C_x/C_y/C_z: " + "; ".join(rows)
                          + f"; holds at {held} of {tested} β", verdict, reason.strip()))
@@ -856,9 +865,10 @@ def contact_checks(data: Runs) -> list[Check]:
                          "; ".join(rows) + f"; agree (2σ + 10 %) in {held} of {len(ds)}; "
                          f"pooled g(d+)/χ_CS = {pm(*pooled)}{spread}",
                          _cap(verdict, ds),
-                         ("" if verdict == REPRODUCED else
-                          "the contact value departs from Enskog-CS: " + "; ".join(causes)
-                          + ".") + _steady_note(ds),
+                         _with_steady_note(
+                             "" if verdict == REPRODUCED else
+                             "the contact value departs from Enskog-CS: " + "; ".join(causes)
+                             + ".", ds),
                          own=True))  # the thesis shows g(r) but states no contact value
     return out
 
@@ -919,7 +929,7 @@ def gr_shell_checks(data: Runs) -> list[Check]:
                   "centre-bin g(r) peaks beyond 1.5 d (r/d): " + "; ".join(rows)
                   + f"; both shells in {len(both)} of {len(ds)} runs",
                   _cap(verdict, ds),
-                  (reason + _steady_note(ds)).strip())]
+                  _with_steady_note(reason, ds))]
 
 
 #: a wall bin is "sparse" below this fraction of a uniform gas's φ there
@@ -959,7 +969,7 @@ def sparse_wall_checks(data: Runs) -> list[Check]:
                   "d/2 off the wall): " + "; ".join(rows)
                   + f"; below {100 * SPARSE:.0f} % in {len(sparse)} of {len(ds)}",
                   _cap(verdict, ds),
-                  (reason + _steady_note(ds)).strip())]
+                  _with_steady_note(reason, ds))]
 
 
 def uniform_wall_share(n_bins: int, width: float) -> float:
@@ -1067,13 +1077,13 @@ def lambda_checks(data: Runs) -> list[Check]:
         within_floor = ", ".join(_tag(d) for d in rough if d in departs and d not in beyond)
         out.append(Check(ref, statement, thesis, measured,
                          _cap(verdict, rough),
-                         (("" if verdict == REPRODUCED else
+                         _with_steady_note(
+                          ("" if verdict == REPRODUCED else
                            (f"Λ̄ consistent with 1/3 (2σ) for {near}. " if near else "")
                            + (f"Off 1/3, but not by 2σ more than the steady smooth control "
                               f"({floor:.2g}), for {within_floor}: anisotropy, not roughness, "
                               "may explain it." if within_floor else ""))
-                          + control_text
-                          + _steady_note(rough)).strip()))
+                          + control_text, rough)))
     return out
 
 
@@ -1122,7 +1132,7 @@ def dense_checks(data: Runs) -> list[Check]:
     return [Check(ref, statement, "liquid-like core and plug",
                   f"core φ (bins 10-16) {pm(fc, efc, 2)}; |dU_x/dy| core {shear_core:.3g}, "
                   f"at the walls {shear_wall:.3g} per √(d/g)" + structure,
-                  _cap(verdict, d), (reason + _steady_note(d)).strip())]
+                  _cap(verdict, d), _with_steady_note(reason, d))]
 
 
 #: hard-sphere melting: the densest equilibrium fluid coexists with the crystal up to here
@@ -1188,7 +1198,8 @@ def _s_wave(data: Runs) -> Check:
               "wave rather than an S-wave")
     reason = f"{reason}; {PROFILE_MODE}" if reason else PROFILE_MODE[0].upper() + PROFILE_MODE[1:]
     return Check(ref, statement, "S-wave (mode (1,1) of the xy density)", text,
-                 _cap(REPRODUCED if seen else NOT_REPRODUCED, d), reason + "." + _steady_note(d),
+                 _cap(REPRODUCED if seen else NOT_REPRODUCED, d),
+                 _with_steady_note(reason + ".", d),
                  runs=(d.flow.name,))
 
 
@@ -1215,11 +1226,12 @@ def _beta_structure(data: Runs, beta: float) -> Check:
     measured = f"{kind}: {why}; {s_wave_text(r)}"
     if not plug:
         return Check(ref, statement, thesis, measured, NO_THESIS_VALUE,
-                     "the thesis shows this run's snapshots without naming its structure; "
-                     + PROFILE_MODE + "." + _steady_note(d), runs=(d.flow.name,))
+                     _with_steady_note(
+                         "the thesis shows this run's snapshots without naming its structure; "
+                         + PROFILE_MODE + ".", d), runs=(d.flow.name,))
     if kind == "plug":
         return Check(ref, statement, thesis, measured, _cap(REPRODUCED, d),
-                     _steady_note(d).strip(), runs=(d.flow.name,))
+                     _with_steady_note("", d), runs=(d.flow.name,))
     other = data.get((0.1, 0.99, 0.7))
     than = ""
     if other is not None:
@@ -1227,9 +1239,10 @@ def _beta_structure(data: Runs, beta: float) -> Check:
         than = (f" ({_x_share(r):.2g} % of (0, 1)'s power here against {_x_share(o):.2g} % "
                 "in the β = 0.99 run the thesis calls an S-wave)")
     return Check(ref, statement, thesis, measured, NOT_REPRODUCED,
-                 f"not a plug: the density is modulated along the flow ({kind}){than}; the "
-                 "thesis's plug is read off snapshots (one time), ours is the mean over the "
-                 "production's frames; " + PROFILE_MODE + "." + _steady_note(d),
+                 _with_steady_note(
+                     f"not a plug: the density is modulated along the flow ({kind}){than}; "
+                     "the thesis's plug is read off snapshots (one time), ours is the mean "
+                     "over the production's frames; " + PROFILE_MODE + ".", d),
                  runs=(d.flow.name,))
 
 
@@ -1275,6 +1288,7 @@ def freepath_checks(data: Runs) -> list[Check]:
     return [Check(ref, statement, "figure only (no values in the text)",
                   f"bin 13, exp(-l/ℓ) fitted over λ < l < {WALL_REACH * reach:.0f} d: "
                   + "; ".join(parts), NO_THESIS_VALUE,
+                  _with_steady_note(
                   f"ℓ/λ = {lo:.2f}-{hi:.2f} over the fit window (about "
                   f"{np.nanmean(widths):.1f} decay lengths wide; no error is given: a "
                   "yardstick): the distribution falls off "
@@ -1282,7 +1296,7 @@ def freepath_checks(data: Runs) -> list[Check]:
                   f"path. The walls, {reach:.0f} d from bin 13, end the longest flights: "
                   "beyond that distance the figure's P(l) leaves the exponential, and the "
                   "mean λ counts those shortened flights too. The thesis states no value to "
-                  "compare with." + _steady_note(ds),
+                  "compare with.", ds),
                   runs=tuple(d.flow.name for d in ds))]
 
 
@@ -1331,9 +1345,10 @@ def wall_value_checks(data: Runs) -> list[Check]:
                          "roll along them; gradients: the change per d from the wall into the "
                          "flow of that wall value)",
                          NO_THESIS_VALUE,
+                         _with_steady_note(
                          "the thesis plots these against e without stating values; its text's "
                          "one claim about the walls (much wall dissipation for β = 0) has its "
-                         "own row." + _steady_note(ds), runs=tuple(d.flow.name for d in ds)))
+                         "own row.", ds), runs=tuple(d.flow.name for d in ds)))
     return out
 
 
@@ -1453,7 +1468,7 @@ def vcorr_checks(data: Runs) -> list[Check]:
             continue
         out.append(Check(ref, statement, thesis,
                          "; ".join(_correlation_text(d, bins) for d in ds), NO_THESIS_VALUE,
-                         _common_motion(ds) + "." + _steady_note(ds),
+                         _with_steady_note(_common_motion(ds) + ".", ds),
                          runs=tuple(d.flow.name for d in ds)))
     return out
 

@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ..base import Analysis, Case
+from .tc import STUDY_TC
 from .waves_boxes import BOXES, QUICK, Box
 
 #: quick runs: two W = 15 boxes, past the KE's rise (≈ 100 √(d/g); 120 √(d/g) ≈ 1200-3600 c/p
@@ -34,13 +35,13 @@ QUICK_RUN = {"run": {"equilibration": 120.0, "production": 100.0, "sample_interv
 THESIS_SPAN = {"run": {"unit": "collisions", "equilibration": 1000.0, "production": 14000.0,
                        "sample_interval": 200.0}}
 
-#: the TC-model twins (not in the thesis): boxes run again at t_c = 10⁻⁶ √(d/g) instead of the
-#: engine's default 10⁻⁵, over the same span, so the same snapshot windows compare. At the
-#: default L42W30H30's slug made 6 % of the pair collisions elastic, L90W30H30's 17.7 % and
-#: L150W50H10's 15-18 %, L150W30H30's 17.7 % and L70W50H50's 12.7 % (the thesis's collisions
-#: all dissipate): does the structure depend on the engine's TC model? The cheapest W = 30
-#: box, the W = 30 slugs with the largest shares, the flat W = 50 plane and the thesis's
-#: featured N = 50094 box (Figs 5.6-5.10); ≈ 10-35 min each on one core here, ≈ 75 min the
+#: the TC-model twins (not in the thesis): boxes run again at t_c = 10⁻⁶ √(d/g) (the engine's
+#: default for spheres now) instead of the study's 10⁻⁵ (``tc.STUDY_TC``), over the same span, so
+#: the same snapshot windows compare. At 10⁻⁵ L42W30H30's slug made 6 % of the pair collisions
+#: elastic, L90W30H30's 17.7 %, L150W50H10's 15-18 %, L150W30H30's 17.7 % and L70W50H50's 12.7 %
+#: (the thesis's collisions all dissipate): does the structure depend on the engine's TC model? The
+#: cheapest W = 30 box, the W = 30 slugs with the largest shares, the flat W = 50 plane and the
+#: thesis's featured N = 50094 box (Figs 5.6-5.10); ≈ 10-35 min each on one core here, ≈ 75 min the
 #: last.
 TC_TWINS = ("L42W30H30", "L90W30H30", "L150W50H10", "L150W30H30", "L70W50H50")
 TC_TWIN_TC = 1e-6
@@ -76,7 +77,8 @@ def cases(quick: bool) -> list[Case]:
         if quick and not is_quick:
             continue
         out.append(Case(box.name, box.scene, sections=sections, quick=is_quick,
-                        quick_sections=QUICK_RUN if is_quick else {}))
+                        quick_sections=QUICK_RUN if is_quick else {},
+                        options={"tc": STUDY_TC}))
     if not quick:
         out += [Case(twin_name(box), box.scene, sections=THESIS_SPAN,
                      options={"tc": TC_TWIN_TC}) for box in twin_boxes()]

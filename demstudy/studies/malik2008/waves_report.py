@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ...engines.edmd.core import DEFAULT_TC
 from ...engines.edmd.tc_share import WARN_SHARE
 from ...errors import BadInputFile
 from ..base import (
@@ -24,11 +23,13 @@ from ..base import (
     NOT_RUN,
     PARTLY,
     REPRODUCED,
+    TWIN_TOLERANCE,
     Analysis,
     Check,
     Figure,
     pm,
 )
+from .tc import STUDY_TC
 from .waves import TC_TWIN_TC, on_thesis_span, twin_boxes, twin_name
 from .waves_boxes import BOXES, QUICK, RESTITUTION, THESIS, Box
 from .waves_figures import phase_figure, run_figure
@@ -247,16 +248,20 @@ def tc_row(tag: str) -> str:
     return f"TC model, {tag}"
 
 
+#: the twins' KE tolerance in words (the studies' one tolerance for a TC twin)
+TOLERANCE_TEXT = f"{100 * TWIN_TOLERANCE:.0f} %"
+
+
 def tc_evidence(own_twin: Check | None = None, agreed: Sequence[str] = (), tag: str = "",
                 disagreed: Mapping[str, str] | None = None,
                 twin_shares: Mapping[str, float] | None = None) -> tuple[bool, str]:
     """What the TC twins say about a box, for the studies' one TC rule
     (:func:`..base.tc_caveats`): (whether its own twin exempts it, the evidence in words).
     ``own_twin``: the TC row of this box's own twin at a smaller t_c; "reproduced" (same
-    class and KE within 2σ + 5 %, small share) exempts it, "partly"/"not reproduced" are
-    named. ``agreed`` and ``disagreed``: the tags of other boxes whose twins agreed, and
-    those whose did not (tag → the twin row's verdict), named when the box has no twin of
-    its own (none decides for this box). ``tag``: this box's tag, naming its twin's row;
+    class and KE within 2σ + ``TWIN_TOLERANCE``, small share) exempts it, "partly"/"not
+    reproduced" are named. ``agreed`` and ``disagreed``: the tags of other boxes whose twins
+    agreed, and those whose did not (tag → the twin row's verdict), named when the box has no
+    twin of its own (none decides for this box). ``tag``: this box's tag, naming its twin's row;
     without it the row is read off the twin's reference. ``twin_shares``: tag → the twin's
     own TC share, which says why a "partly" twin row is one (its share, or its KE/N)."""
     if not tag and own_twin is not None:
@@ -271,7 +276,8 @@ def tc_evidence(own_twin: Check | None = None, agreed: Sequence[str] = (), tag: 
                 "kept the class but not the KE/N")
     if own_twin is not None and own_twin.verdict == REPRODUCED:
         return True, (f"its twin at t_c = {TC_TWIN_TC:g} √(d/g) gives the same class and KE/N "
-                      f"within 2σ + 5 % ({row}): the share does not change the structure "
+                      f"within 2σ + {TOLERANCE_TEXT} ({row}): the share does not change the "
+                      "structure "
                       "here")
     if own_twin is not None and own_twin.verdict in (PARTLY, NOT_REPRODUCED):
         found = ("changes the class, so the structure depends on the engine's TC model"
@@ -306,21 +312,21 @@ def tc_caveat(check: Check, run: RunWaves, own_twin: Check | None = None,
     name = label or tag or "this box"  # label: the box with its e where it is not 0.7
     exempt, text = tc_evidence(own_twin, agreed, tag, disagreed, twin_shares)
     check.runs = (name,)
-    rule([check], {name: (run.tc_fraction, DEFAULT_TC)}, {name: text} if exempt else {},
+    rule([check], {name: (run.tc_fraction, STUDY_TC)}, {name: text} if exempt else {},
          {name: text} if text and not exempt else {}, unit="√(d/g)")
     return check
 
 
 def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
                   why: str = "") -> Check:
-    """The TC twin of ``box`` against the box at the default t_c (demstudy's own check; the
+    """The TC twin of ``box`` against the box at the study's t_c (demstudy's own check; the
     thesis has no TC model): the class of the whole production and at every snapshot window
     both sampled, the KE of each half, and the share at the smaller t_c. ``why``: the cause
     when a run is missing (unreadable, failed)."""
     tc = TC_TWIN_TC
     ref = f"{tc_row(box.tag)} (demstudy; not in the thesis)"
     statement = (f"the structure of {box.tag} (N = {box.n}) does not depend on the "
-                 f"event-driven engine's t_c ({DEFAULT_TC:g} against {tc:g} √(d/g)), and the "
+                 f"event-driven engine's t_c ({STUDY_TC:g} against {tc:g} √(d/g)), and the "
                  "TC-elastic share is small at the smaller t_c")
     thesis = "— (the thesis's collisions all dissipate: no TC model)"
     if base is None or twin is None:
@@ -328,7 +334,7 @@ def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
         return Check(ref, statement, thesis, "not run", NOT_RUN,
                      "run missing: " + ", ".join(absent) + (f" ({why})" if why else ""),
                      own=True)
-    ran = [(t, r) for t, r in ((DEFAULT_TC, base), (tc, twin))
+    ran = [(t, r) for t, r in ((STUDY_TC, base), (tc, twin))
            if math.isfinite(r.tc) and not math.isclose(r.tc, t)]
     if ran:
         return Check(ref, statement, thesis, "not run", NOT_RUN, "; ".join(
@@ -337,7 +343,7 @@ def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
     differ = [c for c in common
               if base.windows[c].cls != twin.windows[c].cls]
     texts = []
-    for t, r in ((DEFAULT_TC, base), (tc, twin)):
+    for t, r in ((STUDY_TC, base), (tc, twin)):
         windows = ", ".join(f"{c:.0f} {r.windows[c].pattern}" for c in common)
         (m1, e1), (m2, e2) = r.ke_halves
         texts.append(f"t_c {t:g}: TC share {_share(r)}, class {r.modes.pattern}; at "
@@ -345,10 +351,11 @@ def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
                      f"KE/N halves {pm(m1, e1)} → {pm(m2, e2)} m g d; {r.rate:.0f} c/p per "
                      "√(d/g)")
     halves = zip(base.ke_halves, twin.ke_halves, strict=True)
-    # the halves apart beyond 2σ + 5 % (the share and the clock change with t_c, so a few
-    # per cent of KE are allowed; the reason states the largest difference either way)
+    # the halves apart beyond 2σ + TWIN_TOLERANCE (10 %: the studies' one tolerance for a TC
+    # twin; the share and the clock change with t_c, so a few per cent of KE are allowed; the
+    # reason states the largest difference either way)
     gaps = [(abs(a - b), float(np.hypot(ea, eb)), abs(a)) for (a, ea), (b, eb) in halves]
-    ke_apart = [i for i, (d, err, ref_) in enumerate(gaps) if d > 2.0 * err + 0.05 * ref_]
+    ke_apart = [i for i, (d, err, ref_) in enumerate(gaps) if d > 2.0 * err + TWIN_TOLERANCE * ref_]
     d, err, ref_ = max(gaps, key=lambda g: g[0] / g[2] if g[2] > 0 else 0.0)
     ke_gap = (f"KE/N halves differ by at most {100 * d / ref_:.1f} % "
               f"({d / err:.1f}σ)" if ref_ > 0 and err > 0 else "")
@@ -369,12 +376,12 @@ def tc_dependence(box: Box, base: RunWaves | None, twin: RunWaves | None,
             reasons[0] += (", the pattern differs at " + ", ".join(f"{c:.0f}" for c in
                                                                 patterns) + " c/p")
     if not ke_apart and ke_gap:
-        reasons.append(ke_gap + " (within 2σ + 5 %)")
+        reasons.append(ke_gap + f" (within 2σ + {TOLERANCE_TEXT})")
     if ke_apart:
         reasons.append("the KE/N of the " + " and ".join(("first", "second")[i]
                                                         for i in ke_apart)
-                       + " half differs by more than 2σ + 5 %: the TC model changes the "
-                       "dissipation")
+                       + f" half differs by more than 2σ + {TOLERANCE_TEXT}: the TC model "
+                       "changes the dissipation")
     clock = twin.rate / base.rate if base.rate > 0 else float("nan")
     if math.isfinite(clock) and not 0.8 < clock < 1.25:
         # equal c/p is then not equal time: the dense clumps collide at another rate
@@ -598,15 +605,16 @@ N_pair / N (our c/p × 2), are classified on their own (3 frames at least); a st
 thesis ties to a time (N = 50094: a slug at 14000 c/p) is compared there, under either
 reading, and the report names the reading that agrees.
 
-**TC model.** The engine makes a pair collision elastic (e = 1, no tangential impulse)
-when either partner collided less than t_c earlier (Luding & McNamara's TC model against
-inelastic collapse; the thesis has none). At the default t_c = 10⁻⁵ √(d/g) this made
-{shares} of the W = 30/50 boxes' pair collisions elastic, so {twins} are run again at
-t_c = 10⁻⁶ over the same span (cases waves-phi0.15-<box>-tc1e-06-edmd): each "TC model" row
-compares the class over the production and at each snapshot window, the KE of each half
-(within 2σ + 5 %) and the share. A box whose own twin agrees keeps its verdicts; in the
-others, with a share above 5 %, an agreement with the thesis counts as "partly" (a weaker
-test) and a mismatch stays "not reproduced" with the share named as one possible cause.
+**TC model.** The engine makes a pair collision elastic (e = 1, no tangential impulse) when either
+partner collided less than t_c earlier (Luding & McNamara's TC model against inelastic collapse; the
+thesis has none). At the study's t_c = 10⁻⁵ √(d/g) this made {shares} of the W = 30/50 boxes' pair
+collisions elastic, so {twins} are run again at t_c = 10⁻⁶ (the engine's default for spheres since
+2026-12-03; the study's runs stay at 10⁻⁵, where its records were made) over the same span (cases
+waves-phi0.15-<box>-tc1e-06-edmd): each "TC model" row compares the class over the production and at
+each snapshot window, the KE of each half (within 2σ + 10 %, the studies' tolerance for a twin) and
+the share. A box whose own twin agrees keeps its verdicts; in the others, with a share above 5 %, an
+agreement with the thesis counts as "partly" (a weaker test) and a mismatch stays "not reproduced"
+with the share named as one possible cause.
 
 **Peak density.** The densest cell column of the xy plane in each production frame (mean
 over the frames), on the 2 d grid and on ≈ 5 d columns, since the thesis's cells are not

@@ -1,0 +1,190 @@
+"""What the event-driven engine's TC time t_c costs and buys: the share of pair collisions the
+TC model makes elastic and the wall time, at t_c = 1e-4, 1e-5 (the default) and 1e-6, on the
+kinds of flow that decide the default (docs/edmd-engine.md, "Why t_c = 1e-5").
+
+Run: .venv/bin/python benchmarks/bench_tc_choice.py [--repeat 2] [--only NAME ...]
+     .venv/bin/python benchmarks/bench_tc_choice.py --pressure [--soft]
+
+Dimensionless particle units: d = 1, m = 1; g = 1 where gravity acts, otherwise the shear rate
+sets the time unit τ. Cases (short versions of shipped scenes, the same scene at every t_c):
+- ``le3d-0.55``: inputs/accuracy-cost/lees-edwards-3d-phi0.55.toml (dense sheared spheres,
+  N = 1050), 10 + 20 strain units;
+- ``le3d-0.3``: the same at φ = 0.3;
+- ``le2d-0.5``: inputs/shear/lees-edwards-2d.toml (ν = 0.5 discs, N = 1996), 10 + 20;
+- ``chute2d-30``: inputs/campbell1982/chute-bumpy-30.toml (Campbell's 40 discs on a bumpy
+  30° base, a dense flowing 2D bed), 100 + 300 √(d/g);
+- ``bed3d``: 100 rough spheres (e = 0.7, β = 0.5) dropped onto a flat floor, 15 √(d/g): a
+  bed coming to rest.
+After one warm-up run, the runs of a round go case by case, t_c by t_c, and the rounds repeat
+(``--repeat``), so a drift of the machine's speed hits every t_c alike; the ratios to the
+default's median wall time are what to quote. Prints one Markdown row per case and t_c: median
+wall time (range), the ratio to t_c = 1e-5, the share of elastic pair collisions, pair
+collisions per particle and time unit. No assertions.
+
+``--pressure``: what the share does not show. The φ = 0.55 shear over 10 + 40 strain units at
+t_c = 1e-4 … 1e-7: the mean pressure (the ``pressure`` timeseries: peculiar kinetic +
+collisional), temperature and rotational energy over the production, with errors from 8
+blocks, and the share; ``--soft`` adds LAMMPS's soft spheres on the same scene (Hooke,
+k* = 10⁶, 10 steps per contact: the stiffest rung of docs/accuracy-cost.md's ladder).
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import re
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+import demstudy as ds
+from demstudy.scene import parse_scene_text, validate_scene
+from demstudy.scene.initial import build_initial_state
+
+ROOT = Path(__file__).resolve().parents[1]
+TCS = (1e-4, 1e-5, 1e-6)
+
+BED3D = """
+dimension = 3
+[meta]
+name = "bench-bed3d"
+description = "100 rough spheres dropped onto a flat floor: a bed coming to rest (d = m = g = 1)"
+[box]
+size = [6.0, 12.0, 6.0]
+[particles]
+count = 100
+inertia = "sphere"
+[contact]
+restitution = 0.7
+tangential = { model = "beta", beta = 0.5 }
+[[walls]]
+side = "lower"
+restitution = 0.7
+tangential = { model = "beta", beta = 0.5 }
+[[walls]]
+side = "upper"
+restitution = 0.7
+[gravity]
+direction = [0.0, -1.0, 0.0]
+[initial]
+placement = "random"
+[initial.velocity]
+temperature = 1.0
+[run]
+equilibration = 0.0
+production = 15.0
+sample_interval = 1.0
+seed = 3
+"""
+
+
+def shortened(path: str, **run: float) -> str:
+    """The scene file's text with its ``[run]`` lengths replaced."""
+    text = (ROOT / path).read_text()
+    for key, value in run.items():
+        text, n = re.subn(rf"^{key}\s*=\s*[0-9.eE+-]+", f"{key} = {value}", text, flags=re.M)
+        assert n == 1, f"{path}: no single {key} to replace"
+    return text
+
+
+CASES = {
+    "le3d-0.55": lambda: shortened("inputs/accuracy-cost/lees-edwards-3d-phi0.55.toml",
+                                   equilibration=10.0, production=20.0),
+    "le3d-0.3": lambda: shortened("inputs/accuracy-cost/lees-edwards-3d-phi0.3.toml",
+                                  equilibration=10.0, production=20.0),
+    "le2d-0.5": lambda: shortened("inputs/shear/lees-edwards-2d.toml",
+                                  equilibration=10.0, production=20.0),
+    "chute2d-30": lambda: shortened("inputs/campbell1982/chute-bumpy-30.toml",
+                                    equilibration=100.0, production=300.0),
+    "bed3d": lambda: BED3D,
+}
+
+
+def one_run(text: str, tc: float, folder: Path) -> dict:
+    scene = validate_scene(parse_scene_text(text))
+    particles = len(build_initial_state(scene).position)
+    out = folder / f"{scene.meta.name}-tc{tc:g}.h5"
+    start = time.perf_counter()
+    ds.run(scene, "edmd", out, isolate=False, progress=False, tc=tc)
+    wall = time.perf_counter() - start
+    with h5py.File(out, "r") as h5:
+        attrs = h5.attrs
+        span = scene.run.equilibration + scene.run.production
+        rate = 2 * int(attrs["pair_collisions"]) / particles / span
+        share = float(attrs["tc_elastic_fraction"])
+    out.unlink()
+    return {"wall": wall, "share": share, "rate": rate}
+
+
+def block_mean(x: np.ndarray, blocks: int = 8) -> tuple[float, float]:
+    """Mean and its standard error from ``blocks`` consecutive block means."""
+    means = np.array([b.mean() for b in np.array_split(np.asarray(x, float), blocks)])
+    return float(means.mean()), float(means.std(ddof=1) / np.sqrt(blocks))
+
+
+def pressure_ladder(soft: bool) -> None:
+    text = CASES["le3d-0.55"]().replace("production = 20.0", "production = 40.0")
+    scene = validate_scene(parse_scene_text(text))
+    stiff = validate_scene(parse_scene_text(
+        text.replace("hardness = { k_star = 1e5 }", "hardness = { k_star = 1e6 }")
+        .replace("steps_per_contact = 50", "steps_per_contact = 10")))
+    runs = [("edmd", scene, {"tc": tc}, f"{tc:g}") for tc in (1e-4, 1e-5, 1e-6, 1e-7)]
+    runs += [("lammps", stiff, {}, "soft, k* = 1e6")] if soft else []
+    print("\n| t_c | P | T | E_rot | elastic share |\n|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for engine, what, options, label in runs:
+            out = Path(tmp) / f"p-{engine}-{len(label)}.h5"
+            ds.run(what, engine, out, isolate=False, progress=False, **options)
+            with h5py.File(out, "r") as h5:
+                ts = h5["timeseries"]
+                keep = ts["time"][:] > scene.run.equilibration
+                cells = [block_mean(ts[k][:][keep]) for k in
+                         ("pressure", "temperature", "rotational_energy")]
+                share = float(h5.attrs.get("tc_elastic_fraction", np.nan))
+            print(f"| {label} | " + " | ".join(f"{m:.4g} ± {e:.2g}" for m, e in cells)
+                  + f" | {100 * share:.3g} % |")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=2)
+    parser.add_argument("--only", nargs="*", choices=sorted(CASES), default=sorted(CASES))
+    parser.add_argument("--pressure", action="store_true",
+                        help="the φ = 0.55 shear's pressure at t_c = 1e-4 … 1e-7 instead")
+    parser.add_argument("--soft", action="store_true",
+                        help="with --pressure: also LAMMPS at k* = 1e6")
+    args = parser.parse_args()
+    if args.pressure:
+        pressure_ladder(args.soft)
+        return
+    texts = {name: CASES[name]() for name in args.only}
+    found: dict[tuple[str, float], list[dict]] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        one_run(BED3D, 1e-4, Path(tmp))  # warm-up: imports and the first run's set-up
+        for _ in range(args.repeat):
+            for name, text in texts.items():
+                for tc in TCS:
+                    found.setdefault((name, tc), []).append(one_run(text, tc, Path(tmp)))
+    print(f"\n{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
+          f"{args.repeat} interleaved rounds\n")
+    print("| case | t_c | wall time (s), median (range) | × t_c = 1e-5 | elastic share | "
+          "pair collisions per particle per τ |")
+    print("|---|---|---|---|---|---|")
+    for name in texts:
+        base = statistics.median(r["wall"] for r in found[(name, 1e-5)])
+        for tc in TCS:
+            runs = found[(name, tc)]
+            walls = [r["wall"] for r in runs]
+            median = statistics.median(walls)
+            share = 100 * statistics.median(r["share"] for r in runs)
+            print(f"| {name} | {tc:g} | {median:.3g} ({min(walls):.3g}-{max(walls):.3g}) | "
+                  f"×{median / base:.2f} | {share:.3g} % | "
+                  f"{statistics.median(r['rate'] for r in runs):.4g} |")
+
+
+if __name__ == "__main__":
+    main()
