@@ -1,9 +1,10 @@
 """What the event-driven engine's TC time t_c costs and buys: the share of pair collisions the
-TC model makes elastic and the wall time, at t_c = 1e-4, 1e-5 (the default) and 1e-6, on the
-kinds of flow that decide the default (docs/edmd-engine.md, "Why t_c = 1e-5").
+TC model makes elastic and the wall time, at t_c = 1e-4, 1e-5 (the default for discs) and 1e-6
+(the default for spheres), on the kinds of flow that decide the defaults (docs/edmd-engine.md,
+"Why these t_c").
 
 Run: .venv/bin/python benchmarks/bench_tc_choice.py [--repeat 2] [--only NAME ...]
-     .venv/bin/python benchmarks/bench_tc_choice.py --pressure [--soft]
+     .venv/bin/python benchmarks/bench_tc_choice.py --pressure [CASE ...] [--soft]
 
 Dimensionless particle units: d = 1, m = 1; g = 1 where gravity acts, otherwise the shear rate
 sets the time unit τ. Cases (short versions of shipped scenes, the same scene at every t_c):
@@ -21,11 +22,13 @@ default's median wall time are what to quote. Prints one Markdown row per case a
 wall time (range), the ratio to t_c = 1e-5, the share of elastic pair collisions, pair
 collisions per particle and time unit. No assertions.
 
-``--pressure``: what the share does not show. The φ = 0.55 shear over 10 + 40 strain units at
-t_c = 1e-4 … 1e-7: the mean pressure (the ``pressure`` timeseries: peculiar kinetic +
-collisional), temperature and rotational energy over the production, with errors from 8
-blocks, and the share; ``--soft`` adds LAMMPS's soft spheres on the same scene (Hooke,
-k* = 10⁶, 10 steps per contact: the stiffest rung of docs/accuracy-cost.md's ladder).
+``--pressure [CASE ...]``: what the share does not show. The φ = 0.55 shear (``le3d-0.55-e0.9``,
+``-e0.7``) over 10 + 40 strain units, and rough discs (β = 0.5) sheared at ν = 0.7, e = 0.9
+(``le2d-0.7-e0.9``) and ν = 0.75, e = 0.5 (``le2d-0.75-e0.5``) in a 30 × 30 box, at t_c = 1e-4 …
+1e-7 (all four without a name): the mean pressure (the ``pressure`` timeseries: peculiar kinetic +
+collisional), temperature and rotational energy over the production, with errors from 8 blocks, and
+the share; ``--soft`` adds LAMMPS's soft spheres on the same scene (Hooke, k* = 10⁶, 10 steps per
+contact: the stiffest rung of docs/accuracy-cost.md's ladder).
 """
 
 from __future__ import annotations
@@ -126,26 +129,52 @@ def block_mean(x: np.ndarray, blocks: int = 8) -> tuple[float, float]:
     return float(means.mean()), float(means.std(ddof=1) / np.sqrt(blocks))
 
 
-def pressure_ladder(soft: bool) -> None:
+def dense_discs(nu: float, e: float) -> str:
+    """The 2D shear scene (β = 0.5) in a 30 × 30 box at ν and e, 10 + 40 strain units."""
+    text = shortened("inputs/shear/lees-edwards-2d.toml", equilibration=10.0, production=40.0)
+    for key, value in (("solid_fraction", nu), ("restitution", e)):
+        text = re.sub(rf"^{key}\s*=\s*[0-9.]+", f"{key} = {value}", text, count=1, flags=re.M)
+    return text.replace("size = [56.0, 56.0]", "size = [30.0, 30.0]")
+
+
+def dense_spheres(e: float) -> str:
+    """The φ = 0.55 shear (β = 0.5, N = 1050) at e, 10 + 40 strain units."""
     text = CASES["le3d-0.55"]().replace("production = 20.0", "production = 40.0")
-    scene = validate_scene(parse_scene_text(text))
-    stiff = validate_scene(parse_scene_text(
-        text.replace("hardness = { k_star = 1e5 }", "hardness = { k_star = 1e6 }")
-        .replace("steps_per_contact = 50", "steps_per_contact = 10")))
-    runs = [("edmd", scene, {"tc": tc}, f"{tc:g}") for tc in (1e-4, 1e-5, 1e-6, 1e-7)]
-    runs += [("lammps", stiff, {}, "soft, k* = 1e6")] if soft else []
-    print("\n| t_c | P | T | E_rot | elastic share |\n|---|---|---|---|---|")
+    return re.sub(r"^restitution\s*=\s*[0-9.]+", f"restitution = {e}", text, count=1, flags=re.M)
+
+
+PRESSURE_CASES = {  # name: (label, scene text)
+    "le3d-0.55-e0.9": ("spheres φ = 0.55, e = 0.9", lambda: dense_spheres(0.9)),
+    "le3d-0.55-e0.7": ("spheres φ = 0.55, e = 0.7", lambda: dense_spheres(0.7)),
+    "le2d-0.7-e0.9": ("discs ν = 0.7, e = 0.9", lambda: dense_discs(0.7, 0.9)),
+    "le2d-0.75-e0.5": ("discs ν = 0.75, e = 0.5", lambda: dense_discs(0.75, 0.5)),
+}
+
+
+def pressure_ladder(names: list[str], soft: bool) -> None:
+    runs = []
+    for key in names:
+        name, text = PRESSURE_CASES[key]
+        scene = validate_scene(parse_scene_text(text()))
+        runs += [(name, "edmd", scene, {"tc": tc}, f"{tc:g}") for tc in (1e-4, 1e-5, 1e-6, 1e-7)]
+    if soft:
+        stiff = validate_scene(parse_scene_text(
+            dense_spheres(0.9).replace("hardness = { k_star = 1e5 }", "hardness = { k_star = 1e6 }")
+            .replace("steps_per_contact = 50", "steps_per_contact = 10")))
+        runs.append(("spheres φ = 0.55, e = 0.9", "lammps", stiff, {}, "soft, k* = 1e6"))
+    print("\n| case | t_c | P | T | E_rot | elastic share |\n|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
-        for engine, what, options, label in runs:
-            out = Path(tmp) / f"p-{engine}-{len(label)}.h5"
-            ds.run(what, engine, out, isolate=False, progress=False, **options)
+        for name, engine, scene, options, label in runs:
+            out = Path(tmp) / "p.h5"
+            ds.run(scene, engine, out, isolate=False, progress=False, **options)
             with h5py.File(out, "r") as h5:
                 ts = h5["timeseries"]
                 keep = ts["time"][:] > scene.run.equilibration
                 cells = [block_mean(ts[k][:][keep]) for k in
                          ("pressure", "temperature", "rotational_energy")]
                 share = float(h5.attrs.get("tc_elastic_fraction", np.nan))
-            print(f"| {label} | " + " | ".join(f"{m:.4g} ± {e:.2g}" for m, e in cells)
+            out.unlink()
+            print(f"| {name} | {label} | " + " | ".join(f"{m:.4g} ± {e:.2g}" for m, e in cells)
                   + f" | {100 * share:.3g} % |")
 
 
@@ -153,13 +182,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--only", nargs="*", choices=sorted(CASES), default=sorted(CASES))
-    parser.add_argument("--pressure", action="store_true",
-                        help="the φ = 0.55 shear's pressure at t_c = 1e-4 … 1e-7 instead")
+    parser.add_argument("--pressure", nargs="*", choices=sorted(PRESSURE_CASES), default=None,
+                        help="dense shear flows' pressure at t_c = 1e-4 … 1e-7 instead (the "
+                             "cases named, all without a name)")
     parser.add_argument("--soft", action="store_true",
                         help="with --pressure: also LAMMPS at k* = 1e6")
     args = parser.parse_args()
-    if args.pressure:
-        pressure_ladder(args.soft)
+    if args.pressure is not None:
+        pressure_ladder(args.pressure or list(PRESSURE_CASES), args.soft)
         return
     texts = {name: CASES[name]() for name in args.only}
     found: dict[tuple[str, float], list[dict]] = {}
