@@ -19,6 +19,7 @@ from pathlib import Path
 import demstudy as ds
 from demstudy.accuracy.analyze import run_error
 from demstudy.accuracy.plan import stiffness_scale
+from demstudy.engines.edmd import default_tc
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "analysis"))  # the studies' definitions
@@ -45,7 +46,12 @@ def main(argv: list[str] | None = None) -> int:
         scene = scene.model_copy(update={"soft": soft})
         res = ds.run(scene, engine="lammps", out=args.out / "auto" / f"{name}.h5",
                      progress=False)
-        refs = sorted(str(p) for p in folder.glob("ref-edmd-tc1e-05-r*.h5"))
+        # the cost study's references at the event-driven default for the scene's dimension
+        tc = default_tc(scene.dimension)
+        refs = sorted(str(p) for p in folder.glob(f"ref-edmd-tc{tc:g}-r*.h5"))
+        if not refs:
+            raise SystemExit(f"{folder}: no reference ref-edmd-tc{tc:g}-r*.h5 (run the cost "
+                             "study there first)")
         (comparison,) = ds.compare(refs, res)
         err = run_error(comparison)
         kstar = float(res.attrs["kn"]) / stiffness_scale(scene).unit

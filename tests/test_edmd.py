@@ -708,3 +708,26 @@ def test_a_periodic_box_shorter_than_three_diameters_is_refused_by_name(tmp_path
                        run={"equilibration": 0.0, "production": 1.0, "sample_interval": 1.0})
     with pytest.raises(UnsupportedByEngine, match=r"box.size = .*at least 3 largest diameters"):
         run_scene(scene, "edmd", RunOptions(out=tmp_path / "x.h5", progress=False))
+
+
+def test_resume_without_tc_keeps_the_checkpoints_tc_and_says_so(tmp_path, capfd):
+    """A run stopped at a t_c that is not its dimension's default (here 1e-4 for discs; in
+    practice a 3D run started at 1e-5 before spheres defaulted to 1e-6) continues at its own
+    t_c when resumed without one, records it, and says at the end that it is not a default
+    run; with another explicit t_c it is refused."""
+    from demstudy.errors import EngineError
+
+    scene = engine_scene({"run.production": 1.0})
+    out = tmp_path / "r.h5"
+    with pytest.raises(EngineError, match="--resume"):
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, wall_limit=0.0,
+                                            extra={"tc": 1e-4}))
+    with pytest.raises(EngineError, match="checkpoint was run with --tc 0.0001"):
+        run_scene(scene, "edmd", RunOptions(out=out, progress=False, resume=True,
+                                            extra={"tc": 1e-5}))
+    capfd.readouterr()
+    res = read_results(run_scene(scene, "edmd", RunOptions(out=out, progress=False,
+                                                           resume=True)))
+    assert res.attrs["tc"] == 1e-4
+    err = capfd.readouterr().err
+    assert "resumed at the checkpoint's t_c = 0.0001, not the default 1e-05" in err

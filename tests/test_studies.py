@@ -605,7 +605,11 @@ def test_a_run_at_another_t_c_is_not_taken_for_the_case(tmp_path):
     assert option_mismatch({"tc": 1e-5, **discs}, "edmd", {"tc": 1e-6}) == (
         "made at t_c = 1e-05, the run asks for t_c = 1e-06")
     assert option_mismatch(discs, "edmd", {"tc": 1e-6}) is None  # older than the attribute
-    assert option_mismatch({"tc": 1e-5}, "edmd", {"tc": 1e-6}) is None  # no scene: can't tell
+    assert option_mismatch({"tc": 1e-5}, "edmd", {"tc": 1e-6}) == (  # no scene, explicit t_c
+        "made at t_c = 1e-05, the run asks for t_c = 1e-06")
+    assert option_mismatch({"tc": 1e-5}, "edmd", {}) is None  # no scene: the default unknown
+    assert option_mismatch({"tc": 1e-5, "scene_toml": b"dimension = 3\n"}, "edmd", {}) == (
+        "made at t_c = 1e-05, the run asks for t_c = 1e-06")
     assert option_mismatch({"tc": 1e-5, **discs}, "lammps", {"tc": 1e-6}) is None
     scene = load_scene("campbell1982/couette-rough", ["run.equilibration=0",
                                                       "run.production=2"])

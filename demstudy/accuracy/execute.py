@@ -53,8 +53,11 @@ def _dimension(attrs: Mapping[str, Any]) -> int | None:
     """The dimension of the scene a results file's root ``attrs`` hold (None: unreadable)."""
     import tomllib
 
+    text = attrs.get("scene_toml")
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", "replace")
     try:
-        return int(tomllib.loads(str(attrs["scene_toml"]))["dimension"])
+        return int(tomllib.loads(str(text))["dimension"])
     except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
         return None
 
@@ -64,10 +67,13 @@ def option_mismatch(attrs: Mapping[str, Any], engine: str,
     """Why a finished run (its results file's root ``attrs``) is not the run of ``engine``
     with ``options``, for the engine options that change the physics (None: it is): the
     event-driven engine's t_c (the option, else the engine's default for the scene's
-    dimension). A file that does not record it (older than the attribute) or its scene cannot
-    tell, and passes."""
-    dimension = _dimension(attrs)
-    wanted = None if dimension is None else wanted_tc(engine, options, dimension)
+    dimension). A file that does not record it (older than the attribute) cannot tell, and
+    passes; so does one whose scene cannot be read when the default is asked for."""
+    if "tc" in (options or {}):  # asked for explicitly: the dimension does not matter
+        wanted = wanted_tc(engine, options, 3)
+    else:
+        dimension = _dimension(attrs)
+        wanted = None if dimension is None else wanted_tc(engine, options, dimension)
     if wanted is None or attrs.get("tc") is None:
         return None
     made = float(attrs["tc"])

@@ -119,6 +119,7 @@ class EdmdBackend(BackendBase):
     def __init__(self, scene: Scene, options, workdir):
         super().__init__(scene, options, workdir)
         self.tc = float(options.extra.get("tc", default_tc(scene.dimension)))
+        self.resumed_tc_note = ""
         # whether a collision can lose energy: with t_c = 0 a stall is then inelastic collapse
         self.dissipative = (scene.contact.restitution < 1.0
                             or scene.contact.law.model != "constant"
@@ -148,7 +149,14 @@ class EdmdBackend(BackendBase):
             if "tc" in self.run_options.extra:  # asked for explicitly: refuse to change it
                 raise EngineError(f"--resume: the checkpoint was run with --tc "
                                   f"{saved['tc']:g}, this call has {self.tc:g}")
-            self.tc = float(saved["tc"])  # not given: continue with the run's own t_c
+            # not given: continue with the run's own t_c (a run started before the default
+            # changed, e.g. spheres at 1e-5 before 1e-6), and say so at the end
+            self.resumed_tc_note = (
+                f"note: resumed at the checkpoint's t_c = {saved['tc']:g}, not the default "
+                f"{self.tc:g} for this dimension; the results say t_c = {saved['tc']:g}, and a "
+                f"study or cost ladder that asks for the default will remake the run (give "
+                f"--tc {saved['tc']:g} to keep it)")
+            self.tc = float(saved["tc"])
         self.core: EventDriven = from_initial_state(everything, scene.box.size, tc=self.tc,
                                                     **options)
         if saved is not None:
@@ -288,4 +296,5 @@ class EdmdBackend(BackendBase):
 
     def end_notes(self, attrs: dict) -> list[str]:
         share = TcShare.from_attrs(attrs)
-        return [share.line()] + ([share.warning()] if share.warning() else [])
+        return ([share.line()] + ([share.warning()] if share.warning() else [])
+                + ([self.resumed_tc_note] if self.resumed_tc_note else []))

@@ -42,7 +42,7 @@ from ..._native import EventDriven, edmd_collide_pair
 from ...errors import EngineError
 from ...scene.initial import InitialState
 
-#: the TC time of 3D runs: dense sheared spheres keep the elastic share below 1-6 % and their
+#: the TC time of 3D runs: dense sheared spheres keep their elastic share at 0.3-6 % and their
 #: pressure converged (φ = 0.55 shear, e = 0.9: P 42.0 ± 0.9 at 1e-5, 47.1 ± 1.3 at 1e-6,
 #: 46.1 ± 1.7 at 1e-7; e = 0.7: 58.7, 76.5, 78.7) at ×1.0-2.1 the cost of 1e-5; a bed at rest
 #: costs ~1/t_c events per particle and time unit (×5 at 1e-6)

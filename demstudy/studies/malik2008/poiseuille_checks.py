@@ -90,7 +90,8 @@ def _with_steady_note(reason: str, ds: FlowData | Sequence[FlowData]) -> str:
     note, reason = _steady_note(ds).strip(), reason.strip()
     if not note or not reason:
         return reason or note
-    return f"{reason.rstrip(';:,')}{'' if reason.endswith('.') else '.'} {note}"
+    reason = reason.rstrip(";:,").rstrip()
+    return f"{reason}{'' if reason.endswith('.') else '.'} {note}"
 
 
 def _cap(verdict: str, ds: FlowData | Sequence[FlowData]) -> str:
