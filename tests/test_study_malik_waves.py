@@ -477,6 +477,13 @@ def test_the_tc_twin_check_compares_class_ke_and_share(tmp_path: Path) -> None:
     beyond = tc_dependence(box, dataclasses.replace(base, ke_halves=((m1, e1), (m2, err))),
                            dataclasses.replace(twin, ke_halves=((m1, e1), (1.13 * m2, err))))
     assert beyond.verdict == PARTLY and "more than 2σ + 10 %" in beyond.reason
+    # within the tolerance both, but one half resolved (35σ): the reason names it too
+    sharp = ((m1, 0.001 * m1), (m2, 0.05 * m2))
+    resolved = tc_dependence(box, dataclasses.replace(base, ke_halves=sharp),
+                             dataclasses.replace(twin, ke_halves=(
+                                 (1.05 * m1, 0.001 * m1), (1.12 * m2, 0.05 * m2))))
+    assert resolved.verdict == REPRODUCED
+    assert "at most 12.0 % (1.7σ); the other half 5.0 % (35.4σ, resolved)" in resolved.reason
     shared = tc_dependence(box, base, dataclasses.replace(twin, tc_fraction=0.08))
     assert shared.verdict == PARTLY and "≥ 5 %" in shared.reason
     unknown = tc_dependence(box, base, dataclasses.replace(twin, tc_fraction=float("nan")))
