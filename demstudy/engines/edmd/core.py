@@ -47,8 +47,9 @@ from ...scene.initial import InitialState
 #: 46.1 ± 1.7 at 1e-7; e = 0.7: 58.7, 76.5, 78.7) at ×1.0-2.1 the cost of 1e-5; a bed at rest
 #: costs ~1/t_c events per particle and time unit (×5 at 1e-6)
 DEFAULT_TC_3D = 1e-6
-#: the TC time of 2D runs: in dense 2D flows a smaller t_c raised the share instead (the
-#: elastic collisions are a cluster's re-collisions) and cost ×7 (Campbell's chute)
+#: the TC time of 2D runs: mildly dissipative dense shear is converged at any t_c, strongly
+#: dissipative shear at none (ν = 0.75, e = 0.5: the run warns), and in Campbell's chute a
+#: smaller t_c raised the share (a cluster's re-collisions) at ×7.6 the cost
 DEFAULT_TC_2D = 1e-5
 # events between two synchronisations and checks for a stop request; the simulated time's
 # progress is checked over windows of at least STALL_CHUNK and STALL_CHUNK_PER_PARTICLE × N
