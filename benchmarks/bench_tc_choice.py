@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import argparse
 import platform
-import re
 import statistics
 import tempfile
 import time
@@ -45,8 +44,8 @@ import h5py
 import numpy as np
 
 import demstudy as ds
-from demstudy.scene import parse_scene_text, validate_scene
-from demstudy.scene.initial import build_initial_state
+from demstudy.analysis.blocking import split_mean
+from demstudy.scene import Scene, parse_scene_text, validate_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 TCS = (1e-4, 1e-5, 1e-6)
@@ -85,31 +84,25 @@ seed = 3
 """
 
 
-def shortened(path: str, **run: float) -> str:
-    """The scene file's text with its ``[run]`` lengths replaced."""
-    text = (ROOT / path).read_text()
-    for key, value in run.items():
-        text, n = re.subn(rf"^{key}\s*=\s*[0-9.eE+-]+", f"{key} = {value}", text, flags=re.M)
-        assert n == 1, f"{path}: no single {key} to replace"
-    return text
+def shortened(path: str, equilibration: float, production: float, **sections) -> Scene:
+    """The scene file (under the repository) with its run lengths and ``sections`` replaced."""
+    run = {"equilibration": equilibration, "production": production}
+    return ds.load_scene(ROOT / path, **{**sections, "run": {**sections.get("run", {}), **run}})
 
 
 CASES = {
     "le3d-0.55": lambda: shortened("inputs/accuracy-cost/lees-edwards-3d-phi0.55.toml",
-                                   equilibration=10.0, production=20.0),
+                                   10.0, 20.0),
     "le3d-0.3": lambda: shortened("inputs/accuracy-cost/lees-edwards-3d-phi0.3.toml",
-                                  equilibration=10.0, production=20.0),
-    "le2d-0.5": lambda: shortened("inputs/shear/lees-edwards-2d.toml",
-                                  equilibration=10.0, production=20.0),
-    "chute2d-30": lambda: shortened("inputs/campbell1982/chute-bumpy-30.toml",
-                                    equilibration=100.0, production=300.0),
-    "bed3d": lambda: BED3D,
+                                  10.0, 20.0),
+    "le2d-0.5": lambda: shortened("inputs/shear/lees-edwards-2d.toml", 10.0, 20.0),
+    "chute2d-30": lambda: shortened("inputs/campbell1982/chute-bumpy-30.toml", 100.0, 300.0),
+    "bed3d": lambda: validate_scene(parse_scene_text(BED3D)),
 }
 
 
-def one_run(text: str, tc: float, folder: Path) -> dict:
-    scene = validate_scene(parse_scene_text(text))
-    particles = len(build_initial_state(scene).position)
+def one_run(scene: Scene, tc: float, folder: Path) -> dict:
+    particles = scene.n_particles
     out = folder / f"{scene.meta.name}-tc{tc:g}.h5"
     start = time.perf_counter()
     ds.run(scene, "edmd", out, isolate=False, progress=False, tc=tc)
@@ -123,27 +116,19 @@ def one_run(text: str, tc: float, folder: Path) -> dict:
     return {"wall": wall, "share": share, "rate": rate}
 
 
-def block_mean(x: np.ndarray, blocks: int = 8) -> tuple[float, float]:
-    """Mean and its standard error from ``blocks`` consecutive block means."""
-    means = np.array([b.mean() for b in np.array_split(np.asarray(x, float), blocks)])
-    return float(means.mean()), float(means.std(ddof=1) / np.sqrt(blocks))
-
-
-def dense_discs(nu: float, e: float) -> str:
+def dense_discs(nu: float, e: float) -> Scene:
     """The 2D shear scene (β = 0.5) in a 30 × 30 box at ν and e, 10 + 40 strain units."""
-    text = shortened("inputs/shear/lees-edwards-2d.toml", equilibration=10.0, production=40.0)
-    for key, value in (("solid_fraction", nu), ("restitution", e)):
-        text = re.sub(rf"^{key}\s*=\s*[0-9.]+", f"{key} = {value}", text, count=1, flags=re.M)
-    return text.replace("size = [56.0, 56.0]", "size = [30.0, 30.0]")
+    return shortened("inputs/shear/lees-edwards-2d.toml", 10.0, 40.0, box={"size": [30.0, 30.0]},
+                     particles={"solid_fraction": nu}, contact={"restitution": e})
 
 
-def dense_spheres(e: float) -> str:
+def dense_spheres(e: float, **sections) -> Scene:
     """The φ = 0.55 shear (β = 0.5, N = 1050) at e, 10 + 40 strain units."""
-    text = CASES["le3d-0.55"]().replace("production = 20.0", "production = 40.0")
-    return re.sub(r"^restitution\s*=\s*[0-9.]+", f"restitution = {e}", text, count=1, flags=re.M)
+    return shortened("inputs/accuracy-cost/lees-edwards-3d-phi0.55.toml", 10.0, 40.0,
+                     contact={"restitution": e}, **sections)
 
 
-PRESSURE_CASES = {  # name: (label, scene text)
+PRESSURE_CASES = {  # name: (label, scene)
     "le3d-0.55-e0.9": ("spheres φ = 0.55, e = 0.9", lambda: dense_spheres(0.9)),
     "le3d-0.55-e0.7": ("spheres φ = 0.55, e = 0.7", lambda: dense_spheres(0.7)),
     "le2d-0.7-e0.9": ("discs ν = 0.7, e = 0.9", lambda: dense_discs(0.7, 0.9)),
@@ -154,13 +139,11 @@ PRESSURE_CASES = {  # name: (label, scene text)
 def pressure_ladder(names: list[str], soft: bool) -> None:
     runs = []
     for key in names:
-        name, text = PRESSURE_CASES[key]
-        scene = validate_scene(parse_scene_text(text()))
+        name, scene_of = PRESSURE_CASES[key]
+        scene = scene_of()
         runs += [(name, "edmd", scene, {"tc": tc}, f"{tc:g}") for tc in (1e-4, 1e-5, 1e-6, 1e-7)]
     if soft:
-        stiff = validate_scene(parse_scene_text(
-            dense_spheres(0.9).replace("hardness = { k_star = 1e5 }", "hardness = { k_star = 1e6 }")
-            .replace("steps_per_contact = 50", "steps_per_contact = 10")))
+        stiff = dense_spheres(0.9, soft={"hardness": {"k_star": 1e6}, "steps_per_contact": 10})
         runs.append(("spheres φ = 0.55, e = 0.9", "lammps", stiff, {}, "soft, k* = 1e6"))
     print("\n| case | t_c | P | T | E_rot | elastic share |\n|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
@@ -170,7 +153,7 @@ def pressure_ladder(names: list[str], soft: bool) -> None:
             with h5py.File(out, "r") as h5:
                 ts = h5["timeseries"]
                 keep = ts["time"][:] > scene.run.equilibration
-                cells = [block_mean(ts[k][:][keep]) for k in
+                cells = [split_mean(ts[k][:][keep], blocks=8) for k in
                          ("pressure", "temperature", "rotational_energy")]
                 share = float(h5.attrs.get("tc_elastic_fraction", np.nan))
             out.unlink()
@@ -191,20 +174,20 @@ def main() -> None:
     if args.pressure is not None:
         pressure_ladder(args.pressure or list(PRESSURE_CASES), args.soft)
         return
-    texts = {name: CASES[name]() for name in args.only}
+    scenes = {name: CASES[name]() for name in args.only}
     found: dict[tuple[str, float], list[dict]] = {}
     with tempfile.TemporaryDirectory() as tmp:
-        one_run(BED3D, 1e-4, Path(tmp))  # warm-up: imports and the first run's set-up
+        one_run(CASES["bed3d"](), 1e-4, Path(tmp))  # warm-up: imports and the first run's set-up
         for _ in range(args.repeat):
-            for name, text in texts.items():
+            for name, scene in scenes.items():
                 for tc in TCS:
-                    found.setdefault((name, tc), []).append(one_run(text, tc, Path(tmp)))
+                    found.setdefault((name, tc), []).append(one_run(scene, tc, Path(tmp)))
     print(f"\n{platform.processor() or platform.machine()}, Python {platform.python_version()}, "
           f"{args.repeat} interleaved rounds\n")
     print("| case | t_c | wall time (s), median (range) | × t_c = 1e-5 | elastic share | "
           "pair collisions per particle per τ |")
     print("|---|---|---|---|---|---|")
-    for name in texts:
+    for name in scenes:
         base = statistics.median(r["wall"] for r in found[(name, 1e-5)])
         for tc in TCS:
             runs = found[(name, tc)]

@@ -38,15 +38,19 @@ class Task:
         return scene_for(base, self.spec)
 
 
-def wanted_tc(engine: str, options: Mapping[str, Any] | None, dimension: int) -> float | None:
+def wanted_tc(engine: str, options: Mapping[str, Any] | None,
+              dimension: int | None) -> float | None:
     """The TC time a run of ``engine`` with ``options`` in a ``dimension``-D scene is made at:
     the ``tc`` option, else the event-driven engine's default for that dimension
-    (``engines.edmd.core.default_tc``); None for engines without a TC model."""
+    (``engines.edmd.core.default_tc``); None for engines without a TC model, and for the
+    default of an unknown dimension."""
     if engine != "edmd":
         return None
+    if "tc" in (options or {}):
+        return float(options["tc"])
     from ..engines.edmd.core import default_tc
 
-    return float((options or {}).get("tc", default_tc(dimension)))
+    return None if dimension is None else default_tc(dimension)
 
 
 def _dimension(attrs: Mapping[str, Any]) -> int | None:
@@ -69,11 +73,7 @@ def option_mismatch(attrs: Mapping[str, Any], engine: str,
     event-driven engine's t_c (the option, else the engine's default for the scene's
     dimension). A file that does not record it (older than the attribute) cannot tell, and
     passes; so does one whose scene cannot be read when the default is asked for."""
-    if "tc" in (options or {}):  # asked for explicitly: the dimension does not matter
-        wanted = wanted_tc(engine, options, 3)
-    else:
-        dimension = _dimension(attrs)
-        wanted = None if dimension is None else wanted_tc(engine, options, dimension)
+    wanted = wanted_tc(engine, options, _dimension(attrs))
     if wanted is None or attrs.get("tc") is None:
         return None
     made = float(attrs["tc"])
